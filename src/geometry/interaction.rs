@@ -1,0 +1,44 @@
+//! What a closest-hit query returns.
+
+use glam::{Vec2, Vec3};
+
+/// Sentinel for "no area light attached".
+pub const NO_LIGHT: u32 = u32::MAX;
+
+/// A ray–surface intersection.
+///
+/// Normal conventions follow pbrt-v4: `ng` is the geometric normal of the primitive (for
+/// triangle meshes with per-vertex normals it is flipped to the side of the shading normal;
+/// otherwise its orientation follows the winding/ReverseOrientation). It is *not* flipped
+/// toward the ray; one-sided area lights emit on the side of `ng`.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Hit point (world space).
+    pub p: Vec3,
+    /// Unit geometric normal.
+    pub ng: Vec3,
+    /// Unit shading normal (interpolated, same hemisphere as `ng`).
+    pub ns: Vec3,
+    /// Surface parameterisation (texture coordinates).
+    pub uv: Vec2,
+    /// Conservative absolute error bound of `p`, used to offset spawned rays.
+    pub p_error: f32,
+    /// Index of the primitive in the scene's geometry.
+    pub prim: u32,
+    /// Material index into `Scene::materials`.
+    pub material: u32,
+    /// Index into `Scene::lights` of the area light on this primitive, or [`NO_LIGHT`].
+    pub light: u32,
+}
+
+impl SurfaceHit {
+    /// Origin for a ray leaving the surface toward direction `w` (offset along ±ng by the
+    /// error bound so it cannot re-hit the surface it leaves).
+    #[inline]
+    pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
+        let off = self.ng * self.p_error;
+        if w.dot(self.ng) >= 0.0 { self.p + off } else { self.p - off }
+    }
+}

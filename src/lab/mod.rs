@@ -1,0 +1,1 @@
+//! The lab: comparison figures, convergence plots and the HTML report. TODO(issue 7).

@@ -1,0 +1,28 @@
+//! Equal probability 1/N for every light.
+
+use super::{LightSelector, SelectedLight, ShadingPoint};
+
+/// Uniform light selection.
+#[derive(Clone, Copy, Debug)]
+pub struct UniformSelector {
+    /// Number of lights.
+    pub count: u32,
+}
+
+impl LightSelector for UniformSelector {
+    fn sample(&self, _ctx: &ShadingPoint, u: f32) -> Option<SelectedLight> {
+        if self.count == 0 {
+            return None;
+        }
+        let index = ((u * self.count as f32) as u32).min(self.count - 1);
+        Some(SelectedLight { index, pmf: 1.0 / self.count as f32 })
+    }
+
+    fn pmf(&self, _ctx: &ShadingPoint, light: u32) -> f32 {
+        if light < self.count { 1.0 / self.count as f32 } else { 0.0 }
+    }
+
+    fn name(&self) -> &'static str {
+        "uniform"
+    }
+}

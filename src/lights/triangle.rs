@@ -1,0 +1,85 @@
+//! Diffuse emissive triangle. TODO(issue 4): spherical-triangle solid-angle sampling.
+
+use super::{LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle};
+use crate::sampling::uniform_triangle_point;
+use crate::{Rgb, luminance};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// A triangle emitting constant radiance `l` on the side of `n` (both sides if `two_sided`).
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleLight {
+    /// Vertices (world space).
+    pub p: [Vec3; 3],
+    /// Unit emitting normal (the surface's geometric normal, pbrt orientation).
+    pub n: Vec3,
+    /// Area.
+    pub area: f32,
+    /// Emitted radiance.
+    pub l: Rgb,
+    /// Emits on both sides.
+    pub two_sided: bool,
+}
+
+impl TriangleLight {
+    /// A light on triangle (p0, p1, p2) with emitting normal `n`; `None` if the area is zero.
+    pub fn new(p: [Vec3; 3], n: Vec3, l: Rgb, two_sided: bool) -> Option<Self> {
+        let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+        if !(area > 0.0) || !area.is_finite() {
+            return None;
+        }
+        Some(Self { p, n: n.normalize(), area, l, two_sided })
+    }
+
+    #[inline]
+    fn emits_toward(&self, w: Vec3) -> bool {
+        self.two_sided || self.n.dot(w) > 0.0
+    }
+}
+
+impl LightSource for TriangleLight {
+    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2, _mode: SamplingMode) -> Option<LightLiSample> {
+        let p_light = uniform_triangle_point(u, self.p[0], self.p[1], self.p[2]);
+        let d = p_light - ctx.p;
+        let dist = d.length();
+        if dist == 0.0 {
+            return None;
+        }
+        let wi = d / dist;
+        if !self.emits_toward(-wi) {
+            return None;
+        }
+        let pdf = area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n);
+        if !(pdf > 0.0) || !pdf.is_finite() {
+            return None;
+        }
+        Some(LightLiSample { wi, li: self.l, pdf, p_light, delta: false })
+    }
+
+    fn pdf_li(&self, ctx: &LightSampleContext, _wi: Vec3, p_light: Vec3, _n_light: Vec3, _mode: SamplingMode) -> f32 {
+        area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n)
+    }
+
+    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
+        if self.emits_toward(w) { self.l } else { Rgb::ZERO }
+    }
+
+    fn power(&self) -> f32 {
+        let sides = if self.two_sided { 2.0 } else { 1.0 };
+        luminance(self.l) * self.area * PI * sides
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        let min = self.p[0].min(self.p[1]).min(self.p[2]);
+        let max = self.p[0].max(self.p[1]).max(self.p[2]);
+        Some(LightBounds {
+            min,
+            max,
+            w: self.n,
+            phi: self.power(),
+            cos_theta_o: 1.0,
+            cos_theta_e: 0.0,
+            two_sided: self.two_sided,
+        })
+    }
+}

@@ -1,0 +1,77 @@
+//! RGB textures over (u, v).
+
+use crate::Rgb;
+use glam::Vec2;
+use std::sync::Arc;
+
+/// A linear-RGB image sampled by (u, v), v = 0 at the bottom row (pbrt convention).
+#[derive(Clone, Debug)]
+pub struct ImageRgb {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major pixels, top row first.
+    pub pixels: Vec<Rgb>,
+}
+
+/// A colour that can vary over the surface.
+#[derive(Clone, Debug)]
+pub enum Texture {
+    /// The same colour everywhere.
+    Constant(Rgb),
+    /// Bilinearly filtered image lookup times a scale.
+    Image {
+        /// The image.
+        image: Arc<ImageRgb>,
+        /// Multiplier.
+        scale: Rgb,
+    },
+    /// Two colours in a checkerboard of `freq` squares per unit of uv.
+    Checkerboard {
+        /// Colour of even squares.
+        a: Rgb,
+        /// Colour of odd squares.
+        b: Rgb,
+        /// Squares per unit uv (u, v).
+        freq: Vec2,
+    },
+}
+
+impl Texture {
+    /// Value at texture coordinates `uv`.
+    pub fn eval(&self, uv: Vec2) -> Rgb {
+        match self {
+            Texture::Constant(c) => *c,
+            Texture::Image { image, scale } => image.bilinear(uv) * *scale,
+            Texture::Checkerboard { a, b, freq } => {
+                let s = (uv * *freq).floor();
+                if ((s.x + s.y) as i64).rem_euclid(2) == 0 { *a } else { *b }
+            }
+        }
+    }
+}
+
+impl ImageRgb {
+    /// Bilinear lookup with wrap-around addressing.
+    pub fn bilinear(&self, uv: Vec2) -> Rgb {
+        if self.width == 0 || self.height == 0 {
+            return Rgb::ZERO;
+        }
+        let (w, h) = (self.width as i64, self.height as i64);
+        let x = uv.x * w as f32 - 0.5;
+        let y = (1.0 - uv.y) * h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let at = |i: i64, j: i64| -> Rgb {
+            let i = i.rem_euclid(w) as usize;
+            let j = j.rem_euclid(h) as usize;
+            self.pixels[j * self.width as usize + i]
+        };
+        let (xi, yi) = (x0 as i64, y0 as i64);
+        at(xi, yi) * (1.0 - fx) * (1.0 - fy)
+            + at(xi + 1, yi) * fx * (1.0 - fy)
+            + at(xi, yi + 1) * (1.0 - fx) * fy
+            + at(xi + 1, yi + 1) * fx * fy
+    }
+}

@@ -1,0 +1,44 @@
+//! Stateless hashing and per-sample PCG streams: every random number is a pure function of
+//! (seed, pixel, sample index, dimension), so renders are identical under any scheduling.
+
+use rand_core::Rng;
+use rand_pcg::Pcg32;
+
+/// 64-bit finaliser (splitmix64 / murmur3 style): a good avalanche for combining keys.
+#[inline]
+pub fn mix64(mut x: u64) -> u64 {
+    x ^= x >> 30;
+    x = x.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x ^= x >> 27;
+    x = x.wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+/// Hash any number of 64-bit keys into one well-mixed 64-bit value.
+#[inline]
+pub fn hash_keys(keys: &[u64]) -> u64 {
+    let mut h = 0x9e37_79b9_7f4a_7c15u64;
+    for &k in keys {
+        h = mix64(h ^ k.wrapping_add(0x9e37_79b9_7f4a_7c15).wrapping_add(h << 6));
+    }
+    h
+}
+
+/// A PCG32 stream seeded from a hash of keys (no state shared between threads).
+#[inline]
+pub fn pcg_from_keys(keys: &[u64]) -> Pcg32 {
+    let h = hash_keys(keys);
+    Pcg32::new(h, mix64(h ^ 0xda3e_39cb_94b9_5bdb) | 1)
+}
+
+/// A uniform f32 in [0, 1) from the top 24 bits of a u32.
+#[inline]
+pub fn u32_to_unit(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+/// The next uniform f32 in [0, 1) of a PCG stream.
+#[inline]
+pub fn next_f32(rng: &mut Pcg32) -> f32 {
+    u32_to_unit(rng.next_u32())
+}

@@ -1,0 +1,26 @@
+//! All sampling math: warps by inversion with their pdfs (and inverses), discrete and
+//! piecewise-constant distributions, orthonormal frames, and the per-pixel sample patterns.
+//!
+//! Nothing here knows about rendering; every BSDF, light, light selector and integrator calls
+//! into this module instead of re-deriving a warp.
+
+pub mod alias;
+pub mod chi2;
+pub mod distribution1d;
+pub mod distribution2d;
+pub mod frame;
+pub mod hash;
+pub mod pattern;
+pub mod spherical_rectangle;
+pub mod spherical_triangle;
+pub mod warps;
+
+pub use alias::AliasTable;
+pub use distribution1d::Distribution1D;
+pub use distribution2d::Distribution2D;
+pub use frame::Frame;
+pub use pattern::{PatternKind, SamplePattern};
+pub use warps::*;
+
+/// The largest f32 strictly below 1, so that samples stay in [0, 1).
+pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;

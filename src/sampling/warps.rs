@@ -1,0 +1,218 @@
+//! Warps from the unit square to hemispheres, spheres, disks, triangles and cones, each derived
+//! by the inversion method (marginal + conditional), with its pdf and, where natural, its inverse.
+//!
+//! Conventions: directions are in a local frame with +z the pole (normal); pdfs over directions
+//! are per unit solid angle; pdfs over points are per unit area.
+
+use glam::{Vec2, Vec3};
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI, TAU};
+
+/// `sqrt(max(0, x))`: guards against tiny negative arguments from rounding.
+#[inline]
+pub fn safe_sqrt(x: f32) -> f32 {
+    x.max(0.0).sqrt()
+}
+
+/// Direction with polar cosine `cos_theta` around +z and azimuth `phi`.
+#[inline]
+pub fn spherical_direction(cos_theta: f32, phi: f32) -> Vec3 {
+    let sin_theta = safe_sqrt(1.0 - cos_theta * cos_theta);
+    let (sp, cp) = phi.sin_cos();
+    Vec3::new(sin_theta * cp, sin_theta * sp, cos_theta)
+}
+
+/// Azimuth of a direction in [0, 2π).
+#[inline]
+fn azimuth(d: Vec3) -> f32 {
+    let p = d.y.atan2(d.x);
+    if p < 0.0 { p + TAU } else { p }
+}
+
+/// Uniform hemisphere: cos θ = ξ₁, φ = 2πξ₂ (marginal of θ is sin θ, conditional of φ uniform).
+#[inline]
+pub fn uniform_hemisphere(u: Vec2) -> Vec3 {
+    spherical_direction(u.x, TAU * u.y)
+}
+
+/// Pdf of [`uniform_hemisphere`]: 1/(2π) on z ≥ 0.
+#[inline]
+pub fn uniform_hemisphere_pdf(d: Vec3) -> f32 {
+    if d.z >= 0.0 { 0.5 * FRAC_1_PI } else { 0.0 }
+}
+
+/// Inverse of [`uniform_hemisphere`].
+#[inline]
+pub fn uniform_hemisphere_inverse(d: Vec3) -> Vec2 {
+    Vec2::new(d.z, azimuth(d) / TAU)
+}
+
+/// Cosine-weighted hemisphere: cos θ = √ξ₁, φ = 2πξ₂ (Malley's method by inversion).
+#[inline]
+pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
+    spherical_direction(u.x.sqrt(), TAU * u.y)
+}
+
+/// Pdf of [`cosine_hemisphere`]: cos θ / π on z ≥ 0.
+#[inline]
+pub fn cosine_hemisphere_pdf(d: Vec3) -> f32 {
+    d.z.max(0.0) * FRAC_1_PI
+}
+
+/// Inverse of [`cosine_hemisphere`].
+#[inline]
+pub fn cosine_hemisphere_inverse(d: Vec3) -> Vec2 {
+    Vec2::new(d.z * d.z, azimuth(d) / TAU)
+}
+
+/// Cosine-power (Phong lobe) hemisphere, pdf ∝ cosⁿθ: the marginal cdf of θ is
+/// 1 − cos^(n+1)θ, so cos θ = ξ₁^(1/(n+1)); φ = 2πξ₂.
+#[inline]
+pub fn cosine_power_hemisphere(u: Vec2, n: f32) -> Vec3 {
+    spherical_direction(u.x.powf(1.0 / (n + 1.0)), TAU * u.y)
+}
+
+/// Pdf of [`cosine_power_hemisphere`]: (n+1)/(2π)·cosⁿθ on z ≥ 0.
+#[inline]
+pub fn cosine_power_hemisphere_pdf(d: Vec3, n: f32) -> f32 {
+    if d.z <= 0.0 {
+        return 0.0;
+    }
+    (n + 1.0) * 0.5 * FRAC_1_PI * d.z.powf(n)
+}
+
+/// Inverse of [`cosine_power_hemisphere`].
+#[inline]
+pub fn cosine_power_hemisphere_inverse(d: Vec3, n: f32) -> Vec2 {
+    Vec2::new(d.z.max(0.0).powf(n + 1.0), azimuth(d) / TAU)
+}
+
+/// Uniform sphere: cos θ = 1 − 2ξ₁, φ = 2πξ₂.
+#[inline]
+pub fn uniform_sphere(u: Vec2) -> Vec3 {
+    spherical_direction(1.0 - 2.0 * u.x, TAU * u.y)
+}
+
+/// Pdf of [`uniform_sphere`]: 1/(4π).
+#[inline]
+pub fn uniform_sphere_pdf() -> f32 {
+    0.25 * FRAC_1_PI
+}
+
+/// Inverse of [`uniform_sphere`].
+#[inline]
+pub fn uniform_sphere_inverse(d: Vec3) -> Vec2 {
+    Vec2::new((1.0 - d.z) * 0.5, azimuth(d) / TAU)
+}
+
+/// Shirley–Chiu concentric map of the unit square to the unit disk (area preserving,
+/// low distortion, so stratification survives the warp).
+#[inline]
+pub fn concentric_disk(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, FRAC_PI_4 * (o.y / o.x))
+    } else {
+        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
+    };
+    let (s, c) = theta.sin_cos();
+    Vec2::new(r * c, r * s)
+}
+
+/// Pdf of [`concentric_disk`] per unit area: 1/π inside the unit disk.
+#[inline]
+pub fn concentric_disk_pdf(p: Vec2) -> f32 {
+    if p.length_squared() <= 1.0 { FRAC_1_PI } else { 0.0 }
+}
+
+/// Inverse of [`concentric_disk`].
+pub fn concentric_disk_inverse(p: Vec2) -> Vec2 {
+    let r = p.length();
+    if r == 0.0 {
+        return Vec2::splat(0.5);
+    }
+    let mut theta = p.y.atan2(p.x);
+    if theta < -FRAC_PI_4 {
+        theta += TAU;
+    }
+    // The four wedges of the square map to the four quarter-sectors of the disk.
+    let (a, b) = if theta < FRAC_PI_4 {
+        (r, r * theta / FRAC_PI_4)
+    } else if theta < 3.0 * FRAC_PI_4 {
+        (-r * (theta - FRAC_PI_2) / FRAC_PI_4, r)
+    } else if theta < 5.0 * FRAC_PI_4 {
+        (-r, -r * (theta - PI) / FRAC_PI_4)
+    } else {
+        (r * (theta - 3.0 * FRAC_PI_2) / FRAC_PI_4, -r)
+    };
+    (Vec2::new(a, b) + Vec2::ONE) * 0.5
+}
+
+/// Uniform barycentrics (b0, b1) on a triangle; b2 = 1 − b0 − b1. Uses the square-root
+/// parametrisation: b0 = 1 − √ξ₁, b1 = ξ₂√ξ₁ (marginal + conditional inversion of the area).
+#[inline]
+pub fn uniform_triangle(u: Vec2) -> Vec2 {
+    let su = u.x.sqrt();
+    Vec2::new(1.0 - su, u.y * su)
+}
+
+/// Inverse of [`uniform_triangle`].
+#[inline]
+pub fn uniform_triangle_inverse(b: Vec2) -> Vec2 {
+    let su = 1.0 - b.x;
+    let v = if su > 0.0 { b.y / su } else { 0.5 };
+    Vec2::new(su * su, v)
+}
+
+/// Point uniformly distributed by area on triangle (p0, p1, p2); pdf = 1/area.
+#[inline]
+pub fn uniform_triangle_point(u: Vec2, p0: Vec3, p1: Vec3, p2: Vec3) -> Vec3 {
+    let b = uniform_triangle(u);
+    p0 * b.x + p1 * b.y + p2 * (1.0 - b.x - b.y)
+}
+
+/// Uniform in the solid angle of a cone around +z with cos of half-angle `cos_max`:
+/// cos θ = 1 − ξ₁(1 − cos θmax), φ = 2πξ₂.
+#[inline]
+pub fn uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
+    let cos_theta = 1.0 - u.x * (1.0 - cos_max);
+    spherical_direction(cos_theta, TAU * u.y)
+}
+
+/// Pdf of [`uniform_cone`]: 1/(2π(1 − cos θmax)) inside the cone.
+#[inline]
+pub fn uniform_cone_pdf(d: Vec3, cos_max: f32) -> f32 {
+    if d.z >= cos_max { 1.0 / (TAU * (1.0 - cos_max)) } else { 0.0 }
+}
+
+/// Inverse of [`uniform_cone`].
+#[inline]
+pub fn uniform_cone_inverse(d: Vec3, cos_max: f32) -> Vec2 {
+    Vec2::new((1.0 - d.z) / (1.0 - cos_max), azimuth(d) / TAU)
+}
+
+/// Power heuristic with β = 2 (Veach): weight of a sample drawn with `nf` samples of pdf `f_pdf`
+/// against `ng` samples of pdf `g_pdf`.
+#[inline]
+pub fn power_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
+    let f = nf * f_pdf;
+    let g = ng * g_pdf;
+    if f.is_infinite() {
+        return 1.0;
+    }
+    let (f2, g2) = (f * f, g * g);
+    if f2 + g2 == 0.0 { 0.0 } else { f2 / (f2 + g2) }
+}
+
+/// Balance heuristic (Veach).
+#[inline]
+pub fn balance_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
+    let f = nf * f_pdf;
+    let g = ng * g_pdf;
+    if f.is_infinite() {
+        return 1.0;
+    }
+    if f + g == 0.0 { 0.0 } else { f / (f + g) }
+}

@@ -1,0 +1,79 @@
+//! Scenes: the [`Scene`] every integrator renders, the [`SceneBuilder`] every loader and built-in
+//! scene fills, and the loaders themselves. Nothing below this module knows about file formats.
+//! TODO(issue 3): builder (meshes → BVH, emissive triangles → lights), built-in `cornell`.
+//! TODO(issue 5): pbrt-v4, OBJ/MTL, glTF loaders.
+
+use crate::Rgb;
+use crate::camera::Camera;
+use crate::lights::Light;
+use crate::material::Material;
+use glam::{UVec2, Vec2, Vec3};
+
+/// Pixel reconstruction filter, applied by filter importance sampling (every sample weight 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Filter {
+    /// Box of the given radius in pixels (0.5 = one pixel).
+    Box {
+        /// Radius (x, y).
+        radius: Vec2,
+    },
+    /// Tent (triangle) of the given radius.
+    Triangle {
+        /// Radius (x, y).
+        radius: Vec2,
+    },
+}
+
+/// Output settings a scene file may carry (CLI flags override them).
+#[derive(Clone, Debug)]
+pub struct FilmSpec {
+    /// Resolution in pixels.
+    pub resolution: UVec2,
+    /// Reconstruction filter.
+    pub filter: Filter,
+    /// Default output file name, if the scene names one.
+    pub filename: Option<String>,
+    /// Default eye rays per pixel, if the scene names one.
+    pub spp: Option<u32>,
+}
+
+/// Emission attached to a shape (pbrt `AreaLightSource "diffuse"`).
+#[derive(Clone, Copy, Debug)]
+pub struct AreaEmission {
+    /// Radiance (already multiplied by any scale).
+    pub l: Rgb,
+    /// Emits on both sides.
+    pub two_sided: bool,
+}
+
+/// An indexed triangle mesh in world space.
+#[derive(Clone, Debug, Default)]
+pub struct TriangleMesh {
+    /// Vertex positions (world space).
+    pub positions: Vec<Vec3>,
+    /// Optional per-vertex shading normals (world space).
+    pub normals: Option<Vec<Vec3>>,
+    /// Optional per-vertex texture coordinates.
+    pub uvs: Option<Vec<Vec2>>,
+    /// Three indices per triangle.
+    pub indices: Vec<u32>,
+    /// pbrt's `ReverseOrientation` xor "transform swaps handedness": flips the geometric
+    /// normal when the mesh has no per-vertex normals.
+    pub flip_normals: bool,
+}
+
+/// A renderable scene.
+pub struct Scene {
+    /// Geometry and its BVH.
+    pub geometry: crate::geometry::Geometry,
+    /// Materials, indexed by `SurfaceHit::material`.
+    pub materials: Vec<Material>,
+    /// All lights; area lights are referenced by `SurfaceHit::light`.
+    pub lights: Vec<Light>,
+    /// Indices of infinite lights (added to rays that escape).
+    pub infinite_lights: Vec<u32>,
+    /// The camera.
+    pub camera: Camera,
+    /// Film settings.
+    pub film: FilmSpec,
+}
