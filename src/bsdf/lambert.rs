@@ -32,7 +32,12 @@ impl Bxdf for Lambert {
         if pdf <= 0.0 {
             return None;
         }
-        Some(BsdfSample { wi, f: self.r * FRAC_1_PI, pdf, delta: false })
+        Some(BsdfSample {
+            wi,
+            f: self.r * FRAC_1_PI,
+            pdf,
+            delta: false,
+        })
     }
 
     #[inline]

@@ -11,7 +11,9 @@ pub struct Args {
 impl Args {
     /// What `penumbra` with no subcommand renders.
     pub fn default_scene() -> Self {
-        Self { scene: "cornell".into() }
+        Self {
+            scene: "cornell".into(),
+        }
     }
 }
 

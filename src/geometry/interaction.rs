@@ -39,6 +39,10 @@ impl SurfaceHit {
     #[inline]
     pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
         let off = self.ng * self.p_error;
-        if w.dot(self.ng) >= 0.0 { self.p + off } else { self.p - off }
+        if w.dot(self.ng) >= 0.0 {
+            self.p + off
+        } else {
+            self.p - off
+        }
     }
 }

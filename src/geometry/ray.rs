@@ -18,7 +18,11 @@ impl Ray {
     /// A ray with unbounded extent.
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        Self { o, d, t_max: f32::INFINITY }
+        Self {
+            o,
+            d,
+            t_max: f32::INFINITY,
+        }
     }
 
     /// Point at parameter t.

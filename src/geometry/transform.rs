@@ -19,7 +19,10 @@ impl Default for Transform {
 
 impl Transform {
     /// The identity.
-    pub const IDENTITY: Self = Self { m: Mat4::IDENTITY, m_inv: Mat4::IDENTITY };
+    pub const IDENTITY: Self = Self {
+        m: Mat4::IDENTITY,
+        m_inv: Mat4::IDENTITY,
+    };
 
     /// From a matrix; `None` if it is singular or not finite.
     pub fn new(m: Mat4) -> Option<Self> {
@@ -27,17 +30,26 @@ impl Transform {
         if !det.is_finite() || det.abs() < 1e-12 {
             return None;
         }
-        Some(Self { m, m_inv: m.inverse() })
+        Some(Self {
+            m,
+            m_inv: m.inverse(),
+        })
     }
 
     /// The inverse transform.
     pub fn inverse(&self) -> Self {
-        Self { m: self.m_inv, m_inv: self.m }
+        Self {
+            m: self.m_inv,
+            m_inv: self.m,
+        }
     }
 
     /// self ∘ other (apply `other` first).
     pub fn then_apply_to(&self, other: &Self) -> Self {
-        Self { m: self.m * other.m, m_inv: other.m_inv * self.m_inv }
+        Self {
+            m: self.m * other.m,
+            m_inv: other.m_inv * self.m_inv,
+        }
     }
 
     /// Transform a point.

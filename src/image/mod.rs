@@ -17,7 +17,11 @@ pub struct Image {
 impl Image {
     /// A black image.
     pub fn new(width: u32, height: u32) -> Self {
-        Self { width, height, pixels: vec![Rgb::ZERO; width as usize * height as usize] }
+        Self {
+            width,
+            height,
+            pixels: vec![Rgb::ZERO; width as usize * height as usize],
+        }
     }
 
     /// Pixel at (x, y).

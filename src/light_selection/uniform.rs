@@ -15,11 +15,18 @@ impl LightSelector for UniformSelector {
             return None;
         }
         let index = ((u * self.count as f32) as u32).min(self.count - 1);
-        Some(SelectedLight { index, pmf: 1.0 / self.count as f32 })
+        Some(SelectedLight {
+            index,
+            pmf: 1.0 / self.count as f32,
+        })
     }
 
     fn pmf(&self, _ctx: &ShadingPoint, light: u32) -> f32 {
-        if light < self.count { 1.0 / self.count as f32 } else { 0.0 }
+        if light < self.count {
+            1.0 / self.count as f32
+        } else {
+            0.0
+        }
     }
 
     fn name(&self) -> &'static str {

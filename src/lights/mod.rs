@@ -62,10 +62,22 @@ pub struct LightBounds {
 /// The interface every light implements.
 pub trait LightSource {
     /// Sample incident illumination at `ctx` with the 2D sample `u`.
-    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2, mode: SamplingMode) -> Option<LightLiSample>;
+    fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        mode: SamplingMode,
+    ) -> Option<LightLiSample>;
     /// Solid-angle pdf that `sample_li` would draw direction `wi` which hits the light at
     /// `p_light` with light normal `n_light` (for infinite lights, only `wi` matters).
-    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3, p_light: Vec3, n_light: Vec3, mode: SamplingMode) -> f32;
+    fn pdf_li(
+        &self,
+        ctx: &LightSampleContext,
+        wi: Vec3,
+        p_light: Vec3,
+        n_light: Vec3,
+        mode: SamplingMode,
+    ) -> f32;
     /// Emitted radiance leaving the light's surface at `p` with normal `n` in direction `w`
     /// (area lights), or arriving from direction -`w` (infinite lights). Zero for delta lights.
     fn radiance(&self, p: Vec3, n: Vec3, uv: Vec2, w: Vec3) -> Rgb;
@@ -108,13 +120,25 @@ impl Light {
 
 impl LightSource for Light {
     #[inline]
-    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2, mode: SamplingMode) -> Option<LightLiSample> {
+    fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        mode: SamplingMode,
+    ) -> Option<LightLiSample> {
         match self {
             Light::Triangle(l) => l.sample_li(ctx, u, mode),
         }
     }
     #[inline]
-    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3, p_light: Vec3, n_light: Vec3, mode: SamplingMode) -> f32 {
+    fn pdf_li(
+        &self,
+        ctx: &LightSampleContext,
+        wi: Vec3,
+        p_light: Vec3,
+        n_light: Vec3,
+        mode: SamplingMode,
+    ) -> f32 {
         match self {
             Light::Triangle(l) => l.pdf_li(ctx, wi, p_light, n_light, mode),
         }

@@ -1,6 +1,8 @@
 //! Diffuse emissive triangle. TODO(issue 4): spherical-triangle solid-angle sampling.
 
-use super::{LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle};
+use super::{
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
+};
 use crate::sampling::uniform_triangle_point;
 use crate::{Rgb, luminance};
 use glam::{Vec2, Vec3};
@@ -28,7 +30,13 @@ impl TriangleLight {
         if !(area > 0.0) || !area.is_finite() {
             return None;
         }
-        Some(Self { p, n: n.normalize(), area, l, two_sided })
+        Some(Self {
+            p,
+            n: n.normalize(),
+            area,
+            l,
+            two_sided,
+        })
     }
 
     #[inline]
@@ -38,7 +46,12 @@ impl TriangleLight {
 }
 
 impl LightSource for TriangleLight {
-    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2, _mode: SamplingMode) -> Option<LightLiSample> {
+    fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        _mode: SamplingMode,
+    ) -> Option<LightLiSample> {
         let p_light = uniform_triangle_point(u, self.p[0], self.p[1], self.p[2]);
         let d = p_light - ctx.p;
         let dist = d.length();
@@ -53,15 +66,32 @@ impl LightSource for TriangleLight {
         if !(pdf > 0.0) || !pdf.is_finite() {
             return None;
         }
-        Some(LightLiSample { wi, li: self.l, pdf, p_light, delta: false })
+        Some(LightLiSample {
+            wi,
+            li: self.l,
+            pdf,
+            p_light,
+            delta: false,
+        })
     }
 
-    fn pdf_li(&self, ctx: &LightSampleContext, _wi: Vec3, p_light: Vec3, _n_light: Vec3, _mode: SamplingMode) -> f32 {
+    fn pdf_li(
+        &self,
+        ctx: &LightSampleContext,
+        _wi: Vec3,
+        p_light: Vec3,
+        _n_light: Vec3,
+        _mode: SamplingMode,
+    ) -> f32 {
         area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n)
     }
 
     fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        if self.emits_toward(w) { self.l } else { Rgb::ZERO }
+        if self.emits_toward(w) {
+            self.l
+        } else {
+            Rgb::ZERO
+        }
     }
 
     fn power(&self) -> f32 {

@@ -24,9 +24,11 @@ impl Material {
     pub fn bsdf(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
         let _ = front;
         match self {
-            Material::Diffuse { reflectance } => {
-                Bsdf::Lambert(Lambert { r: reflectance.eval(hit.uv).clamp(crate::Rgb::ZERO, crate::Rgb::ONE) })
-            }
+            Material::Diffuse { reflectance } => Bsdf::Lambert(Lambert {
+                r: reflectance
+                    .eval(hit.uv)
+                    .clamp(crate::Rgb::ZERO, crate::Rgb::ONE),
+            }),
         }
     }
 }

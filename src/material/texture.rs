@@ -46,7 +46,11 @@ impl Texture {
             Texture::Image { image, scale } => image.bilinear(uv) * *scale,
             Texture::Checkerboard { a, b, freq } => {
                 let s = (uv * *freq).floor();
-                if ((s.x + s.y) as i64).rem_euclid(2) == 0 { *a } else { *b }
+                if ((s.x + s.y) as i64).rem_euclid(2) == 0 {
+                    *a
+                } else {
+                    *b
+                }
             }
         }
     }

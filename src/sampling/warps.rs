@@ -124,7 +124,11 @@ pub fn concentric_disk(u: Vec2) -> Vec2 {
 /// Pdf of [`concentric_disk`] per unit area: 1/π inside the unit disk.
 #[inline]
 pub fn concentric_disk_pdf(p: Vec2) -> f32 {
-    if p.length_squared() <= 1.0 { FRAC_1_PI } else { 0.0 }
+    if p.length_squared() <= 1.0 {
+        FRAC_1_PI
+    } else {
+        0.0
+    }
 }
 
 /// Inverse of [`concentric_disk`].
@@ -184,7 +188,11 @@ pub fn uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
 /// Pdf of [`uniform_cone`]: 1/(2π(1 − cos θmax)) inside the cone.
 #[inline]
 pub fn uniform_cone_pdf(d: Vec3, cos_max: f32) -> f32 {
-    if d.z >= cos_max { 1.0 / (TAU * (1.0 - cos_max)) } else { 0.0 }
+    if d.z >= cos_max {
+        1.0 / (TAU * (1.0 - cos_max))
+    } else {
+        0.0
+    }
 }
 
 /// Inverse of [`uniform_cone`].
@@ -215,4 +223,27 @@ pub fn balance_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
         return 1.0;
     }
     if f + g == 0.0 { 0.0 } else { f / (f + g) }
+}
+
+/// 1D tent (triangle filter) of radius r centred at 0, by inverting its cdf on each half:
+/// pdf(x) = (r − |x|)/r².
+#[inline]
+pub fn tent(u: f32, r: f32) -> f32 {
+    if u < 0.5 {
+        let v = 2.0 * u;
+        -r * (1.0 - v.sqrt())
+    } else {
+        let v = 2.0 * u - 1.0;
+        r * (1.0 - (1.0 - v).sqrt())
+    }
+}
+
+/// Pdf of [`tent`].
+#[inline]
+pub fn tent_pdf(x: f32, r: f32) -> f32 {
+    if x.abs() >= r {
+        0.0
+    } else {
+        (r - x.abs()) / (r * r)
+    }
 }

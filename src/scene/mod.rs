@@ -3,6 +3,10 @@
 //! TODO(issue 3): builder (meshes → BVH, emissive triangles → lights), built-in `cornell`.
 //! TODO(issue 5): pbrt-v4, OBJ/MTL, glTF loaders.
 
+pub mod builder;
+
+pub use builder::SceneBuilder;
+
 use crate::Rgb;
 use crate::camera::Camera;
 use crate::lights::Light;
