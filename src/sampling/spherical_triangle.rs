@@ -1,7 +1,11 @@
 //! Uniform sampling of the solid angle subtended by a triangle (Arvo 1995).
-//! TODO(issue 2): implement; signatures are the contract used by `lights`.
+//!
+//! Arvo's method is an inversion: ξ₁ picks the sub-triangle (A, B, Ĉ) of area ξ₁·Ω, which fixes
+//! the vertex Ĉ on arc AC; ξ₂ then picks the point on arc BĈ with the right conditional density
+//! (uniform in 1 − cos of the arc length from B). All the trigonometry runs in f64, because for
+//! small triangles it cancels catastrophically in f32.
 
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 /// A triangle (a, b, c) seen from point `p`, precomputed for solid-angle sampling.
 #[derive(Clone, Copy, Debug)]
@@ -14,24 +18,156 @@ pub struct SphericalTriangle {
     pub c: Vec3,
     /// Solid angle (sr).
     pub area: f32,
+    /// The same vertices in f64.
+    da: DVec3,
+    db: DVec3,
+    dc: DVec3,
+    /// Solid angle in f64.
+    area64: f64,
+    /// Interior angle at A.
+    alpha: f64,
+    /// +1 or −1: orientation of (a, b, c), for the inside test.
+    orientation: f64,
+}
+
+/// Solid angle of the spherical triangle of unit vectors (Van Oosterom & Strackee 1983);
+/// accurate for tiny triangles, unlike the angle excess α + β + γ − π.
+fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let num = a.dot(b.cross(c)).abs();
+    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+    2.0 * num.atan2(den)
+}
+
+/// Unit tangent at `a` of the great-circle arc towards `b` (`None` if b = ±a).
+fn tangent(a: DVec3, b: DVec3) -> Option<DVec3> {
+    (b - a * a.dot(b)).try_normalize()
+}
+
+/// Angle between two unit vectors, accurate near 0 and π.
+fn angle_between(x: DVec3, y: DVec3) -> f64 {
+    x.cross(y).length().atan2(x.dot(y))
 }
 
 impl SphericalTriangle {
+    /// Smallest solid angle (sr) this sampler accepts: below it f64 Arvo loses accuracy, and
+    /// callers should sample by area instead.
+    pub const MIN_SOLID_ANGLE: f64 = 1e-10;
+
     /// Project triangle (v0, v1, v2) onto the unit sphere around `p`; `None` if degenerate.
     pub fn new(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<Self> {
-        let _ = (p, v0, v1, v2);
-        todo!("issue 2")
+        let p = p.as_dvec3();
+        let da = (v0.as_dvec3() - p).try_normalize()?;
+        let db = (v1.as_dvec3() - p).try_normalize()?;
+        let dc = (v2.as_dvec3() - p).try_normalize()?;
+        let area64 = solid_angle(da, db, dc);
+        if !(area64 >= Self::MIN_SOLID_ANGLE && area64.is_finite()) {
+            return None;
+        }
+        let alpha = angle_between(tangent(da, db)?, tangent(da, dc)?);
+        let triple = da.dot(db.cross(dc));
+        Some(Self {
+            a: da.as_vec3(),
+            b: db.as_vec3(),
+            c: dc.as_vec3(),
+            area: area64 as f32,
+            da,
+            db,
+            dc,
+            area64,
+            alpha,
+            orientation: if triple >= 0.0 { 1.0 } else { -1.0 },
+        })
     }
 
     /// Unit direction uniformly distributed in the spherical triangle; pdf = 1/area.
     pub fn sample(&self, u: Vec2) -> Vec3 {
-        let _ = u;
-        todo!("issue 2")
+        let (a, b) = (self.da, self.db);
+        let sub_area = u.x as f64 * self.area64;
+        let (s, t) = (sub_area - self.alpha).sin_cos();
+        let (sin_alpha, cos_alpha) = self.alpha.sin_cos();
+        let uu = t - cos_alpha;
+        let v = s + sin_alpha * a.dot(b);
+        // q = cos of the arc from A to Ĉ, the far vertex of the sub-triangle of area ξ₁·Ω.
+        let den = (v * s + uu * t) * sin_alpha;
+        let q = if den != 0.0 {
+            (((v * t - uu * s) * cos_alpha - v) / den).clamp(-1.0, 1.0)
+        } else {
+            1.0
+        };
+        let c_perp = tangent(a, self.dc).unwrap_or(DVec3::ZERO);
+        let c_hat = (a * q + c_perp * (1.0 - q * q).max(0.0).sqrt()).normalize();
+        // cos of the arc from B is uniform between Ĉ·B and 1.
+        let z = 1.0 - u.y as f64 * (1.0 - c_hat.dot(b));
+        let dir = match tangent(b, c_hat) {
+            Some(t) => b * z + t * (1.0 - z * z).max(0.0).sqrt(),
+            None => b,
+        };
+        dir.normalize().as_vec3()
     }
 
     /// Inverse of [`Self::sample`] for a direction inside the triangle.
     pub fn inverse(&self, d: Vec3) -> Vec2 {
-        let _ = d;
-        todo!("issue 2")
+        let (a, b, c) = (self.da, self.db, self.dc);
+        let Some(d) = d.as_dvec3().try_normalize() else {
+            return Vec2::ZERO;
+        };
+        // Ĉ: where the great circle through B and d meets arc AC.
+        let Some(mut c_hat) = b.cross(d).cross(a.cross(c)).try_normalize() else {
+            return Vec2::ZERO; // d = B: any ξ₁ maps there.
+        };
+        if c_hat.dot(a + c) < 0.0 {
+            c_hat = -c_hat;
+        }
+        let u0 = solid_angle(a, b, c_hat) / self.area64;
+        let den = 1.0 - c_hat.dot(b);
+        let u1 = if den > 0.0 {
+            (1.0 - d.dot(b)) / den
+        } else {
+            0.0
+        };
+        Vec2::new(u0.clamp(0.0, 1.0) as f32, u1.clamp(0.0, 1.0) as f32)
+    }
+
+    /// Whether direction `d` (any length) points into the triangle.
+    pub fn contains(&self, d: Vec3) -> bool {
+        let d = d.as_dvec3() * self.orientation;
+        d.dot(self.da.cross(self.db)) >= 0.0
+            && d.dot(self.db.cross(self.dc)) >= 0.0
+            && d.dot(self.dc.cross(self.da)) >= 0.0
+    }
+
+    /// Solid-angle pdf of [`Self::sample`] at direction `d`: 1/area inside, 0 outside.
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        if self.contains(d) {
+            (1.0 / self.area64) as f32
+        } else {
+            0.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spherical_triangle_octant_has_area_pi_over_2() {
+        let t = SphericalTriangle::new(Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z).unwrap();
+        assert!((t.area - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        // The corners of the unit square map to the vertices.
+        assert!((t.sample(Vec2::new(0.0, 1.0)) - Vec3::X).length() < 1e-5);
+        assert!((t.sample(Vec2::new(0.7, 0.0)) - Vec3::Y).length() < 1e-5);
+        assert!((t.sample(Vec2::new(1.0, 1.0)) - Vec3::Z).length() < 1e-5);
+        assert!(t.contains(Vec3::ONE) && !t.contains(-Vec3::ONE));
+    }
+
+    #[test]
+    fn spherical_triangle_degenerate_is_none() {
+        let o = Vec3::ZERO;
+        assert!(SphericalTriangle::new(o, Vec3::X, 2.0 * Vec3::X, Vec3::Y).is_none());
+        assert!(SphericalTriangle::new(o, o, Vec3::X, Vec3::Y).is_none());
+        assert!(SphericalTriangle::new(o, Vec3::NAN, Vec3::X, Vec3::Y).is_none());
+        // Viewpoint in the triangle's plane: zero solid angle.
+        assert!(SphericalTriangle::new(o, Vec3::X, Vec3::Y, Vec3::X + Vec3::Y).is_none());
     }
 }
