@@ -19,6 +19,14 @@ pub enum SamplingError {
     /// All weights were zero.
     #[error("all weights are zero")]
     ZeroSum,
+    /// A sample pattern name that `--pattern` does not know.
+    #[error(
+        "unknown sample pattern {name:?}; expected one of: fixed, random, grid, stratified, lhs, sobol"
+    )]
+    UnknownPattern {
+        /// The name given.
+        name: String,
+    },
     /// The data length does not match the stated shape.
     #[error("2D distribution of {nu}x{nv} needs {} values, got {len}", nu * nv)]
     Shape {

@@ -12,6 +12,7 @@ pub mod error;
 pub mod frame;
 pub mod hash;
 pub mod pattern;
+pub mod permutation;
 pub mod spherical_rectangle;
 pub mod spherical_triangle;
 pub mod warps;
@@ -21,7 +22,10 @@ pub use distribution1d::Distribution1D;
 pub use distribution2d::Distribution2D;
 pub use error::SamplingError;
 pub use frame::Frame;
-pub use pattern::{PatternKind, SamplePattern};
+pub use pattern::{Pattern, PatternKind, SamplePattern, make_pattern};
+pub use permutation::permute;
+pub use spherical_rectangle::SphericalRectangle;
+pub use spherical_triangle::SphericalTriangle;
 pub use warps::*;
 
 /// The largest f32 strictly below 1, so that samples stay in [0, 1).

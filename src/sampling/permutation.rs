@@ -1,0 +1,92 @@
+//! Hashed random permutations of [0, n): a pure function of (index, n, key), so strata can be
+//! assigned to sample indices without storing a shuffled table (idea after Kensler 2013,
+//! "Correlated Multi-Jittered Sampling"; this construction is our own).
+
+/// One keyed round of invertible operations on `bits`-bit integers (`mask = 2^bits − 1`).
+#[inline]
+fn round(mut i: u32, mask: u32, bits: u32, k: u32, m: u32) -> u32 {
+    // Each step is a bijection of [0, 2^bits): xor/add a constant, multiply by an odd number,
+    // and xor with a right shift of itself (the result stays inside the mask).
+    i ^= k & mask;
+    i = i.wrapping_mul(m | 1) & mask;
+    i ^= i >> (bits / 2 + 1);
+    i = i.wrapping_add(k >> 16) & mask;
+    i = i.wrapping_mul(0x2c1b_3c6d) & mask;
+    i ^= i >> (bits / 3 + 1);
+    i
+}
+
+/// The image of `index` under a pseudo-random permutation of [0, n) selected by `key`.
+///
+/// Indices ≥ n wrap modulo n; n = 0 is treated as 1. Works for any n by cycle-walking a
+/// bijection of the enclosing power of two (expected < 2 steps).
+pub fn permute(index: u32, n: u32, key: u64) -> u32 {
+    if n <= 1 {
+        return 0;
+    }
+    let bits = 32 - (n - 1).leading_zeros();
+    let mask = if bits == 32 {
+        u32::MAX
+    } else {
+        (1 << bits) - 1
+    };
+    let k = super::hash::mix64(key);
+    let (k0, k1, k2, k3) = (
+        k as u32,
+        (k >> 32) as u32,
+        super::hash::mix64(k) as u32,
+        (super::hash::mix64(k) >> 32) as u32,
+    );
+    let mut i = index % n;
+    loop {
+        i = round(i, mask, bits, k0, k1);
+        i = round(i, mask, bits, k2, k3);
+        i = round(i, mask, bits, k1 ^ k2, k0 ^ k3);
+        if i < n {
+            return i;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::chi2::{Chi2Config, chi2_discrete};
+
+    #[test]
+    fn permute_is_a_bijection_for_every_length() {
+        for n in 1..=300u32 {
+            for key in [0u64, 1, 0xdead_beef, u64::MAX] {
+                let mut seen = vec![false; n as usize];
+                for i in 0..n {
+                    let j = permute(i, n, key) as usize;
+                    assert!(!seen[j], "n = {n}, key = {key}: {j} hit twice");
+                    seen[j] = true;
+                }
+            }
+        }
+        assert_eq!(permute(5, 0, 3), 0);
+        assert_eq!(permute(7, 5, 9), permute(2, 5, 9));
+    }
+
+    #[test]
+    fn chi2_permute_image_is_uniform_over_keys() {
+        // Over random keys, where a fixed index lands must be uniform on [0, n), for a
+        // power of two and for an awkward length that needs cycle-walking.
+        for (n, index) in [(16u32, 3u32), (37, 0), (37, 36)] {
+            let pmf = vec![1.0 / n as f64; n as usize];
+            let cfg = Chi2Config {
+                samples: 200_000,
+                num_tests: 3,
+                ..Default::default()
+            };
+            let r = chi2_discrete(&cfg, &pmf, |u| {
+                let key = ((u[0].to_bits() as u64) << 40)
+                    ^ ((u[1].to_bits() as u64) << 20)
+                    ^ u[2].to_bits() as u64;
+                Some(permute(index, n, key) as usize)
+            });
+            assert!(r.passed, "n = {n}, index = {index}: {}", r.summary());
+        }
+    }
+}
