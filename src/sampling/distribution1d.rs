@@ -79,7 +79,16 @@ impl Distribution1D {
     /// Continuous sample: (x in [0,1), pdf(x), bin index).
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
         let (i, _, du) = self.sample_discrete(u);
-        let x = ((i as f32 + du) / self.func.len() as f32).min(ONE_MINUS_EPSILON);
+        let n = self.func.len();
+        let mut x = ((i as f32 + du) / n as f32).min(ONE_MINUS_EPSILON);
+        // (i + du)/n can round onto the next bin edge; step back so that pdf(x) is the density
+        // of bin i, the one actually sampled.
+        while x > 0.0 && self.bin_of(x) > i {
+            x = f32::from_bits(x.to_bits() - 1);
+        }
+        while self.bin_of(x) < i {
+            x = f32::from_bits(x.to_bits() + 1);
+        }
         (x, self.pdf_bin(i), i)
     }
 
@@ -119,13 +128,19 @@ impl Distribution1D {
         }
     }
 
+    /// Bin of x ∈ [0,1), computed exactly as [`Self::pdf`] does.
+    #[inline]
+    fn bin_of(&self, x: f32) -> usize {
+        let n = self.func.len();
+        ((x * n as f32) as usize).min(n - 1)
+    }
+
     /// Density at x ∈ [0,1) for continuous sampling.
     pub fn pdf(&self, x: f32) -> f32 {
         if !(0.0..1.0).contains(&x) {
             return 0.0;
         }
-        let n = self.func.len();
-        self.pdf_bin(((x * n as f32) as usize).min(n - 1))
+        self.pdf_bin(self.bin_of(x))
     }
 
     /// Inverse of the continuous sample: the u that maps to x.

@@ -16,7 +16,8 @@ pub fn safe_sqrt(x: f32) -> f32 {
 /// Direction with polar cosine `cos_theta` around +z and azimuth `phi`.
 #[inline]
 pub fn spherical_direction(cos_theta: f32, phi: f32) -> Vec3 {
-    let sin_theta = safe_sqrt(1.0 - cos_theta * cos_theta);
+    // (1 − c)(1 + c) keeps sin θ accurate near the poles, where 1 − c² cancels.
+    let sin_theta = safe_sqrt((1.0 - cos_theta) * (1.0 + cos_theta));
     let (sp, cp) = phi.sin_cos();
     Vec3::new(sin_theta * cp, sin_theta * sp, cos_theta)
 }
@@ -25,7 +26,9 @@ pub fn spherical_direction(cos_theta: f32, phi: f32) -> Vec3 {
 #[inline]
 fn azimuth(d: Vec3) -> f32 {
     let p = d.y.atan2(d.x);
-    if p < 0.0 { p + TAU } else { p }
+    // p + 2π can round up to 2π for tiny negative p; wrap so that φ/2π stays in [0, 1).
+    let p = if p < 0.0 { p + TAU } else { p };
+    if p >= TAU { 0.0 } else { p }
 }
 
 /// Uniform hemisphere: cos θ = ξ₁, φ = 2πξ₂ (marginal of θ is sin θ, conditional of φ uniform).
@@ -68,7 +71,19 @@ pub fn cosine_hemisphere_inverse(d: Vec3) -> Vec2 {
 /// 1 − cos^(n+1)θ, so cos θ = ξ₁^(1/(n+1)); φ = 2πξ₂.
 #[inline]
 pub fn cosine_power_hemisphere(u: Vec2, n: f32) -> Vec3 {
-    spherical_direction(u.x.powf(1.0 / (n + 1.0)), TAU * u.y)
+    // 1 − cos θ = −expm1(ln ξ₁ / (n+1)) stays accurate for very sharp lobes, where
+    // ξ₁^(1/(n+1)) rounds to 1 in f32.
+    let one_minus_cos = -(u.x.ln() / (n + 1.0)).exp_m1();
+    direction_from_one_minus_cos(one_minus_cos, TAU * u.y)
+}
+
+/// Direction with 1 − cos θ = `t` around +z and azimuth `phi`, accurate for tiny θ.
+#[inline]
+pub fn direction_from_one_minus_cos(t: f32, phi: f32) -> Vec3 {
+    let t = t.clamp(0.0, 2.0);
+    let sin_theta = safe_sqrt(t * (2.0 - t));
+    let (sp, cp) = phi.sin_cos();
+    Vec3::new(sin_theta * cp, sin_theta * sp, 1.0 - t)
 }
 
 /// Pdf of [`cosine_power_hemisphere`]: (n+1)/(2π)·cosⁿθ on z ≥ 0.
@@ -83,7 +98,9 @@ pub fn cosine_power_hemisphere_pdf(d: Vec3, n: f32) -> f32 {
 /// Inverse of [`cosine_power_hemisphere`].
 #[inline]
 pub fn cosine_power_hemisphere_inverse(d: Vec3, n: f32) -> Vec2 {
-    Vec2::new(d.z.max(0.0).powf(n + 1.0), azimuth(d) / TAU)
+    // ξ₁ = cos^(n+1) θ = exp((n+1)·ln(1 − t)) with t = 1 − cos θ computed without cancellation.
+    let t = one_minus_cos_of(d).clamp(0.0, 1.0);
+    Vec2::new(((n + 1.0) * (-t).ln_1p()).exp(), azimuth(d) / TAU)
 }
 
 /// Uniform sphere: cos θ = 1 − 2ξ₁, φ = 2πξ₂.
@@ -181,8 +198,7 @@ pub fn uniform_triangle_point(u: Vec2, p0: Vec3, p1: Vec3, p2: Vec3) -> Vec3 {
 /// cos θ = 1 − ξ₁(1 − cos θmax), φ = 2πξ₂.
 #[inline]
 pub fn uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
-    let cos_theta = 1.0 - u.x * (1.0 - cos_max);
-    spherical_direction(cos_theta, TAU * u.y)
+    direction_from_one_minus_cos(u.x * (1.0 - cos_max), TAU * u.y)
 }
 
 /// Pdf of [`uniform_cone`]: 1/(2π(1 − cos θmax)) inside the cone.
@@ -198,7 +214,52 @@ pub fn uniform_cone_pdf(d: Vec3, cos_max: f32) -> f32 {
 /// Inverse of [`uniform_cone`].
 #[inline]
 pub fn uniform_cone_inverse(d: Vec3, cos_max: f32) -> Vec2 {
-    Vec2::new((1.0 - d.z) / (1.0 - cos_max), azimuth(d) / TAU)
+    Vec2::new(one_minus_cos_of(d) / (1.0 - cos_max), azimuth(d) / TAU)
+}
+
+/// 1 − cos θ of a unit direction, accurate near +z (where 1 − z cancels).
+#[inline]
+pub fn one_minus_cos_of(d: Vec3) -> f32 {
+    if d.z > 0.5 {
+        (d.x * d.x + d.y * d.y) / (1.0 + d.z)
+    } else {
+        1.0 - d.z
+    }
+}
+
+/// 1 − cos θmax of a cone with sin²θmax = `sin2_max` (θmax ≤ 90°), without cancellation:
+/// for a sphere light of radius r at distance d, sin²θmax = r²/d².
+#[inline]
+pub fn cone_one_minus_cos(sin2_max: f32) -> f32 {
+    let s2 = sin2_max.clamp(0.0, 1.0);
+    s2 / (1.0 + safe_sqrt(1.0 - s2))
+}
+
+/// Uniform in a cone around +z given sin²θmax (θmax ≤ 90°); the accurate form of
+/// [`uniform_cone`] for the tiny cones of distant sphere lights.
+#[inline]
+pub fn uniform_cone_sin2(u: Vec2, sin2_max: f32) -> Vec3 {
+    direction_from_one_minus_cos(u.x * cone_one_minus_cos(sin2_max), TAU * u.y)
+}
+
+/// Pdf of [`uniform_cone_sin2`]: 1/(2π(1 − cos θmax)) inside the cone.
+#[inline]
+pub fn uniform_cone_sin2_pdf(d: Vec3, sin2_max: f32) -> f32 {
+    let inside = d.z > 0.0 && d.x * d.x + d.y * d.y <= sin2_max * d.length_squared();
+    if inside {
+        1.0 / (TAU * cone_one_minus_cos(sin2_max))
+    } else {
+        0.0
+    }
+}
+
+/// Inverse of [`uniform_cone_sin2`].
+#[inline]
+pub fn uniform_cone_sin2_inverse(d: Vec3, sin2_max: f32) -> Vec2 {
+    Vec2::new(
+        one_minus_cos_of(d) / cone_one_minus_cos(sin2_max),
+        azimuth(d) / TAU,
+    )
 }
 
 /// Power heuristic with β = 2 (Veach): weight of a sample drawn with `nf` samples of pdf `f_pdf`
