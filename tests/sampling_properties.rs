@@ -41,9 +41,12 @@ fn integrate_zonal(pdf: impl Fn(Vec3) -> f32) -> f64 {
     2.0 * PI * s
 }
 
+/// A direction pdf under test.
+type PdfFn = Box<dyn Fn(Vec3) -> f32>;
+
 #[test]
 fn hemisphere_and_sphere_pdfs_integrate_to_one() {
-    let cases: Vec<(&str, Box<dyn Fn(Vec3) -> f32>)> = vec![
+    let cases: Vec<(&str, PdfFn)> = vec![
         ("uniform hemisphere", Box::new(uniform_hemisphere_pdf)),
         ("cosine hemisphere", Box::new(cosine_hemisphere_pdf)),
         ("uniform sphere", Box::new(|_| uniform_sphere_pdf())),

@@ -275,7 +275,11 @@ fn adaptive(f: &impl Fn(f64, f64) -> f64, r: [f64; 4], whole: Piece, tol: f64, d
     let err = |v: &[Piece; 2]| (v[0].integral + v[1].integral - whole.integral).abs();
     let (ex, ey) = (err(&xv), err(&yv));
     // Split where the estimate moves most; on a tie (e.g. an undetected edge), alternate.
-    let along_x = if ex == ey { depth % 2 == 0 } else { ex > ey };
+    let along_x = if ex == ey {
+        depth.is_multiple_of(2)
+    } else {
+        ex > ey
+    };
     let (halves, vals) = if along_x { (xs, xv) } else { (ys, yv) };
     if ex.max(ey) <= tol && !whole.straddles {
         return vals[0].integral + vals[1].integral;

@@ -116,7 +116,7 @@ pub fn grid_dims(count: u32) -> (u32, u32) {
     while nx * nx > count {
         nx -= 1;
     }
-    while count % nx != 0 {
+    while !count.is_multiple_of(nx) {
         nx -= 1;
     }
     (nx, count / nx)

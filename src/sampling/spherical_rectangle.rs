@@ -57,7 +57,9 @@ impl SphericalRectangle {
             z0 = -z0;
         }
         // In-plane viewpoints see no solid angle; relative threshold keeps f64 sane.
-        if !(z0 < -1e-9 * (exl + eyl)) {
+        // (NaN input fails this test too, hence the positive form.)
+        let far_enough = z0 < -1e-9 * (exl + eyl);
+        if !far_enough {
             return None;
         }
         let (x0, y0) = (d.dot(x), d.dot(y));
