@@ -184,6 +184,27 @@ fn chi2_negative_control_cosine_power_1000_vs_1050_zoomed() {
     assert!(!r.passed, "zoomed harness has no power: {}", r.summary());
 }
 
+#[test]
+fn chi2_negative_control_area_sampling_vs_solid_angle_pdf() {
+    // Uniform-by-area points on a triangle are not uniform in solid angle: the harness must
+    // tell Arvo's sampler from area sampling judged against 1/Ω.
+    let (p, v) = (Vec3::ZERO, [Vec3::X, Vec3::Y, Vec3::Z]);
+    let omega = triangle_solid_angle(p, v[0], v[1], v[2]);
+    let r = chi2_directions(
+        &cfg(),
+        |u| (uniform_triangle_point(v2(u), v[0], v[1], v[2]) - p).try_normalize(),
+        |d| {
+            if ray_hits_triangle(p.as_dvec3(), d.as_dvec3(), v[0], v[1], v[2]) {
+                1.0 / omega
+            } else {
+                0.0
+            }
+        },
+    );
+    eprintln!("negative control area vs solid angle: {}", r.summary());
+    assert!(!r.passed, "harness has no power: {}", r.summary());
+}
+
 // ---------------------------------------------------------------- disk, triangle, tent
 
 #[test]
