@@ -5,6 +5,7 @@
 
 pub mod builder;
 pub mod builtin;
+pub mod load;
 
 pub use builder::SceneBuilder;
 
