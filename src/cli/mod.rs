@@ -20,15 +20,19 @@ pub enum Command {
     Scenes,
     /// Print rays/s and time per image on the standard scenes.
     Bench(bench::Args),
+    /// Compare an image with a reference: MSE, relMSE, MAE.
+    Compare(compare::Args),
 }
 
 pub mod bench;
+pub mod compare;
 pub mod render;
 
 /// Dispatch a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Render(a)) => render::run(a),
+        Some(Command::Compare(a)) => compare::run(a),
         Some(Command::Scenes) => {
             for b in penumbra::scene::builtin::BUILTINS {
                 println!("{:<16} {}", b.name, b.description);

@@ -11,7 +11,8 @@ pub mod metrics;
 pub mod montage;
 pub mod plot;
 
-pub use io::{read_image, write_image};
+pub use io::{read_image, save_png_atomic, write_image};
+pub use metrics::{ErrorStats, compare, error_image};
 
 
 use crate::Rgb;
