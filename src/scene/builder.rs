@@ -6,7 +6,7 @@ use crate::geometry::{
     Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Transform,
     interaction::NO_LIGHT,
 };
-use crate::lights::{Light, TriangleLight};
+use crate::lights::{DiskLight, Light, QuadLight, SphereLight, TriangleLight};
 use crate::material::Material;
 use anyhow::{Context, bail, ensure};
 use glam::Vec3;
@@ -174,8 +174,23 @@ impl SceneBuilder {
             indices: vec![0, 1, 2, 0, 2, 3],
             flip_normals: false,
         };
-        self.add_mesh(mesh, material, emission)
-            .context("adding a quad")
+        let before = self.prims.len();
+        self.add_mesh(mesh, material, None)
+            .context("adding a quad")?;
+        if let Some(e) = emission {
+            check_emission(&e)?;
+            let n = e1.cross(e2).normalize_or_zero();
+            // One light for the whole parallelogram, so it can be sampled by solid angle
+            // (spherical rectangle) instead of as two triangles.
+            if let Some(l) = QuadLight::new(corner, e1, e2, n, e.l, e.two_sided) {
+                self.lights.push(Light::Quad(l));
+                let id = (self.lights.len() - 1) as u32;
+                for p in &mut self.prims[before..] {
+                    p.light = id;
+                }
+            }
+        }
+        Ok(())
     }
 
     fn add_quadric(
@@ -185,10 +200,15 @@ impl SceneBuilder {
         emission: Option<AreaEmission>,
     ) -> anyhow::Result<()> {
         self.check_material(material)?;
-        if let Some(e) = emission {
-            check_emission(&e)?;
-            bail!("emissive spheres and disks are not supported yet");
-        }
+        let light = match emission {
+            Some(e) => {
+                check_emission(&e)?;
+                let light = quadric_light(&q, &e)?;
+                self.lights.push(light);
+                (self.lights.len() - 1) as u32
+            }
+            None => NO_LIGHT,
+        };
         self.quadrics.push(q);
         self.prims.push(Primitive {
             p0: Vec3::ZERO,
@@ -196,7 +216,7 @@ impl SceneBuilder {
             e2: Vec3::ZERO,
             kind: PrimKind::Quadric((self.quadrics.len() - 1) as u32),
             material,
-            light: NO_LIGHT,
+            light,
         });
         Ok(())
     }
@@ -259,8 +279,17 @@ impl SceneBuilder {
             film.resolution.y
         );
         let geometry = Geometry::new(self.prims, self.meshes, self.quadrics);
-        let infinite_lights = self
-            .lights
+        let mut lights = self.lights;
+        let (lo, hi) = geometry.bounds();
+        let (center, radius) = if lo.x <= hi.x {
+            ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-3))
+        } else {
+            (Vec3::ZERO, 1.0)
+        };
+        for l in &mut lights {
+            l.preprocess(center, radius);
+        }
+        let infinite_lights = lights
             .iter()
             .enumerate()
             .filter(|(_, l)| l.is_infinite())
@@ -269,7 +298,7 @@ impl SceneBuilder {
         Ok(Scene {
             geometry,
             materials: self.materials,
-            lights: self.lights,
+            lights,
             infinite_lights,
             camera,
             film,
@@ -284,4 +313,33 @@ fn check_emission(e: &AreaEmission) -> anyhow::Result<()> {
         e.l
     );
     Ok(())
+}
+
+/// The area light of an emissive sphere or disk. Lights are analytic in world space, so the
+/// transform must scale uniformly (rotations, translations and mirrors are fine).
+fn quadric_light(q: &Quadric, e: &AreaEmission) -> anyhow::Result<Light> {
+    let m = &q.to_world.m;
+    let sx = m.x_axis.truncate().length();
+    let sy = m.y_axis.truncate().length();
+    let sz = m.z_axis.truncate().length();
+    let uniform = (sx - sy).abs() <= 1e-4 * sx && (sx - sz).abs() <= 1e-4 * sx;
+    ensure!(
+        uniform,
+        "emissive spheres and disks need a uniformly scaling transform (scales {sx}, {sy}, {sz})"
+    );
+    let light = match q.kind {
+        QuadricKind::Sphere { radius } => {
+            let c = q.to_world.point(Vec3::ZERO);
+            SphereLight::new(c, radius * sx, e.l, q.flip).map(Light::Sphere)
+        }
+        QuadricKind::Disk { height, radius } => {
+            let c = q.to_world.point(Vec3::new(0.0, 0.0, height));
+            let mut n = q.to_world.normal(Vec3::Z).normalize_or_zero();
+            if q.flip {
+                n = -n;
+            }
+            DiskLight::new(c, n, radius * sx, e.l, e.two_sided).map(Light::Disk)
+        }
+    };
+    light.ok_or_else(|| anyhow::anyhow!("degenerate emissive shape"))
 }
