@@ -199,3 +199,41 @@ fn image_arithmetic() {
     assert_eq!(a.get(0, 0), Rgb::splat(0.5));
     assert!(!a.has_non_finite());
 }
+
+#[test]
+fn hdr_and_tga_reads() {
+    let dir = scratch("hdr");
+    // Radiance HDR: linear; RGBE shares one exponent per pixel with 8-bit mantissas, so the
+    // error is bounded relative to the pixel's largest channel.
+    let src = image::Rgb32FImage::from_fn(5, 3, |x, y| {
+        image::Rgb([
+            0.5 + x as f32,
+            10.0 * (y + 1) as f32,
+            0.01 * (x + y + 1) as f32,
+        ])
+    });
+    let p = dir.join("a.hdr");
+    image::DynamicImage::ImageRgb32F(src.clone())
+        .save(&p)
+        .unwrap();
+    let back = read_image(&p).unwrap();
+    for (x, y, s) in src.enumerate_pixels() {
+        let b = back.get(x, y);
+        for c in 0..3 {
+            assert!(
+                (b[c] - s[c]).abs() <= s[c] / 128.0,
+                "({x},{y}) {b} vs {s:?}"
+            );
+        }
+    }
+    // TGA: 8-bit sRGB code values are linearised.
+    let tga = image::RgbImage::from_fn(2, 2, |x, y| {
+        image::Rgb([(x * 255) as u8, (y * 128) as u8, 64])
+    });
+    let p = dir.join("a.tga");
+    tga.save(&p).unwrap();
+    let back = read_image(&p).unwrap();
+    assert_eq!(back.get(1, 0).x, 1.0);
+    assert!((back.get(0, 1).y - srgb_to_linear(128.0 / 255.0)).abs() < 1e-6);
+    assert!((back.get(0, 0).z - srgb_to_linear(64.0 / 255.0)).abs() < 1e-6);
+}
