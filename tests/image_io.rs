@@ -19,7 +19,11 @@ fn scratch(name: &str) -> PathBuf {
 fn test_image() -> Image {
     Image::from_fn(7, 5, |x, y| {
         let t = (y * 7 + x) as f32;
-        Rgb::new(t * 0.37 - 2.0, (t * 0.11).exp() * 1e-3, 1.0 / (t + 1.0) * 40.0)
+        Rgb::new(
+            t * 0.37 - 2.0,
+            (t * 0.11).exp() * 1e-3,
+            1.0 / (t + 1.0) * 40.0,
+        )
     })
 }
 
@@ -30,7 +34,10 @@ fn no_temp_files_left(dir: &Path) {
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .filter(|n| n.contains(".tmp-"))
         .collect();
-    assert!(leftovers.is_empty(), "temp files left behind: {leftovers:?}");
+    assert!(
+        leftovers.is_empty(),
+        "temp files left behind: {leftovers:?}"
+    );
 }
 
 #[test]
@@ -67,7 +74,10 @@ fn pfm_big_endian_and_grey_decode() {
         be.extend_from_slice(&v.to_be_bytes());
     }
     let img = decode_pfm(&be).unwrap();
-    assert_eq!(img.pixels, vec![Rgb::new(1.0, 2.0, 3.0), Rgb::new(4.0, 5.0, 6.0)]);
+    assert_eq!(
+        img.pixels,
+        vec![Rgb::new(1.0, 2.0, 3.0), Rgb::new(4.0, 5.0, 6.0)]
+    );
 
     let mut grey = b"Pf\n1 2\n-1.0\n".to_vec();
     for v in [0.25f32, 0.75] {
@@ -77,8 +87,14 @@ fn pfm_big_endian_and_grey_decode() {
     assert_eq!(img.get(0, 1), Rgb::splat(0.25));
     assert_eq!(img.get(0, 0), Rgb::splat(0.75));
 
-    assert!(decode_pfm(b"PF\n2 2\n-1.0\n\0\0").is_err(), "truncated raster accepted");
-    assert!(decode_pfm(b"P6\n2 2\n255\n").is_err(), "wrong magic accepted");
+    assert!(
+        decode_pfm(b"PF\n2 2\n-1.0\n\0\0").is_err(),
+        "truncated raster accepted"
+    );
+    assert!(
+        decode_pfm(b"P6\n2 2\n255\n").is_err(),
+        "wrong magic accepted"
+    );
 }
 
 #[test]
@@ -139,7 +155,10 @@ fn failed_writes_leave_existing_file_untouched() {
     let bad = dir.join("a.bmp");
     std::fs::write(&bad, b"keep me").unwrap();
     let err = write_image(&img, &bad, 0.0).unwrap_err().to_string();
-    assert!(err.contains("bmp") && err.contains("exr") && err.contains("png"), "{err}");
+    assert!(
+        err.contains("bmp") && err.contains("exr") && err.contains("png"),
+        "{err}"
+    );
     assert_eq!(std::fs::read(&bad).unwrap(), b"keep me");
 
     // Rename onto a directory fails after the temp file was written: the temp must vanish and
@@ -179,4 +198,40 @@ fn image_arithmetic() {
     assert_eq!(a.get(2, 1), Rgb::splat(2.0));
     assert_eq!(a.get(0, 0), Rgb::splat(0.5));
     assert!(!a.has_non_finite());
+}
+
+#[test]
+fn hdr_and_tga_reads() {
+    let dir = scratch("hdr");
+    // Radiance HDR: linear; RGBE shares one exponent per pixel with 8-bit mantissas, so the
+    // error is bounded relative to the pixel's largest channel.
+    let src = image::Rgb32FImage::from_fn(5, 3, |x, y| {
+        image::Rgb([
+            0.5 + x as f32,
+            10.0 * (y + 1) as f32,
+            0.01 * (x + y + 1) as f32,
+        ])
+    });
+    let p = dir.join("a.hdr");
+    image::DynamicImage::ImageRgb32F(src.clone())
+        .save(&p)
+        .unwrap();
+    let back = read_image(&p).unwrap();
+    for (x, y, s) in src.enumerate_pixels() {
+        let b = back.get(x, y);
+        let max = s[0].max(s[1]).max(s[2]);
+        for c in 0..3 {
+            assert!((b[c] - s[c]).abs() <= max / 128.0, "({x},{y}) {b} vs {s:?}");
+        }
+    }
+    // TGA: 8-bit sRGB code values are linearised.
+    let tga = image::RgbImage::from_fn(2, 2, |x, y| {
+        image::Rgb([(x * 255) as u8, (y * 128) as u8, 64])
+    });
+    let p = dir.join("a.tga");
+    tga.save(&p).unwrap();
+    let back = read_image(&p).unwrap();
+    assert_eq!(back.get(1, 0).x, 1.0);
+    assert!((back.get(0, 1).y - srgb_to_linear(128.0 / 255.0)).abs() < 1e-6);
+    assert!((back.get(0, 0).z - srgb_to_linear(64.0 / 255.0)).abs() < 1e-6);
 }

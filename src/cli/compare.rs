@@ -20,6 +20,13 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let test = read_image(&args.test)?;
     let reference = read_image(&args.reference)?;
+    for (img, path) in [(&test, &args.test), (&reference, &args.reference)] {
+        let bad = img.count_non_finite();
+        if bad > 0 {
+            // The metrics will be NaN/Inf; say why rather than leave the user guessing.
+            eprintln!("warning: {}: {bad} pixel(s) with NaN/Inf", path.display());
+        }
+    }
     let stats = compare(&test, &reference)?;
     println!("MSE     {:.4e}", stats.mse);
     println!("relMSE  {:.4e}", stats.rel_mse);

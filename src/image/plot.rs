@@ -46,13 +46,29 @@ fn plottable(points: &[(f64, f64)]) -> impl Iterator<Item = (f64, f64)> + '_ {
 
 /// Log-axis range covering `values` with a little headroom; a fallback when there are none.
 fn log_range(values: impl Iterator<Item = f64>, fallback: (f64, f64)) -> std::ops::Range<f64> {
-    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
     if !lo.is_finite() {
         return fallback.0..fallback.1;
     }
     // A single decade or less looks degenerate on log axes; pad multiplicatively.
-    let (lo, hi) = if hi / lo < 1.5 { (lo / 2.0, hi * 2.0) } else { (lo / 1.2, hi * 1.2) };
+    let (lo, hi) = if hi / lo < 1.5 {
+        (lo / 2.0, hi * 2.0)
+    } else {
+        (lo / 1.2, hi * 1.2)
+    };
     lo..hi
+}
+
+/// Short tick label: plain decimals without trailing zeros in [0.01, 1e4), else `1e-3` style.
+fn compact(v: f64) -> String {
+    if (0.01..1e4).contains(&v.abs()) {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{v:.0e}")
+    }
 }
 
 /// Draw the chart onto any plotters backend.
@@ -78,8 +94,8 @@ where
         .configure_mesh()
         .x_desc("time [s]")
         .y_desc("relMSE")
-        .x_label_formatter(&|v| format!("{v:.2}"))
-        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .x_label_formatter(&|v| compact(*v))
+        .y_label_formatter(&|v| compact(*v))
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 16))
         .draw()?;
@@ -88,7 +104,9 @@ where
         chart
             .draw_series(LineSeries::new(plottable(points), color.stroke_width(2)))?
             .label(name.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2))
+            });
         chart.draw_series(plottable(points).map(|p| Circle::new(p, 3, color.filled())))?;
     }
     if !series.is_empty() {
