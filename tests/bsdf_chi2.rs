@@ -17,7 +17,8 @@ const NUM_TESTS: usize = 37;
 
 fn cfg() -> Chi2Config {
     Chi2Config {
-        samples: 400_000,
+        samples: 200_000,
+        res: (32, 64),
         num_tests: NUM_TESTS,
         ..Default::default()
     }
@@ -56,7 +57,7 @@ fn zoomed(name: &str, bsdf: &Bsdf, wo: Vec3, axis: Vec3, w: f32) {
     let mut sample = sampler(bsdf, wo);
     let r = chi2_points(
         &Chi2Config {
-            res: (64, 64),
+            res: (40, 40),
             ..cfg()
         },
         [-w, w, -w, w],
