@@ -176,7 +176,13 @@ fn chi2_ggx_conductor_anisotropic() {
     for deg in [40.0, 85.0] {
         let wo = wo_at(deg);
         sphere(&format!("ggx α=(0.08,0.4) {deg}°"), &b, wo);
-        zoomed(&format!("ggx α=(0.08,0.4) {deg}°"), &b, wo, mirror_dir(wo), 1.5);
+        zoomed(
+            &format!("ggx α=(0.08,0.4) {deg}°"),
+            &b,
+            wo,
+            mirror_dir(wo),
+            1.5,
+        );
     }
 }
 
