@@ -13,7 +13,7 @@ use penumbra::sampling::Frame;
 use penumbra::sampling::chi2::{Chi2Config, Chi2Result, chi2_directions, chi2_points};
 
 /// Number of chi-square tests in this file (for the Šidák correction); keep in sync.
-const NUM_TESTS: usize = 37;
+const NUM_TESTS: usize = 41;
 
 fn cfg() -> Chi2Config {
     Chi2Config {
@@ -232,5 +232,29 @@ fn chi2_lambert_modes() {
         let mut b = Bsdf::Lambert(penumbra::bsdf::Lambert::new(Rgb::splat(0.5)));
         b.set_sampling(s);
         sphere(&format!("lambert {s:?} 45°"), &b, wo_at(45.0));
+    }
+}
+
+// ---------------------------------------------------------------- rough dielectric
+
+#[test]
+fn chi2_rough_dielectric() {
+    use penumbra::bsdf::Dielectric;
+    for (alpha, entering, deg) in [
+        (Vec2::splat(0.3), true, 30.0),
+        (Vec2::splat(0.3), true, 80.0),
+        (Vec2::splat(0.3), false, 30.0),
+        (Vec2::new(0.1, 0.4), false, 60.0),
+    ] {
+        let b = Bsdf::Dielectric(Dielectric {
+            eta: 1.5,
+            alpha,
+            entering,
+        });
+        sphere(
+            &format!("rough glass α={alpha} entering={entering} {deg}°"),
+            &b,
+            wo_at(deg),
+        );
     }
 }

@@ -469,6 +469,48 @@ fn dielectric_event_probabilities_and_energy() {
     assert!(s.wi.z < 0.0 && (s.f.x * s.wi.z.abs() - 2.25).abs() < 1e-4);
 }
 
+#[test]
+fn rough_dielectric_energy() {
+    // Flux bookkeeping: reflection weight + η²·(radiance weight of transmission) estimates the
+    // fraction of energy that single scattering keeps; it can only lose energy (shadowing).
+    for entering in [true, false] {
+        for alpha in [0.1f32, 0.5] {
+            let g = Dielectric {
+                eta: 1.5,
+                alpha: Vec2::splat(alpha),
+                entering,
+            };
+            assert!(!g.is_delta());
+            let eta2 = g.eta_rel().powi(2) as f64;
+            for deg in [0.0f32, 60.0] {
+                let wo = wo_at(deg);
+                let n = 100_000;
+                let mut rng = pcg_from_keys(&[14]);
+                let (mut s, mut s2) = (0.0f64, 0.0f64);
+                for _ in 0..n {
+                    let uc = next_f32(&mut rng);
+                    let u = Vec2::new(next_f32(&mut rng), next_f32(&mut rng));
+                    if let Some(bs) = g.sample(wo, uc, u) {
+                        let w = (bs.f.x * bs.wi.z.abs() / bs.pdf) as f64;
+                        let w = if bs.wi.z < 0.0 { w * eta2 } else { w };
+                        s += w;
+                        s2 += w * w;
+                    }
+                }
+                let m = s / n as f64;
+                let sd = ((s2 / n as f64 - m * m).max(0.0) / n as f64).sqrt();
+                eprintln!(
+                    "rough glass α={alpha} entering={entering} {deg}°: energy {m:.4} ± {sd:.1e}"
+                );
+                assert!(m <= 1.0 + 5.0 * sd, "energy {m} > 1");
+                if alpha <= 0.1 && deg < 45.0 {
+                    assert!(m > 0.97, "energy {m} too low for α = {alpha}");
+                }
+            }
+        }
+    }
+}
+
 // ---------------------------------------------------------------- constructors and materials
 
 #[test]

@@ -49,11 +49,11 @@ pub enum Material {
         /// Coat index of refraction.
         eta: f32,
     },
-    /// Glass-like dielectric (rendered smooth).
+    /// Glass-like dielectric (smooth or GGX rough).
     Dielectric {
         /// Index of refraction (inside / outside).
         eta: f32,
-        /// GGX widths (stored; see [`Dielectric`]).
+        /// GGX widths (already remapped from roughness by the loader).
         alpha: Vec2,
     },
     /// Perfect mirror (reflectance 1).
@@ -99,8 +99,10 @@ impl Material {
     /// True if every BSDF of this material is a delta lobe (light sampling cannot help).
     pub fn is_delta_only(&self) -> bool {
         match self {
-            Material::Mirror | Material::Dielectric { .. } => true,
-            Material::Conductor { alpha, .. } => is_smooth(*alpha),
+            Material::Mirror => true,
+            Material::Conductor { alpha, .. } | Material::Dielectric { alpha, .. } => {
+                is_smooth(*alpha)
+            }
             Material::Diffuse { .. } | Material::Phong { .. } | Material::CoatedDiffuse { .. } => {
                 false
             }
