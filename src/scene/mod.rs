@@ -4,6 +4,7 @@
 //! TODO(issue 5): pbrt-v4, OBJ/MTL, glTF loaders.
 
 pub mod builder;
+pub mod pbrt;
 
 pub use builder::SceneBuilder;
 
