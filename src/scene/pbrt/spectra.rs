@@ -3,11 +3,12 @@
 //! Method (stated, as the issue asks): a spectrum S(λ) is projected onto the CIE 1931 colour
 //! matching functions — the analytic multi-lobe Gaussian fit of Wyman, Sloan & Shirley (JCGT
 //! 2013) — by a Riemann sum over 360–830 nm in 1 nm steps, the XYZ is converted to linear
-//! sRGB (D65 matrix), and every channel is divided by the RGB of the constant spectrum 1 so a
-//! flat spectrum maps to exactly (1, 1, 1) (a von Kries-style white balance in RGB).
-//! Illuminants (blackbody, sampled emission spectra) are then normalised to luminance 1, as
-//! pbrt-v4 divides light spectra by their photometric integral; a blackbody thus gives the
-//! *colour* of temperature T and the light's `scale`/`power` its brightness.
+//! sRGB (D65 matrix). Reflectances are white-balanced: every channel is divided by the RGB of
+//! the constant spectrum 1, so a flat spectrum maps to exactly (1, 1, 1). Illuminants
+//! (blackbody, sampled emission spectra) are not white-balanced (as in pbrt-v4, a 6500 K
+//! blackbody comes out nearly white in sRGB) but normalised to luminance 1, as pbrt-v4 divides
+//! light spectra by their photometric integral; a blackbody thus gives the *colour* of
+//! temperature T and the light's `scale`/`power` its brightness.
 //! Named spectra: `stdillum-*` → white (1,1,1); `metal-*-eta`/`-k` are resolved by the
 //! material conversion (`bsdf::named_metal`); `glass-*` give a scalar IOR at ≈ 550 nm.
 
@@ -82,10 +83,16 @@ pub fn planck(lambda_nm: f64, t_kelvin: f64) -> f64 {
     2.0 * H * C * C / (l.powi(5) * ((H * C / (l * KB * t_kelvin)).exp() - 1.0))
 }
 
+/// Linear sRGB of an emission spectrum, normalised to luminance 1 (no white balance).
+pub fn illuminant_to_rgb(s: impl Fn(f64) -> f64) -> Rgb {
+    let c = project(s);
+    normalise_luminance(Rgb::new(c[0] as f32, c[1] as f32, c[2] as f32))
+}
+
 /// Normalised RGB colour of a blackbody at `t_kelvin` (luminance 1).
 pub fn blackbody_rgb(t_kelvin: f32) -> Rgb {
     let t = t_kelvin as f64;
-    normalise_luminance(spectrum_to_rgb(|l| planck(l, t)))
+    illuminant_to_rgb(|l| planck(l, t))
 }
 
 fn normalise_luminance(c: Rgb) -> Rgb {
@@ -140,14 +147,10 @@ pub fn to_rgb(v: &SpecVal, usage: SpectrumUse) -> Option<Rgb> {
     let c = match v {
         SpecVal::Rgb(c) => return Some(clamp_for(*c, usage)),
         SpecVal::Blackbody(t) => blackbody_rgb(*t),
-        SpecVal::Sampled(p) => {
-            let c = spectrum_to_rgb(|l| sampled_at(p, l));
-            if usage == SpectrumUse::Illuminant {
-                normalise_luminance(c)
-            } else {
-                c
-            }
+        SpecVal::Sampled(p) if usage == SpectrumUse::Illuminant => {
+            illuminant_to_rgb(|l| sampled_at(p, l))
         }
+        SpecVal::Sampled(p) => spectrum_to_rgb(|l| sampled_at(p, l)),
         SpecVal::Named(n) if n.starts_with("stdillum-") => Rgb::ONE,
         SpecVal::Named(n) => return named_glass_ior(n).map(Rgb::splat),
     };
