@@ -40,7 +40,9 @@ fn catalogue_has_at_least_25_files_and_each_is_a_located_error() {
                 let msg = e.to_string();
                 let located = msg.contains(&format!("{name}:{line}:"));
                 if !located || !msg.contains(&what) {
-                    failures.push(format!("{name}: want '{name}:{line}:' and '{what}', got: {msg}"));
+                    failures.push(format!(
+                        "{name}: want '{name}:{line}:' and '{what}', got: {msg}"
+                    ));
                 }
             }
         }
@@ -52,7 +54,9 @@ fn cornell() -> String {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/scenes/cornell-box-bitterli/scene-v4.pbrt");
     std::fs::read_to_string(&p)
-        .or_else(|_| std::fs::read_to_string("/work/shared/scenes/cornell-box-bitterli/scene-v4.pbrt"))
+        .or_else(|_| {
+            std::fs::read_to_string("/work/shared/scenes/cornell-box-bitterli/scene-v4.pbrt")
+        })
         .expect("cornell scene")
 }
 
@@ -60,7 +64,10 @@ fn cornell() -> String {
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         self.0 >> 33
     }
 }
@@ -78,7 +85,10 @@ fn truncated_scenes_never_panic_and_errors_are_located() {
             Err(e) => {
                 errors += 1;
                 let m = e.to_string();
-                assert!(m.starts_with("trunc.pbrt:"), "unlocated error at cut {cut}: {m}");
+                assert!(
+                    m.starts_with("trunc.pbrt:"),
+                    "unlocated error at cut {cut}: {m}"
+                );
             }
         }
     }
