@@ -782,7 +782,7 @@ fn plymesh_without_normals_and_with_uint_indices() {
 #[ignore]
 fn big_ply_parse_timing() {
     let d = tmpdir("big");
-    let n = 708; // (n−1)² · 2 ≈ 1.0M triangles
+    let n = 709; // (n−1)² · 2 ≈ 1.0M triangles
     let mut b = ply_header("binary_little_endian", n * n, (n - 1) * (n - 1), false);
     for j in 0..n {
         for i in 0..n {
