@@ -1,9 +1,9 @@
-//! Pinhole perspective camera with pbrt-v4 conventions (fov on the shorter image axis, LookAt,
-//! left-handed camera space looking down +z, +y up, raster y downward).
-//! TODO(issue 3): implement; `generate_ray` is the contract.
+//! Pinhole perspective camera with pbrt-v4 conventions: camera space is left-handed, looking
+//! down +z with +y up and +x to the right of the image; the field of view spans the shorter
+//! image axis; raster y grows downward.
 
 use crate::geometry::{Ray, Transform};
-use glam::Vec2;
+use glam::{UVec2, Vec2, Vec3};
 
 /// A pinhole camera.
 #[derive(Clone, Debug)]
@@ -17,10 +17,61 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// A camera at `eye` looking at `target` (pbrt `LookAt` semantics).
+    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_deg: f32) -> anyhow::Result<Self> {
+        let cam_from_world = Transform::look_at(eye, target, up)?;
+        Ok(Self {
+            camera_to_world: cam_from_world.inverse(),
+            fov_deg,
+            screen_window: None,
+        })
+    }
+
+    /// The screen window in effect for resolution `res`.
+    pub fn window(&self, res: UVec2) -> [f32; 4] {
+        if let Some(w) = self.screen_window {
+            return w;
+        }
+        let aspect = res.x as f32 / res.y as f32;
+        if aspect > 1.0 {
+            [-aspect, aspect, -1.0, 1.0]
+        } else {
+            [-1.0, 1.0, -1.0 / aspect, 1.0 / aspect]
+        }
+    }
+
+    /// Camera-space direction (not normalised, z = 1) through raster position `p`.
+    #[inline]
+    fn camera_dir(&self, p: Vec2, res: UVec2, win: &[f32; 4], tan_half: f32) -> Vec3 {
+        let sx = win[0] + (p.x / res.x as f32) * (win[1] - win[0]);
+        let sy = win[3] - (p.y / res.y as f32) * (win[3] - win[2]);
+        Vec3::new(sx * tan_half, sy * tan_half, 1.0)
+    }
+
     /// The ray through continuous raster position `p_raster` (pixels, origin top-left) of a
-    /// `res.x × res.y` image.
-    pub fn generate_ray(&self, p_raster: Vec2, res: glam::UVec2) -> Ray {
-        let _ = (p_raster, res);
-        todo!("issue 3")
+    /// `res.x × res.y` image. The direction is unit length.
+    pub fn generate_ray(&self, p_raster: Vec2, res: UVec2) -> Ray {
+        let win = self.window(res);
+        let tan_half = (self.fov_deg.to_radians() * 0.5).tan();
+        let d = self.camera_dir(p_raster, res, &win, tan_half);
+        let o = self.camera_to_world.point(Vec3::ZERO);
+        let dw = self.camera_to_world.vector(d).normalize();
+        Ray::new(o, dw)
+    }
+
+    /// Continuous raster position of world point `p`, or `None` if it is behind the camera.
+    pub fn project(&self, p: Vec3, res: UVec2) -> Option<Vec2> {
+        let pc = self.camera_to_world.m_inv.transform_point3(p);
+        if pc.z <= 0.0 {
+            return None;
+        }
+        let win = self.window(res);
+        let tan_half = (self.fov_deg.to_radians() * 0.5).tan();
+        let sx = pc.x / pc.z / tan_half;
+        let sy = pc.y / pc.z / tan_half;
+        Some(Vec2::new(
+            (sx - win[0]) / (win[1] - win[0]) * res.x as f32,
+            (win[3] - sy) / (win[3] - win[2]) * res.y as f32,
+        ))
     }
 }

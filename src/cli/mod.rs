@@ -16,14 +16,33 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene (built-in name or file) to an image.
     Render(render::Args),
+    /// List the built-in scenes.
+    Scenes,
+    /// Print rays/s and time per image on the standard scenes.
+    Bench(bench::Args),
+    /// Compare an image with a reference: MSE, relMSE, MAE.
+    Compare(compare::Args),
 }
 
+pub mod bench;
+pub mod compare;
 pub mod render;
 
 /// Dispatch a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Render(a)) => render::run(a),
-        None => render::run(render::Args::default_scene()),
+        Some(Command::Compare(a)) => compare::run(a),
+        Some(Command::Scenes) => {
+            for b in penumbra::scene::builtin::BUILTINS {
+                println!("{:<16} {}", b.name, b.description);
+            }
+            Ok(())
+        }
+        Some(Command::Bench(a)) => bench::run(a),
+        None => match Cli::try_parse_from(["penumbra", "render"])?.command {
+            Some(Command::Render(a)) => render::run(a),
+            _ => unreachable!("`render` parses to the render command"),
+        },
     }
 }

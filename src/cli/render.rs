@@ -1,23 +1,137 @@
-//! `penumbra render`. TODO(issue 3).
+//! `penumbra render`: load a scene, render it with the chosen estimator, write the image.
+
+use anyhow::Context;
+use glam::UVec2;
+use penumbra::integrator::{MisHeuristic, RenderOptions, Strategy, render};
+use penumbra::sampling::PatternKind;
+use penumbra::scene::builtin::BuiltinOptions;
+use penumbra::scene::load::{LoadOptions, load};
+use std::path::PathBuf;
 
 /// Arguments of `penumbra render`.
-#[derive(clap::Args, Debug)]
+#[derive(clap::Args, Debug, Clone)]
 pub struct Args {
-    /// Built-in scene name or scene file path.
+    /// Built-in scene name (see `penumbra scenes`) or scene file path.
     #[arg(default_value = "cornell")]
     pub scene: String,
+    /// Output image (.png, .exr or .pfm); default: the scene's file name or penumbra.png.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Eye rays per pixel (N); default: the scene's, else 64.
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Light (or BSDF) samples per eye ray (M).
+    #[arg(long, default_value_t = 1)]
+    pub shadow_rays: u32,
+    /// Resolution WxH; default: the scene's.
+    #[arg(long, value_parser = parse_res)]
+    pub res: Option<UVec2>,
+    /// Seed of every random number.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Estimator: bsdf, light-area, light-solid-angle or mis.
+    #[arg(long, default_value = "mis")]
+    pub strategy: Strategy,
+    /// MIS heuristic: power (β = 2) or balance.
+    #[arg(long, default_value = "power")]
+    pub mis: MisHeuristic,
+    /// Sample pattern: fixed, random, grid, stratified, lhs or sobol.
+    #[arg(long, default_value = "stratified")]
+    pub pattern: PatternKind,
+    /// Light selection strategy.
+    #[arg(long, default_value = "uniform")]
+    pub light_selection: String,
+    /// PNG exposure in stops.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Number of lights of the many-light built-in scenes.
+    #[arg(long)]
+    pub light_count: Option<u32>,
+    /// Rooms per side of `many-rooms`.
+    #[arg(long)]
+    pub rooms: Option<u32>,
 }
 
-impl Args {
-    /// What `penumbra` with no subcommand renders.
-    pub fn default_scene() -> Self {
-        Self {
-            scene: "cornell".into(),
-        }
+/// Parse `WxH`.
+pub fn parse_res(s: &str) -> Result<UVec2, String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WxH (e.g. 512x512), got '{s}'"))?;
+    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
+    if w == 0 || h == 0 || w > 65536 || h > 65536 {
+        return Err(format!("resolution must be between 1 and 65536 per axis, got '{s}'"));
+    }
+    Ok(UVec2::new(w, h))
+}
+
+/// The load options the render-like commands share.
+pub fn load_options(a: &Args) -> LoadOptions {
+    LoadOptions {
+        builtin: BuiltinOptions {
+            light_count: a.light_count,
+            rooms: a.rooms,
+            triangles: None,
+        },
     }
 }
 
 /// Run the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("render of {} not implemented yet (issue 3)", args.scene)
+    anyhow::ensure!(args.shadow_rays >= 1, "--shadow-rays must be at least 1");
+    anyhow::ensure!(args.exposure.is_finite(), "--exposure must be finite");
+    let loaded = load(&args.scene, &load_options(&args))?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    let scene = loaded.scene;
+    let res = args.res.unwrap_or(scene.film.resolution);
+    let opts = RenderOptions {
+        spp: args.spp.or(scene.film.spp).unwrap_or(64),
+        shadow_rays: args.shadow_rays,
+        seed: args.seed,
+        strategy: args.strategy,
+        mis: args.mis,
+        pattern: args.pattern,
+        light_selection: args.light_selection.clone(),
+        progress: !args.quiet,
+    };
+    anyhow::ensure!(opts.spp >= 1, "--spp must be at least 1");
+    let out = args
+        .output
+        .clone()
+        .or_else(|| scene.film.filename.as_ref().map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("penumbra.png"));
+    let (img, stats) = match args.threads {
+        Some(t) => {
+            anyhow::ensure!(t >= 1, "--threads must be at least 1");
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .context("creating the thread pool")?
+                .install(|| render(&scene, res, &opts))?
+        }
+        None => render(&scene, res, &opts)?,
+    };
+    penumbra::image::io::write_image(&img, &out, args.exposure)
+        .with_context(|| format!("writing {}", out.display()))?;
+    println!(
+        "{}x{}  {} spp x {} shadow rays  {}  {:.3} s  {:.2} M rays  {:.1} Mrays/s  -> {}",
+        res.x,
+        res.y,
+        opts.spp,
+        opts.shadow_rays,
+        opts.strategy,
+        stats.time.as_secs_f64(),
+        stats.rays as f64 / 1e6,
+        stats.mrays_per_s(),
+        out.display()
+    );
+    Ok(())
 }

@@ -1,11 +1,16 @@
-//! Shapes, transforms, rays and the ray-query acceleration structure (BVH).
-//! TODO(issue 3): shapes (mesh, sphere, disk), obvhs-backed BVH, robust ray offsets.
+//! Shapes, transforms, rays and the ray-query acceleration structure (obvhs CWBVH).
 
+pub mod accel;
+pub mod float;
 pub mod interaction;
+pub mod quadric;
 pub mod ray;
 pub mod transform;
+pub mod triangle;
 
+pub use accel::{Geometry, MeshShading, PrimKind, Primitive};
 pub use interaction::SurfaceHit;
+pub use quadric::{Quadric, QuadricKind};
 pub use ray::Ray;
 pub use transform::Transform;
 
@@ -16,6 +21,3 @@ pub trait RayQuery: Send + Sync {
     /// True if anything blocks the ray for t in (0, ray.t_max) (shadow rays).
     fn occluded(&self, ray: &Ray) -> bool;
 }
-
-/// All scene geometry behind one BVH. TODO(issue 3): triangles, spheres, disks; obvhs CWBVH.
-pub struct Geometry {}

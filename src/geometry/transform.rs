@@ -75,3 +75,36 @@ impl Transform {
         self.m.determinant() < 0.0
     }
 }
+
+impl Transform {
+    /// pbrt's `LookAt`: the camera-from-world transform of a camera at `eye` looking at
+    /// `target` (left-handed: +z forward, +y up, +x right).
+    pub fn look_at(eye: glam::Vec3, target: glam::Vec3, up: glam::Vec3) -> anyhow::Result<Self> {
+        let dir = (target - eye).normalize_or_zero();
+        anyhow::ensure!(dir != glam::Vec3::ZERO, "LookAt: eye and target coincide");
+        let right = up.normalize_or_zero().cross(dir);
+        anyhow::ensure!(
+            right.length_squared() > 1e-12,
+            "LookAt: up vector and viewing direction are parallel"
+        );
+        let right = right.normalize();
+        let new_up = dir.cross(right);
+        let world_from_camera = Mat4::from_cols(
+            right.extend(0.0),
+            new_up.extend(0.0),
+            dir.extend(0.0),
+            eye.extend(1.0),
+        );
+        let t = Transform::new(world_from_camera)
+            .ok_or_else(|| anyhow::anyhow!("LookAt: singular camera transform"))?;
+        Ok(t.inverse())
+    }
+
+    /// Translation by `v`.
+    pub fn translate(v: glam::Vec3) -> Self {
+        Self {
+            m: Mat4::from_translation(v),
+            m_inv: Mat4::from_translation(-v),
+        }
+    }
+}

@@ -1,7 +1,18 @@
 //! Direct-lighting estimators and the render loop.
-//! TODO(issue 3): render loop + light-area estimator. TODO(issue 4): bsdf, solid-angle, MIS.
+//!
+//! `direct` holds the lecture's estimators (BSDF sampling, light-area sampling, solid-angle
+//! sampling, MIS); `render` drives them over tiles in parallel; `film` turns pixel samples into
+//! raster positions by filter importance sampling.
+
+pub mod direct;
+pub mod film;
+pub mod render;
+
+pub use render::{RenderStats, render};
 
 use crate::sampling::PatternKind;
+use std::fmt;
+use std::str::FromStr;
 
 /// The estimator selected by `--strategy`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -16,6 +27,44 @@ pub enum Strategy {
     Mis,
 }
 
+impl Strategy {
+    /// Every strategy, in CLI order.
+    pub const ALL: [Strategy; 4] = [
+        Strategy::Bsdf,
+        Strategy::LightArea,
+        Strategy::LightSolidAngle,
+        Strategy::Mis,
+    ];
+
+    /// The CLI name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::Bsdf => "bsdf",
+            Strategy::LightArea => "light-area",
+            Strategy::LightSolidAngle => "light-solid-angle",
+            Strategy::Mis => "mis",
+        }
+    }
+}
+
+impl fmt::Display for Strategy {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Strategy {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == s.trim())
+            .ok_or_else(|| {
+                format!("unknown strategy '{s}' (expected one of: bsdf, light-area, light-solid-angle, mis)")
+            })
+    }
+}
+
 /// MIS weighting heuristic.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum MisHeuristic {
@@ -23,6 +72,17 @@ pub enum MisHeuristic {
     Power,
     /// Balance heuristic.
     Balance,
+}
+
+impl FromStr for MisHeuristic {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim() {
+            "power" => Ok(Self::Power),
+            "balance" => Ok(Self::Balance),
+            _ => Err(format!("unknown MIS heuristic '{s}' (expected power or balance)")),
+        }
+    }
 }
 
 /// Everything that decides how an image is rendered (besides the scene).
@@ -44,4 +104,19 @@ pub struct RenderOptions {
     pub light_selection: String,
     /// Show a progress bar.
     pub progress: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            spp: 64,
+            shadow_rays: 1,
+            seed: 0,
+            strategy: Strategy::Mis,
+            mis: MisHeuristic::Power,
+            pattern: PatternKind::Stratified,
+            light_selection: "uniform".into(),
+            progress: false,
+        }
+    }
 }

@@ -38,3 +38,16 @@ pub trait LightSelector: Send + Sync {
     /// Name as accepted by `--light-selection`.
     fn name(&self) -> &'static str;
 }
+
+/// The selector named `name` (as accepted by `--light-selection`) for `scene`.
+pub fn make_selector(
+    name: &str,
+    scene: &crate::scene::Scene,
+) -> anyhow::Result<Box<dyn LightSelector>> {
+    match name {
+        "uniform" => Ok(Box::new(UniformSelector {
+            count: scene.lights.len() as u32,
+        })),
+        other => anyhow::bail!("unknown light selection '{other}' (expected one of: uniform)"),
+    }
+}

@@ -1,7 +1,9 @@
 //! Light sources. Each returns radiance and a **solid-angle** pdf (area pdfs are converted in
 //! one place, [`area_to_solid_angle`]), its power Φ and its bounds (for power and BVH selection).
-//! TODO(issue 4): point, spot, distant, triangle/quad/sphere/disk area lights, uniform
-//! infinite, environment map; area and solid-angle sampling.
+//!
+//! One light per file: [`TriangleLight`], [`QuadLight`], [`SphereLight`], [`DiskLight`] (area
+//! lights, area or solid-angle sampling), [`PointLight`], [`SpotLight`], [`DistantLight`]
+//! (delta lights), [`UniformInfiniteLight`] and [`EnvMapLight`] (infinite lights).
 
 use crate::Rgb;
 use glam::{Vec2, Vec3};
@@ -100,21 +102,103 @@ pub fn area_to_solid_angle(pdf_area: f32, p: Vec3, p_light: Vec3, n_light: Vec3)
     if cos <= 0.0 { 0.0 } else { pdf_area * r2 / cos }
 }
 
+/// Smallest solid angle (sr) for which area lights sample the spherical polygon: below it the
+/// spherical construction loses precision in f32/f64, while area sampling is already nearly
+/// uniform in solid angle (the light is small and far), so nothing is lost by falling back.
+pub const MIN_SPHERICAL_SOLID_ANGLE: f32 = 1e-4;
+/// Largest solid angle (sr, just under the 2π of a half-space) for which area lights sample the
+/// spherical polygon: beyond it the receiver is almost in the light's plane next to a large
+/// light, the polygon's corners are nearly antipodal and the construction is ill-conditioned.
+pub const MAX_SPHERICAL_SOLID_ANGLE: f32 = 6.22;
+
+/// Whether a spherical polygon of solid angle `omega` is sampled directly (see the thresholds).
+#[inline]
+pub(crate) fn spherical_ok(omega: f32) -> bool {
+    (MIN_SPHERICAL_SOLID_ANGLE..=MAX_SPHERICAL_SOLID_ANGLE).contains(&omega)
+}
+
+pub mod disk;
+pub mod distant;
+pub mod envmap;
+pub mod point;
+pub mod quad;
+pub mod sphere;
+pub mod spot;
 pub mod triangle;
+pub mod uniform_infinite;
 
+pub use disk::DiskLight;
+pub use distant::DistantLight;
+pub use envmap::EnvMapLight;
+pub use point::PointLight;
+pub use quad::QuadLight;
+pub use sphere::SphereLight;
+pub use spot::SpotLight;
 pub use triangle::TriangleLight;
+pub use uniform_infinite::UniformInfiniteLight;
 
-/// Closed set of lights (enum dispatch: a million emissive triangles stay compact and fast).
+/// Closed set of lights (enum dispatch: a million emissive triangles stay compact and fast;
+/// the bulky environment map is boxed so it does not inflate every triangle).
 #[derive(Clone, Debug)]
 pub enum Light {
     /// Diffuse emissive triangle.
     Triangle(TriangleLight),
+    /// Diffuse emissive parallelogram.
+    Quad(QuadLight),
+    /// Diffuse emissive sphere.
+    Sphere(SphereLight),
+    /// Diffuse emissive disk.
+    Disk(DiskLight),
+    /// Isotropic point light.
+    Point(PointLight),
+    /// Spot light with smoothstep falloff.
+    Spot(SpotLight),
+    /// Directional light from infinitely far away.
+    Distant(DistantLight),
+    /// Constant radiance from every direction.
+    UniformInfinite(UniformInfiniteLight),
+    /// Lat-long environment map.
+    EnvMap(Box<EnvMapLight>),
+}
+
+/// Calls `$body` with `$l` bound to the inner light of every variant.
+macro_rules! dispatch {
+    ($self:expr, $l:ident => $body:expr) => {
+        match $self {
+            Light::Triangle($l) => $body,
+            Light::Quad($l) => $body,
+            Light::Sphere($l) => $body,
+            Light::Disk($l) => $body,
+            Light::Point($l) => $body,
+            Light::Spot($l) => $body,
+            Light::Distant($l) => $body,
+            Light::UniformInfinite($l) => $body,
+            Light::EnvMap($l) => $body,
+        }
+    };
 }
 
 impl Light {
     /// True for lights at infinity (environment, uniform sky), hit by rays that escape.
     pub fn is_infinite(&self) -> bool {
-        false
+        matches!(self, Light::UniformInfinite(_) | Light::EnvMap(_))
+    }
+
+    /// True for lights described by a Dirac delta (point, spot, distant): no ray can hit them,
+    /// so they cannot be combined with BSDF sampling by MIS.
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Light::Point(_) | Light::Spot(_) | Light::Distant(_))
+    }
+
+    /// Give distant and infinite lights the scene's bounding sphere (they need it to place
+    /// shadow-ray endpoints and to compute their power); a no-op for the others.
+    pub fn preprocess(&mut self, center: Vec3, radius: f32) {
+        match self {
+            Light::Distant(l) => l.preprocess(center, radius),
+            Light::UniformInfinite(l) => l.preprocess(center, radius),
+            Light::EnvMap(l) => l.preprocess(center, radius),
+            _ => {}
+        }
     }
 }
 
@@ -126,9 +210,7 @@ impl LightSource for Light {
         u: Vec2,
         mode: SamplingMode,
     ) -> Option<LightLiSample> {
-        match self {
-            Light::Triangle(l) => l.sample_li(ctx, u, mode),
-        }
+        dispatch!(self, l => l.sample_li(ctx, u, mode))
     }
     #[inline]
     fn pdf_li(
@@ -139,24 +221,23 @@ impl LightSource for Light {
         n_light: Vec3,
         mode: SamplingMode,
     ) -> f32 {
-        match self {
-            Light::Triangle(l) => l.pdf_li(ctx, wi, p_light, n_light, mode),
-        }
+        dispatch!(self, l => l.pdf_li(ctx, wi, p_light, n_light, mode))
     }
     #[inline]
     fn radiance(&self, p: Vec3, n: Vec3, uv: Vec2, w: Vec3) -> Rgb {
-        match self {
-            Light::Triangle(l) => l.radiance(p, n, uv, w),
-        }
+        dispatch!(self, l => l.radiance(p, n, uv, w))
     }
     fn power(&self) -> f32 {
-        match self {
-            Light::Triangle(l) => l.power(),
-        }
+        dispatch!(self, l => l.power())
     }
     fn bounds(&self) -> Option<LightBounds> {
-        match self {
-            Light::Triangle(l) => l.bounds(),
-        }
+        dispatch!(self, l => l.bounds())
     }
+}
+
+/// Endpoint of a shadow ray toward a light at infinity: twice the scene radius along `wi`,
+/// safely outside the scene's bounding sphere from any point inside it.
+#[inline]
+pub(crate) fn far_point(p: Vec3, wi: Vec3, scene_radius: f32) -> Vec3 {
+    p + wi * (2.0 * scene_radius)
 }

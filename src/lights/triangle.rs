@@ -1,9 +1,11 @@
-//! Diffuse emissive triangle. TODO(issue 4): spherical-triangle solid-angle sampling.
+//! Diffuse emissive triangle: area sampling (uniform barycentrics) or solid-angle sampling
+//! (Arvo's spherical triangle, [`crate::sampling::SphericalTriangle`]).
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
+    spherical_ok,
 };
-use crate::sampling::uniform_triangle_point;
+use crate::sampling::{SphericalTriangle, uniform_triangle_point};
 use crate::{Rgb, luminance};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -43,6 +45,25 @@ impl TriangleLight {
     fn emits_toward(&self, w: Vec3) -> bool {
         self.two_sided || self.n.dot(w) > 0.0
     }
+
+    /// Whether a receiver at `p` can see the emitting side at all (one-sided lights are dark
+    /// from behind; a receiver in the plane sees nothing).
+    #[inline]
+    fn faces(&self, p: Vec3) -> bool {
+        let s = self.n.dot(p - self.p[0]);
+        if self.two_sided { s != 0.0 } else { s > 0.0 }
+    }
+
+    /// The spherical triangle to sample from `p` in solid-angle mode, or `None` where the rule
+    /// of [`spherical_ok`] says to sample by area. `sample_li` and `pdf_li` both decide through
+    /// this one function, so the sample and its pdf always agree.
+    fn spherical(&self, p: Vec3, mode: SamplingMode) -> Option<SphericalTriangle> {
+        if mode != SamplingMode::SolidAngle {
+            return None;
+        }
+        let st = SphericalTriangle::new(p, self.p[0], self.p[1], self.p[2])?;
+        spherical_ok(st.area).then_some(st)
+    }
 }
 
 impl LightSource for TriangleLight {
@@ -50,8 +71,27 @@ impl LightSource for TriangleLight {
         &self,
         ctx: &LightSampleContext,
         u: Vec2,
-        _mode: SamplingMode,
+        mode: SamplingMode,
     ) -> Option<LightLiSample> {
+        if !self.faces(ctx.p) {
+            return None;
+        }
+        if let Some(st) = self.spherical(ctx.p, mode) {
+            let wi = st.sample(u);
+            // Where the sampled direction meets the triangle's plane (the shadow-ray target).
+            let denom = self.n.dot(wi);
+            let t = self.n.dot(self.p[0] - ctx.p) / denom;
+            if !(t > 0.0) || !t.is_finite() {
+                return None;
+            }
+            return Some(LightLiSample {
+                wi,
+                li: self.l,
+                pdf: 1.0 / st.area,
+                p_light: ctx.p + wi * t,
+                delta: false,
+            });
+        }
         let p_light = uniform_triangle_point(u, self.p[0], self.p[1], self.p[2]);
         let d = p_light - ctx.p;
         let dist = d.length();
@@ -59,9 +99,6 @@ impl LightSource for TriangleLight {
             return None;
         }
         let wi = d / dist;
-        if !self.emits_toward(-wi) {
-            return None;
-        }
         let pdf = area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n);
         if !(pdf > 0.0) || !pdf.is_finite() {
             return None;
@@ -78,12 +115,19 @@ impl LightSource for TriangleLight {
     fn pdf_li(
         &self,
         ctx: &LightSampleContext,
-        _wi: Vec3,
+        wi: Vec3,
         p_light: Vec3,
         _n_light: Vec3,
-        _mode: SamplingMode,
+        mode: SamplingMode,
     ) -> f32 {
-        area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n)
+        // Directions onto the dark side are never sampled (sample_li returns None there).
+        if !self.faces(ctx.p) {
+            return 0.0;
+        }
+        match self.spherical(ctx.p, mode) {
+            Some(st) => st.pdf(wi),
+            None => area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n),
+        }
     }
 
     fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {

@@ -1,11 +1,15 @@
 //! [`SceneBuilder`]: what every loader and built-in scene calls to assemble a [`Scene`].
-//! TODO(issue 3): implement (meshes → BVH primitives; emissive triangles → one light each).
 
 use super::{AreaEmission, FilmSpec, Scene, TriangleMesh};
 use crate::camera::Camera;
-use crate::geometry::Transform;
-use crate::lights::Light;
+use crate::geometry::{
+    Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Transform,
+    interaction::NO_LIGHT,
+};
+use crate::lights::{DiskLight, Light, QuadLight, SphereLight, TriangleLight};
 use crate::material::Material;
+use anyhow::{Context, bail, ensure};
+use glam::Vec3;
 
 /// Accumulates shapes, materials and lights, then builds the BVH once.
 #[derive(Default)]
@@ -14,6 +18,11 @@ pub struct SceneBuilder {
     pub materials: Vec<Material>,
     /// Lights added so far (area lights are appended as emissive shapes are added).
     pub lights: Vec<Light>,
+    prims: Vec<Primitive>,
+    meshes: Vec<MeshShading>,
+    quadrics: Vec<Quadric>,
+    /// Triangles skipped because their area is zero (loaders may warn about them).
+    pub degenerate_triangles: usize,
 }
 
 impl SceneBuilder {
@@ -28,17 +37,188 @@ impl SceneBuilder {
         (self.materials.len() - 1) as u32
     }
 
+    /// Number of primitives added so far.
+    pub fn primitive_count(&self) -> usize {
+        self.prims.len()
+    }
+
+    fn check_material(&self, material: u32) -> anyhow::Result<()> {
+        ensure!(
+            (material as usize) < self.materials.len(),
+            "material index {material} out of range ({} materials)",
+            self.materials.len()
+        );
+        Ok(())
+    }
+
     /// Add a world-space triangle mesh. With `emission`, each triangle becomes its own
-    /// [`crate::lights::TriangleLight`]. Errors on out-of-range indices or non-finite data;
-    /// zero-area triangles are skipped.
+    /// [`TriangleLight`]. Errors on out-of-range indices or non-finite data; zero-area triangles
+    /// are skipped (counted in `degenerate_triangles`).
     pub fn add_mesh(
         &mut self,
         mesh: TriangleMesh,
         material: u32,
         emission: Option<AreaEmission>,
     ) -> anyhow::Result<()> {
-        let _ = (mesh, material, emission);
-        todo!("issue 3")
+        self.check_material(material)?;
+        let TriangleMesh {
+            positions,
+            normals,
+            uvs,
+            indices,
+            flip_normals,
+        } = mesh;
+        ensure!(!indices.is_empty(), "mesh has no triangles");
+        ensure!(
+            indices.len().is_multiple_of(3),
+            "mesh index count {} is not a multiple of 3",
+            indices.len()
+        );
+        let nv = positions.len();
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            bail!("mesh vertex {i} has a non-finite position {:?}", positions[i]);
+        }
+        let normals = match normals {
+            Some(n) => {
+                ensure!(n.len() == nv, "mesh has {} normals for {nv} vertices", n.len());
+                if let Some(i) = n.iter().position(|v| !v.is_finite()) {
+                    bail!("mesh normal {i} is not finite");
+                }
+                // Normalised here, once, so every loader and built-in scene agrees bit for bit.
+                Some(n.into_iter().map(|v| v.normalize_or_zero()).collect::<Vec<_>>())
+            }
+            None => None,
+        };
+        if let Some(uv) = &uvs {
+            ensure!(uv.len() == nv, "mesh has {} uvs for {nv} vertices", uv.len());
+        }
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= nv) {
+            bail!("mesh index {bad} out of range ({nv} vertices)");
+        }
+        if let Some(e) = &emission {
+            check_emission(e)?;
+        }
+        let mesh_id = self.meshes.len() as u32;
+        for tri in indices.chunks_exact(3) {
+            let v = [tri[0], tri[1], tri[2]];
+            let p = [
+                positions[v[0] as usize],
+                positions[v[1] as usize],
+                positions[v[2] as usize],
+            ];
+            let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+            let cross = e1.cross(e2);
+            if !(cross.length_squared() > 0.0) {
+                self.degenerate_triangles += 1;
+                continue;
+            }
+            let light = match &emission {
+                Some(e) => {
+                    // The emitting side is the hit record's geometric normal (pbrt-v4): the
+                    // winding normal, flipped toward the vertex normals or by the orientation flag.
+                    let mut n = cross.normalize();
+                    match &normals {
+                        Some(ns) => {
+                            let avg = ns[v[0] as usize] + ns[v[1] as usize] + ns[v[2] as usize];
+                            if n.dot(avg) < 0.0 {
+                                n = -n;
+                            }
+                        }
+                        None => {
+                            if flip_normals {
+                                n = -n;
+                            }
+                        }
+                    }
+                    match TriangleLight::new(p, n, e.l, e.two_sided) {
+                        Some(l) => {
+                            self.lights.push(Light::Triangle(l));
+                            (self.lights.len() - 1) as u32
+                        }
+                        None => NO_LIGHT,
+                    }
+                }
+                None => NO_LIGHT,
+            };
+            self.prims.push(Primitive {
+                p0: p[0],
+                e1,
+                e2,
+                kind: PrimKind::Triangle { mesh: mesh_id, v },
+                material,
+                light,
+            });
+        }
+        self.meshes.push(MeshShading {
+            normals,
+            uvs,
+            flip: flip_normals,
+        });
+        Ok(())
+    }
+
+    /// Add a parallelogram corner + s·e1 + t·e2 (s, t ∈ [0,1]) as two triangles, normal
+    /// e1 × e2.
+    pub fn add_quad(
+        &mut self,
+        corner: Vec3,
+        e1: Vec3,
+        e2: Vec3,
+        material: u32,
+        emission: Option<AreaEmission>,
+    ) -> anyhow::Result<()> {
+        let mesh = TriangleMesh {
+            positions: vec![corner, corner + e1, corner + e1 + e2, corner + e2],
+            normals: None,
+            uvs: None,
+            indices: vec![0, 1, 2, 0, 2, 3],
+            flip_normals: false,
+        };
+        let before = self.prims.len();
+        self.add_mesh(mesh, material, None)
+            .context("adding a quad")?;
+        if let Some(e) = emission {
+            check_emission(&e)?;
+            let n = e1.cross(e2).normalize_or_zero();
+            // One light for the whole parallelogram, so it can be sampled by solid angle
+            // (spherical rectangle) instead of as two triangles.
+            if let Some(l) = QuadLight::new(corner, e1, e2, n, e.l, e.two_sided) {
+                self.lights.push(Light::Quad(l));
+                let id = (self.lights.len() - 1) as u32;
+                for p in &mut self.prims[before..] {
+                    p.light = id;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn add_quadric(
+        &mut self,
+        q: Quadric,
+        material: u32,
+        emission: Option<AreaEmission>,
+    ) -> anyhow::Result<()> {
+        self.check_material(material)?;
+        let light = match emission {
+            Some(e) => {
+                check_emission(&e)?;
+                let light = quadric_light(&q, &e)?;
+                self.lights.push(light);
+                (self.lights.len() - 1) as u32
+            }
+            None => NO_LIGHT,
+        };
+        self.quadrics.push(q);
+        self.prims.push(Primitive {
+            p0: Vec3::ZERO,
+            e1: Vec3::ZERO,
+            e2: Vec3::ZERO,
+            kind: PrimKind::Quadric((self.quadrics.len() - 1) as u32),
+            material,
+            light,
+        });
+        Ok(())
     }
 
     /// Add a sphere of `radius` centred at the origin of `to_world`'s object space.
@@ -51,8 +231,16 @@ impl SceneBuilder {
         emission: Option<AreaEmission>,
         reverse_orientation: bool,
     ) -> anyhow::Result<()> {
-        let _ = (to_world, radius, material, emission, reverse_orientation);
-        todo!("issue 3")
+        ensure!(
+            radius.is_finite() && radius > 0.0,
+            "sphere radius must be positive and finite, got {radius}"
+        );
+        let q = Quadric {
+            kind: QuadricKind::Sphere { radius },
+            to_world,
+            flip: reverse_orientation ^ to_world.swaps_handedness(),
+        };
+        self.add_quadric(q, material, emission)
     }
 
     /// Add a disk of `radius` in the z = `height` plane of `to_world`'s object space, normal +z.
@@ -65,15 +253,16 @@ impl SceneBuilder {
         emission: Option<AreaEmission>,
         reverse_orientation: bool,
     ) -> anyhow::Result<()> {
-        let _ = (
-            to_world,
-            height,
-            radius,
-            material,
-            emission,
-            reverse_orientation,
+        ensure!(
+            radius.is_finite() && radius > 0.0 && height.is_finite(),
+            "disk radius must be positive and finite (radius {radius}, height {height})"
         );
-        todo!("issue 3")
+        let q = Quadric {
+            kind: QuadricKind::Disk { height, radius },
+            to_world,
+            flip: reverse_orientation ^ to_world.swaps_handedness(),
+        };
+        self.add_quadric(q, material, emission)
     }
 
     /// Add a light that is not attached to geometry (point, spot, distant, infinite).
@@ -83,7 +272,74 @@ impl SceneBuilder {
 
     /// Build the BVH and light tables.
     pub fn build(self, camera: Camera, film: FilmSpec) -> anyhow::Result<Scene> {
-        let _ = (camera, film);
-        todo!("issue 3")
+        ensure!(
+            film.resolution.x > 0 && film.resolution.y > 0,
+            "film resolution must be positive, got {}x{}",
+            film.resolution.x,
+            film.resolution.y
+        );
+        let geometry = Geometry::new(self.prims, self.meshes, self.quadrics);
+        let mut lights = self.lights;
+        let (lo, hi) = geometry.bounds();
+        let (center, radius) = if lo.x <= hi.x {
+            ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-3))
+        } else {
+            (Vec3::ZERO, 1.0)
+        };
+        for l in &mut lights {
+            l.preprocess(center, radius);
+        }
+        let infinite_lights = lights
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.is_infinite())
+            .map(|(i, _)| i as u32)
+            .collect();
+        Ok(Scene {
+            geometry,
+            materials: self.materials,
+            lights,
+            infinite_lights,
+            camera,
+            film,
+        })
     }
+}
+
+fn check_emission(e: &AreaEmission) -> anyhow::Result<()> {
+    ensure!(
+        e.l.is_finite() && e.l.min_element() >= 0.0,
+        "emitted radiance must be finite and non-negative, got {:?}",
+        e.l
+    );
+    Ok(())
+}
+
+/// The area light of an emissive sphere or disk. Lights are analytic in world space, so the
+/// transform must scale uniformly (rotations, translations and mirrors are fine).
+fn quadric_light(q: &Quadric, e: &AreaEmission) -> anyhow::Result<Light> {
+    let m = &q.to_world.m;
+    let sx = m.x_axis.truncate().length();
+    let sy = m.y_axis.truncate().length();
+    let sz = m.z_axis.truncate().length();
+    let uniform = (sx - sy).abs() <= 1e-4 * sx && (sx - sz).abs() <= 1e-4 * sx;
+    ensure!(
+        uniform,
+        "emissive spheres and disks need a uniformly scaling transform (scales {sx}, {sy}, {sz})"
+    );
+    let light = match q.kind {
+        QuadricKind::Sphere { radius } => {
+            let c = q.to_world.point(Vec3::ZERO);
+            SphereLight::new(c, radius * sx, e.l, q.flip).map(Light::Sphere)
+        }
+        QuadricKind::Disk { height, radius } => {
+            let c = q.to_world.point(Vec3::new(0.0, 0.0, height));
+            let mut n = q.to_world.normal(Vec3::Z).normalize_or_zero();
+            if q.flip {
+                n = -n;
+            }
+            DiskLight::new(c, n, radius * sx, e.l, e.two_sided).map(Light::Disk)
+        }
+    };
+    light.ok_or_else(|| anyhow::anyhow!("degenerate emissive shape"))
 }

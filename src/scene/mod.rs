@@ -4,6 +4,8 @@
 //! TODO(issue 5): pbrt-v4, OBJ/MTL, glTF loaders.
 
 pub mod builder;
+pub mod builtin;
+pub mod load;
 pub mod pbrt;
 
 pub use builder::SceneBuilder;

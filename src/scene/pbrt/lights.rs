@@ -7,7 +7,7 @@
 
 use super::params::ParamSet;
 use super::spectra::{SpectrumUse, to_rgb};
-use super::textures::{Warn, resolve};
+use super::textures::{ImageCache, Warn, load_image, resolve};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
 use crate::geometry::Transform;
@@ -134,6 +134,7 @@ pub fn parse_light(
     params: &ParamSet,
     ctm: &Transform,
     dir: &Path,
+    images: &mut ImageCache,
     loc: &Loc,
     warn: &mut Warn,
 ) -> anyhow::Result<Option<LightDesc>> {
@@ -211,6 +212,15 @@ pub fn parse_light(
                             format!("infinite light: file not found: {}", path.display()),
                         ));
                     }
+                    let floc = params.loc_of("filename").unwrap_or(loc.clone());
+                    let img = load_image(images, &path, &floc)?;
+                    if img.width == img.height {
+                        warn(
+                            "envmap-octahedral",
+                            loc,
+                            "square environment map: pbrt-v4 uses an equal-area octahedral layout, penumbra reads lat-long; it will look different".into(),
+                        );
+                    }
                     if params.has("illuminance") {
                         let _ = params.find("illuminance");
                         warn(
@@ -255,19 +265,45 @@ pub fn parse_light(
     Ok(Some(desc))
 }
 
-/// Convert a description into a renderer light; kinds this build cannot represent yet are
-/// skipped with a warning.
-pub fn to_light(desc: &LightDesc, warnings: &mut Vec<String>) -> Option<Light> {
-    let kind = match desc {
-        LightDesc::Point { .. } => "point",
-        LightDesc::Spot { .. } => "spot",
-        LightDesc::Distant { .. } => "distant",
-        LightDesc::UniformInfinite { .. } => "infinite",
-        LightDesc::EnvMap { .. } => "infinite (image)",
+/// Convert a description into a renderer light (`images` holds what the parser loaded).
+pub fn to_light(desc: &LightDesc, images: &ImageCache) -> anyhow::Result<Light> {
+    use crate::lights::{
+        DistantLight, EnvMapLight, PointLight, SpotLight, UniformInfiniteLight,
     };
-    let msg = format!("warning: {kind} lights are not available in this build; skipped");
-    if !warnings.contains(&msg) {
-        warnings.push(msg);
-    }
-    None
+    Ok(match desc {
+        LightDesc::Point { p, intensity } => Light::Point(PointLight::new(*p, *intensity)),
+        LightDesc::Spot {
+            p,
+            dir,
+            intensity,
+            cos_falloff_start,
+            cos_total_width,
+        } => Light::Spot(SpotLight::new(
+            *p,
+            *dir,
+            *intensity,
+            *cos_falloff_start,
+            *cos_total_width,
+        )),
+        LightDesc::Distant { w_toward_light, l } => {
+            Light::Distant(DistantLight::new(*w_toward_light, *l))
+        }
+        LightDesc::UniformInfinite { l } => {
+            Light::UniformInfinite(UniformInfiniteLight::new(*l))
+        }
+        LightDesc::EnvMap {
+            path,
+            scale,
+            light_to_world,
+        } => {
+            let img = images
+                .get(path)
+                .cloned()
+                .ok_or_else(|| anyhow::anyhow!("{}: image not loaded", path.display()))?;
+            Light::EnvMap(Box::new(
+                EnvMapLight::new(img, Rgb::splat(*scale), *light_to_world)
+                    .map_err(|e| anyhow::anyhow!("{}: {e:#}", path.display()))?,
+            ))
+        }
+    })
 }

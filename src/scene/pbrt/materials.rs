@@ -3,7 +3,7 @@
 
 use super::params::{ParamSet, SpecVal};
 use super::spectra::{SpectrumUse, named_glass_ior, sampled_at, to_rgb};
-use super::textures::{TextureDesc, TextureTable, Warn};
+use super::textures::{ImageCache, TextureDesc, TextureTable, Warn};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
 use crate::material::{Material, Texture};
@@ -235,25 +235,38 @@ pub fn parse_material(
     })
 }
 
-fn texture(t: &TextureDesc, warnings: &mut Vec<String>) -> Texture {
-    match t {
+fn texture(t: &TextureDesc, images: &ImageCache) -> anyhow::Result<Texture> {
+    Ok(match t {
         TextureDesc::Constant(c) => Texture::Constant(*c),
         TextureDesc::Checkerboard { a, b, freq } => Texture::Checkerboard {
             a: *a,
             b: *b,
             freq: *freq,
         },
-        TextureDesc::Image { path, .. } => {
-            push_once(
-                warnings,
-                format!(
-                    "warning: image textures are not loaded yet ({}); using 0.5",
-                    path.display()
-                ),
-            );
-            Texture::Constant(Rgb::splat(0.5))
+        TextureDesc::Image {
+            path,
+            scale,
+            invert,
+        } => {
+            let img = images
+                .get(path)
+                .cloned()
+                .ok_or_else(|| anyhow::anyhow!("{}: image not loaded", path.display()))?;
+            let image = if *invert {
+                let mut inv = (*img).clone();
+                for p in &mut inv.pixels {
+                    *p = (Rgb::ONE - *p).max(Rgb::ZERO);
+                }
+                std::sync::Arc::new(inv)
+            } else {
+                img
+            };
+            Texture::Image {
+                image,
+                scale: *scale,
+            }
         }
-    }
+    })
 }
 
 fn push_once(warnings: &mut Vec<String>, msg: String) {
@@ -264,10 +277,14 @@ fn push_once(warnings: &mut Vec<String>, msg: String) {
 
 /// Convert a description into a renderer material; what cannot be represented falls back to
 /// diffuse grey 0.5 with a warning.
-pub fn to_material(desc: &MaterialDesc, warnings: &mut Vec<String>) -> Material {
-    match desc {
+pub fn to_material(
+    desc: &MaterialDesc,
+    images: &ImageCache,
+    warnings: &mut Vec<String>,
+) -> anyhow::Result<Material> {
+    Ok(match desc {
         MaterialDesc::Diffuse { reflectance } => Material::Diffuse {
-            reflectance: texture(reflectance, warnings),
+            reflectance: texture(reflectance, images)?,
         },
         other => {
             push_once(
@@ -281,7 +298,7 @@ pub fn to_material(desc: &MaterialDesc, warnings: &mut Vec<String>) -> Material 
                 reflectance: Texture::Constant(Rgb::splat(0.5)),
             }
         }
-    }
+    })
 }
 
 fn kind(d: &MaterialDesc) -> &'static str {

@@ -58,6 +58,8 @@ pub struct PbrtScene {
     pub lights: Vec<LightDesc>,
     /// Warnings, `file:line: warning: …`, one per kind.
     pub warnings: Vec<String>,
+    /// Images loaded while parsing (textures, environment maps), by resolved path.
+    pub images: textures::ImageCache,
 }
 
 /// Parse a pbrt-v4 file (and its includes) into descriptions.
@@ -97,7 +99,7 @@ impl PbrtScene {
         let mut warnings = self.warnings;
         let mut b = SceneBuilder::new();
         for m in &self.materials {
-            b.add_material(materials::to_material(m, &mut warnings));
+            b.add_material(materials::to_material(m, &self.images, &mut warnings)?);
         }
         for s in self.shapes {
             let r = match s.geom {
@@ -125,9 +127,7 @@ impl PbrtScene {
             r.map_err(|e| err_at(&s.loc, e))?;
         }
         for l in &self.lights {
-            if let Some(l) = lights::to_light(l, &mut warnings) {
-                b.add_light(l);
-            }
+            b.add_light(lights::to_light(l, &self.images)?);
         }
         Ok((b, self.camera, self.film, warnings))
     }

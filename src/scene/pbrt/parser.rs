@@ -112,6 +112,7 @@ impl Parser {
                 shapes: Vec::new(),
                 lights: Vec::new(),
                 warnings: Vec::new(),
+                images: Default::default(),
             },
         }
     }
@@ -296,6 +297,7 @@ impl Parser {
                 format!("{kind} without matching End at end of file"),
             );
         }
+        self.out.images = std::mem::take(&mut self.textures.images);
         if let Some((cam, fov, sw)) = self.camera.take() {
             self.out.camera = Camera {
                 camera_to_world: cam,
@@ -786,6 +788,7 @@ impl Parser {
                     &ps,
                     &self.gs.ctm,
                     &dir,
+                    &mut self.textures.images,
                     &loc,
                     &mut |k: &str, l: &Loc, m: String| pending.push((k.to_string(), l.clone(), m)),
                 )?;

@@ -5,8 +5,28 @@ use super::spectra::{SpectrumUse, to_rgb};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
 use glam::Vec2;
+use crate::material::texture::ImageRgb;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Images loaded while parsing (each file once), keyed by resolved path.
+pub type ImageCache = HashMap<PathBuf, Arc<ImageRgb>>;
+
+/// Load `path` (cached); errors point at `loc`.
+pub fn load_image(cache: &mut ImageCache, path: &Path, loc: &Loc) -> anyhow::Result<Arc<ImageRgb>> {
+    if let Some(img) = cache.get(path) {
+        return Ok(img.clone());
+    }
+    let img = crate::image::io::read_image(path).map_err(|e| err_at(loc, format!("{e:#}")))?;
+    let rgb = Arc::new(ImageRgb {
+        width: img.width,
+        height: img.height,
+        pixels: img.pixels,
+    });
+    cache.insert(path.to_path_buf(), rgb.clone());
+    Ok(rgb)
+}
 
 /// A spectrum texture as the scene describes it (images are loaded at conversion).
 #[derive(Clone, Debug, PartialEq)]
@@ -62,6 +82,8 @@ pub struct TextureTable {
     pub spectrum: HashMap<String, TextureDesc>,
     /// Float textures: `Some(v)` when constant, `None` when varying (unsupported for floats).
     pub float: HashMap<String, Option<f32>>,
+    /// Every image loaded so far (textures and environment maps).
+    pub images: ImageCache,
 }
 
 /// Sink for "approximated/ignored" warnings: (dedupe key, message).
@@ -215,7 +237,7 @@ impl TextureTable {
     }
 
     fn spectrum_texture(
-        &self,
+        &mut self,
         class: &str,
         params: &ParamSet,
         dir: &Path,
@@ -240,6 +262,8 @@ impl TextureTable {
                         format!("imagemap texture: file not found: {}", path.display()),
                     ));
                 }
+                let floc = params.loc_of("filename").unwrap_or(loc.clone());
+                load_image(&mut self.images, &path, &floc)?;
                 let scale = params.float("scale", 1.0)?;
                 TextureDesc::Image {
                     path,

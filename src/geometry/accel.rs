@@ -1,0 +1,243 @@
+//! [`Geometry`]: every primitive of a scene behind one obvhs compressed-wide BVH (CWBVH).
+
+use super::quadric::Quadric;
+use super::triangle::{barycentric_error, intersect_triangle};
+use super::{Ray, RayQuery, SurfaceHit};
+use glam::{Vec2, Vec3, Vec3A};
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::CwBvh;
+use obvhs::ray::RayHit;
+use std::time::{Duration, Instant};
+
+/// Per-vertex data of a mesh that hit records interpolate.
+#[derive(Clone, Debug, Default)]
+pub struct MeshShading {
+    /// Optional per-vertex shading normals.
+    pub normals: Option<Vec<Vec3>>,
+    /// Optional per-vertex texture coordinates.
+    pub uvs: Option<Vec<Vec2>>,
+    /// Flip the geometric normal (only when there are no vertex normals).
+    pub flip: bool,
+}
+
+/// What a primitive is.
+#[derive(Clone, Copy, Debug)]
+pub enum PrimKind {
+    /// Triangle `tri` (its vertex indices are `indices[3·tri..]`) of mesh `mesh`.
+    Triangle {
+        /// Mesh index into `Geometry::meshes`.
+        mesh: u32,
+        /// Vertex indices into the mesh's arrays.
+        v: [u32; 3],
+    },
+    /// Index into `Geometry::quadrics`.
+    Quadric(u32),
+}
+
+/// A primitive: compact triangle vertices for the hot intersection loop plus its ids.
+#[derive(Clone, Copy, Debug)]
+pub struct Primitive {
+    /// First vertex (triangles).
+    pub p0: Vec3,
+    /// Edge p1 − p0 (triangles).
+    pub e1: Vec3,
+    /// Edge p2 − p0 (triangles).
+    pub e2: Vec3,
+    /// Shape.
+    pub kind: PrimKind,
+    /// Material index.
+    pub material: u32,
+    /// Area light index or `NO_LIGHT`.
+    pub light: u32,
+}
+
+/// All scene geometry and its BVH.
+pub struct Geometry {
+    prims: Vec<Primitive>,
+    /// Per-mesh shading data.
+    pub meshes: Vec<MeshShading>,
+    /// Spheres and disks.
+    pub quadrics: Vec<Quadric>,
+    bvh: Option<CwBvh>,
+    bounds: (Vec3, Vec3),
+    /// Wall time of the BVH build.
+    pub build_time: Duration,
+}
+
+impl Geometry {
+    /// Build the BVH over `prims` (reordered internally so the BVH's leaf order is the storage
+    /// order: one indirection less per intersection test).
+    pub fn new(prims: Vec<Primitive>, meshes: Vec<MeshShading>, quadrics: Vec<Quadric>) -> Self {
+        let start = Instant::now();
+        let aabbs: Vec<Aabb> = prims
+            .iter()
+            .map(|p| {
+                let (lo, hi) = prim_bounds(p, &quadrics);
+                Aabb::new(lo.into(), hi.into())
+            })
+            .collect();
+        let mut bounds = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for a in &aabbs {
+            bounds.0 = bounds.0.min(a.min.into());
+            bounds.1 = bounds.1.max(a.max.into());
+        }
+        let (prims, bvh) = if prims.is_empty() {
+            (prims, None)
+        } else {
+            let mut t = Duration::ZERO;
+            let bvh = obvhs::cwbvh::builder::build_cwbvh(
+                &aabbs,
+                obvhs::BvhBuildParams::medium_build(),
+                &mut t,
+            );
+            let ordered: Vec<Primitive> = bvh
+                .primitive_indices
+                .iter()
+                .map(|&i| prims[i as usize])
+                .collect();
+            (ordered, Some(bvh))
+        };
+        Self {
+            prims,
+            meshes,
+            quadrics,
+            bvh,
+            bounds,
+            build_time: start.elapsed(),
+        }
+    }
+
+    /// Number of primitives.
+    pub fn len(&self) -> usize {
+        self.prims.len()
+    }
+
+    /// True if there is no primitive.
+    pub fn is_empty(&self) -> bool {
+        self.prims.is_empty()
+    }
+
+    /// World bounding box (min, max); inverted (∞, −∞) when empty.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+
+    #[inline(always)]
+    fn prim_t(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        let p = &self.prims[id];
+        match p.kind {
+            PrimKind::Triangle { .. } => match intersect_triangle(o, d, t_max, p.p0, p.e1, p.e2) {
+                Some((t, _, _)) => t,
+                None => f32::INFINITY,
+            },
+            PrimKind::Quadric(q) => self.quadrics[q as usize]
+                .intersect_t(o, d, t_max)
+                .unwrap_or(f32::INFINITY),
+        }
+    }
+
+    fn surface_hit(&self, id: usize, ray: &Ray, t: f32) -> SurfaceHit {
+        let p = &self.prims[id];
+        match p.kind {
+            PrimKind::Triangle { mesh, v } => {
+                let (b1, b2) = match intersect_triangle(ray.o, ray.d, f32::INFINITY, p.p0, p.e1, p.e2)
+                {
+                    Some((_, b1, b2)) => (b1, b2),
+                    None => (1.0 / 3.0, 1.0 / 3.0),
+                };
+                let b0 = 1.0 - b1 - b2;
+                let verts = [p.p0, p.p0 + p.e1, p.p0 + p.e2];
+                let pos = verts[0] * b0 + verts[1] * b1 + verts[2] * b2;
+                let m = &self.meshes[mesh as usize];
+                let mut ng = p.e1.cross(p.e2).normalize_or_zero();
+                let ns = match &m.normals {
+                    Some(n) => {
+                        let ns = (n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2)
+                            .normalize_or_zero();
+                        if ns == Vec3::ZERO {
+                            ng
+                        } else {
+                            if ng.dot(ns) < 0.0 {
+                                ng = -ng;
+                            }
+                            ns
+                        }
+                    }
+                    None => {
+                        if m.flip {
+                            ng = -ng;
+                        }
+                        ng
+                    }
+                };
+                let uv = match &m.uvs {
+                    Some(uv) => uv[v[0] as usize] * b0 + uv[v[1] as usize] * b1 + uv[v[2] as usize] * b2,
+                    // pbrt-v4's default parameterisation (0,0), (1,0), (1,1).
+                    None => Vec2::new(b1 + b2, b2),
+                };
+                let err = barycentric_error([b0, b1, b2], verts);
+                SurfaceHit {
+                    t,
+                    p: pos,
+                    ng,
+                    ns,
+                    uv,
+                    p_error: err.dot(ng.abs()),
+                    prim: id as u32,
+                    material: p.material,
+                    light: p.light,
+                }
+            }
+            PrimKind::Quadric(q) => {
+                let h = self.quadrics[q as usize].hit(ray.o, ray.d, t);
+                SurfaceHit {
+                    t,
+                    p: h.p,
+                    ng: h.n,
+                    ns: h.n,
+                    uv: h.uv,
+                    p_error: h.p_error,
+                    prim: id as u32,
+                    material: p.material,
+                    light: p.light,
+                }
+            }
+        }
+    }
+}
+
+fn prim_bounds(p: &Primitive, quadrics: &[Quadric]) -> (Vec3, Vec3) {
+    match p.kind {
+        PrimKind::Triangle { .. } => {
+            let (a, b, c) = (p.p0, p.p0 + p.e1, p.p0 + p.e2);
+            (a.min(b).min(c), a.max(b).max(c))
+        }
+        PrimKind::Quadric(q) => quadrics[q as usize].bounds(),
+    }
+}
+
+#[inline]
+fn to_obvhs(ray: &Ray) -> obvhs::ray::Ray {
+    obvhs::ray::Ray::new(Vec3A::from(ray.o), Vec3A::from(ray.d), 0.0, ray.t_max)
+}
+
+impl RayQuery for Geometry {
+    fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        let bvh = self.bvh.as_ref()?;
+        let mut hit = RayHit::none();
+        let found = bvh.ray_traverse(to_obvhs(ray), &mut hit, |r, id| {
+            self.prim_t(id, ray.o, ray.d, r.tmax)
+        });
+        if !found {
+            return None;
+        }
+        Some(self.surface_hit(hit.primitive_id as usize, ray, hit.t))
+    }
+
+    fn occluded(&self, ray: &Ray) -> bool {
+        let Some(bvh) = self.bvh.as_ref() else {
+            return false;
+        };
+        !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| self.prim_t(id, ray.o, ray.d, r.tmax))
+    }
+}

@@ -1,0 +1,355 @@
+//! Image files: EXR and PFM (linear float), PNG (sRGB, 8-bit) writing; EXR, PFM, PNG, TGA,
+//! JPEG and Radiance HDR reading.
+//!
+//! Every write is atomic: the file is encoded in memory, written to a hidden temporary file in
+//! the destination directory and renamed over the destination. A failed or interrupted write
+//! therefore never leaves a truncated image behind, and an existing file survives any error.
+
+use std::io::{Cursor, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use anyhow::{Context, bail};
+
+use super::Image;
+use crate::Rgb;
+
+/// Extensions accepted by [`write_image`].
+pub const WRITE_EXTENSIONS: &[&str] = &["exr", "pfm", "png"];
+/// Extensions accepted by [`read_image`].
+pub const READ_EXTENSIONS: &[&str] = &["exr", "pfm", "png", "tga", "jpg", "jpeg", "hdr"];
+
+/// Lower-cased extension of `path`, or "" when it has none.
+fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
+}
+
+/// sRGB opto-electronic transfer: linear [0,1] → encoded [0,1] (IEC 61966-2-1).
+#[inline]
+pub fn linear_to_srgb(x: f32) -> f32 {
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Inverse sRGB transfer: encoded [0,1] → linear [0,1].
+#[inline]
+pub fn srgb_to_linear(s: f32) -> f32 {
+    if s <= 0.040_45 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Encode a linear value as an 8-bit sRGB code value: clamp, transfer, round.
+/// NaN maps to 0 so a stray sample cannot poison a display image.
+#[inline]
+pub fn linear_to_srgb8(x: f32) -> u8 {
+    let c = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    (linear_to_srgb(c) * 255.0 + 0.5) as u8
+}
+
+/// Tonemap a linear image for display: multiply by `2^exposure_stops`, sRGB-encode, clamp.
+pub fn to_rgb8(img: &Image, exposure_stops: f32) -> image::RgbImage {
+    let k = exposure_stops.exp2();
+    let mut out = image::RgbImage::new(img.width, img.height);
+    for (dst, src) in out.pixels_mut().zip(&img.pixels) {
+        let p = *src * k;
+        *dst = image::Rgb([
+            linear_to_srgb8(p.x),
+            linear_to_srgb8(p.y),
+            linear_to_srgb8(p.z),
+        ]);
+    }
+    out
+}
+
+/// Hidden temporary sibling of `path`; pid + a process-wide counter keep concurrent writers
+/// (other processes, or other threads of this one) from sharing a temp file.
+fn temp_path(path: &Path) -> PathBuf {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let name = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "image".into());
+    let tmp = format!(".{name}.tmp-{}-{n}", std::process::id());
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.join(tmp),
+        _ => PathBuf::from(tmp),
+    }
+}
+
+/// Write `bytes` to `path` atomically (temp file in the same directory, then rename).
+/// On error the temp file is removed and an existing `path` is left untouched.
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let tmp = temp_path(path);
+    let result = (|| -> std::io::Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        drop(f);
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e).with_context(|| format!("writing {}", path.display()));
+    }
+    Ok(())
+}
+
+/// Encode an 8-bit RGB image as PNG in memory.
+pub fn encode_png(img: &image::RgbImage) -> anyhow::Result<Vec<u8>> {
+    let mut buf = Cursor::new(Vec::new());
+    img.write_to(&mut buf, image::ImageFormat::Png)
+        .context("encoding PNG")?;
+    Ok(buf.into_inner())
+}
+
+/// Write an 8-bit RGB image as PNG, atomically.
+pub fn save_png_atomic(img: &image::RgbImage, path: &Path) -> anyhow::Result<()> {
+    write_bytes_atomic(path, &encode_png(img)?)
+}
+
+/// Write `img` to `path`, the format chosen by the extension:
+/// `.exr` (linear f32 RGB), `.pfm` (linear f32 RGB) or `.png` (8-bit sRGB of `img·2^exposure`;
+/// the exposure is ignored by the linear formats). NaN/Inf pixels are written as black, with
+/// one warning on stderr giving their count. The write is atomic (see the module docs).
+pub fn write_image(img: &Image, path: &Path, exposure_stops: f32) -> anyhow::Result<()> {
+    let ext = extension(path);
+    if !WRITE_EXTENSIONS.contains(&ext.as_str()) {
+        bail!(
+            "cannot write {}: unsupported extension {:?} (supported: {})",
+            path.display(),
+            ext,
+            WRITE_EXTENSIONS.join(", ")
+        );
+    }
+    let expected = img.width as usize * img.height as usize;
+    if img.pixels.len() != expected {
+        bail!(
+            "cannot write {}: image claims {}x{} but holds {} pixels",
+            path.display(),
+            img.width,
+            img.height,
+            img.pixels.len()
+        );
+    }
+    // Sanitise once here so every format (and every viewer) sees the same finite data.
+    let bad = img.count_non_finite();
+    let sanitized;
+    let img = if bad > 0 {
+        eprintln!(
+            "warning: {}: {bad} pixel(s) with NaN/Inf written as black",
+            path.display()
+        );
+        let mut copy = img.clone();
+        for p in &mut copy.pixels {
+            if !p.is_finite() {
+                *p = Rgb::ZERO;
+            }
+        }
+        sanitized = copy;
+        &sanitized
+    } else {
+        img
+    };
+    let bytes = match ext.as_str() {
+        "exr" => encode_exr(img),
+        "pfm" => Ok(encode_pfm(img)),
+        _ => encode_png(&to_rgb8(img, exposure_stops)),
+    }
+    .with_context(|| format!("encoding {}", path.display()))?;
+    write_bytes_atomic(path, &bytes)
+}
+
+/// OpenEXR, three f32 channels, default (lossless) compression.
+fn encode_exr(img: &Image) -> anyhow::Result<Vec<u8>> {
+    use exr::prelude::{SpecificChannels, Vec2, WritableImage};
+    let w = img.width as usize;
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+        let p = img.pixels[y * w + x];
+        (p.x, p.y, p.z)
+    });
+    let image = exr::image::Image::from_channels((w, img.height as usize), channels);
+    let mut buf = Cursor::new(Vec::new());
+    image.write().to_buffered(&mut buf)?;
+    Ok(buf.into_inner())
+}
+
+/// Portable float map: "PF", little-endian (negative scale), rows bottom to top.
+fn encode_pfm(img: &Image) -> Vec<u8> {
+    let header = format!("PF\n{} {}\n-1.0\n", img.width, img.height);
+    let mut out = Vec::with_capacity(header.len() + img.pixels.len() * 12);
+    out.extend_from_slice(header.as_bytes());
+    let w = img.width as usize;
+    if w > 0 {
+        for row in img.pixels.chunks_exact(w).rev() {
+            for p in row {
+                for c in [p.x, p.y, p.z] {
+                    out.extend_from_slice(&c.to_le_bytes());
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Read an image as linear RGB. `.exr`, `.pfm` (colour "PF" or grey "Pf", either byte order)
+/// and `.hdr` are linear already; `.png`, `.tga`, `.jpg` are sRGB-decoded to linear.
+pub fn read_image(path: &Path) -> anyhow::Result<Image> {
+    let ext = extension(path);
+    let result = match ext.as_str() {
+        "exr" => read_exr(path),
+        "pfm" => std::fs::read(path)
+            .map_err(anyhow::Error::from)
+            .and_then(|b| decode_pfm(&b)),
+        "hdr" => read_with_image_crate(path, false),
+        "png" | "tga" | "jpg" | "jpeg" => read_with_image_crate(path, true),
+        _ => bail!(
+            "cannot read {}: unsupported extension {:?} (supported: {})",
+            path.display(),
+            ext,
+            READ_EXTENSIONS.join(", ")
+        ),
+    };
+    result.with_context(|| format!("reading {}", path.display()))
+}
+
+/// Decode via the `image` crate; `srgb` selects whether code values are sRGB-linearised.
+fn read_with_image_crate(path: &Path, srgb: bool) -> anyhow::Result<Image> {
+    let dynamic = image::ImageReader::open(path)?
+        .with_guessed_format()?
+        .decode()?;
+    let rgb = dynamic.to_rgb32f();
+    let (w, h) = rgb.dimensions();
+    let lin = |v: f32| if srgb { srgb_to_linear(v) } else { v };
+    let pixels = rgb
+        .pixels()
+        .map(|p| Rgb::new(lin(p[0]), lin(p[1]), lin(p[2])))
+        .collect();
+    Ok(Image {
+        width: w,
+        height: h,
+        pixels,
+    })
+}
+
+/// First RGB(A) layer of an EXR; falls back to a luminance-only ("Y") layer as grey.
+fn read_exr(path: &Path) -> anyhow::Result<Image> {
+    use exr::prelude::{RgbaChannels, Vec2, read_first_rgba_layer_from_file};
+    let rgba = read_first_rgba_layer_from_file(
+        path,
+        |res: Vec2<usize>, _: &RgbaChannels| {
+            (res.width(), vec![Rgb::ZERO; res.width() * res.height()])
+        },
+        |(w, px): &mut (usize, Vec<Rgb>), pos: Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = Rgb::new(r, g, b);
+        },
+    );
+    match rgba {
+        Ok(img) => {
+            let size = img.layer_data.size;
+            let (_, pixels) = img.layer_data.channel_data.pixels;
+            Ok(Image {
+                width: u32::try_from(size.width())?,
+                height: u32::try_from(size.height())?,
+                pixels,
+            })
+        }
+        Err(rgba_err) => read_exr_grey(path).map_err(|_| anyhow::Error::from(rgba_err)),
+    }
+}
+
+/// An EXR whose first layer has a "Y" channel, replicated to RGB.
+fn read_exr_grey(path: &Path) -> anyhow::Result<Image> {
+    let img = exr::prelude::read_first_flat_layer_from_file(path)?;
+    let layer = &img.layer_data;
+    let y = layer
+        .channel_data
+        .list
+        .iter()
+        .find(|c| c.name.to_string() == "Y")
+        .ok_or_else(|| anyhow::anyhow!("no R/G/B or Y channels"))?;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let pixels = (0..w * h)
+        .map(|i| Rgb::splat(y.sample_data.value_by_flat_index(i).to_f32()))
+        .collect();
+    Ok(Image {
+        width: u32::try_from(w)?,
+        height: u32::try_from(h)?,
+        pixels,
+    })
+}
+
+/// Decode a PFM file held in memory. The header is three whitespace-separated tokens after the
+/// magic; a single whitespace byte separates it from the raster, as the format requires.
+pub fn decode_pfm(bytes: &[u8]) -> anyhow::Result<Image> {
+    let mut pos = 0usize;
+    let mut token = || -> anyhow::Result<String> {
+        while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        while pos < bytes.len() && !bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        if start == pos {
+            bail!("truncated PFM header");
+        }
+        Ok(String::from_utf8_lossy(&bytes[start..pos]).into_owned())
+    };
+    let magic = token()?;
+    let channels = match magic.as_str() {
+        "PF" => 3,
+        "Pf" => 1,
+        other => bail!("not a PFM file (magic {other:?}, expected \"PF\" or \"Pf\")"),
+    };
+    let width: u32 = token()?.parse().context("bad PFM width")?;
+    let height: u32 = token()?.parse().context("bad PFM height")?;
+    let scale: f32 = token()?.parse().context("bad PFM scale")?;
+    if scale == 0.0 || !scale.is_finite() {
+        bail!("bad PFM scale {scale}");
+    }
+    let little = scale < 0.0;
+    pos += 1; // the single whitespace byte ending the header
+    let n = width as usize * height as usize * channels;
+    let need = n.checked_mul(4).context("PFM size overflows")?;
+    let data = bytes.get(pos..).unwrap_or(&[]);
+    if data.len() < need {
+        bail!(
+            "truncated PFM raster: {width}x{height}x{channels} needs {need} bytes, found {}",
+            data.len()
+        );
+    }
+    let floats: Vec<f32> = data[..need]
+        .chunks_exact(4)
+        .map(|b| {
+            let b = [b[0], b[1], b[2], b[3]];
+            if little {
+                f32::from_le_bytes(b)
+            } else {
+                f32::from_be_bytes(b)
+            }
+        })
+        .collect();
+    let mut img = Image::new(width, height);
+    let w = width as usize;
+    for (row_from_bottom, row) in floats.chunks_exact(w.max(1) * channels).enumerate() {
+        let y = height as usize - 1 - row_from_bottom;
+        for (x, px) in row.chunks_exact(channels).enumerate() {
+            img.pixels[y * w + x] = if channels == 3 {
+                Rgb::new(px[0], px[1], px[2])
+            } else {
+                Rgb::splat(px[0])
+            };
+        }
+    }
+    Ok(img)
+}

@@ -1,0 +1,260 @@
+//! The lecture's direct-lighting estimators of
+//! L(x, ωo) = Le + ∫ f(ωo, x, ωi) · Li · V · cosθx cosθy / ‖x − y‖² dA_y:
+//! BSDF (projected solid angle) sampling, light sampling (area or solid angle) and MIS.
+//!
+//! Both techniques estimate the same integrand restricted to directions above the geometric
+//! surface on the viewer's side (reflection only), so their MIS combination stays unbiased even
+//! where shading normals disagree with the geometry.
+
+use super::{MisHeuristic, Strategy};
+use crate::Rgb;
+use crate::bsdf::{Bsdf, Bxdf};
+use crate::geometry::interaction::NO_LIGHT;
+use crate::geometry::{Ray, RayQuery, SurfaceHit};
+use crate::light_selection::{LightSelector, ShadingPoint};
+use crate::lights::{LightSampleContext, LightSource, SamplingMode};
+use crate::sampling::{Frame, SamplePattern, balance_heuristic, power_heuristic};
+use crate::scene::Scene;
+use glam::{UVec2, Vec2, Vec3};
+
+/// Pattern dimension of the pixel-filter sample.
+pub const DIM_FILTER: u32 = 0;
+/// Pattern dimension of the light-selection number.
+pub const DIM_LIGHT_SELECT: u32 = 1;
+/// Pattern dimension of the point on the light.
+pub const DIM_LIGHT: u32 = 2;
+/// Pattern dimension of the BSDF lobe choice.
+pub const DIM_LOBE: u32 = 3;
+/// Pattern dimension of the BSDF direction.
+pub const DIM_BSDF: u32 = 4;
+
+/// Shadow rays stop this fraction short of the light point so they do not hit the light itself.
+const SHADOW_EPSILON: f32 = 1e-4;
+
+/// One estimator configured for one render.
+pub struct DirectLighting<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Light selection.
+    pub selector: &'a dyn LightSelector,
+    /// Sample pattern.
+    pub pattern: &'a dyn SamplePattern,
+    /// Estimator.
+    pub strategy: Strategy,
+    /// MIS heuristic.
+    pub mis: MisHeuristic,
+    /// Eye rays per pixel (N).
+    pub eye_rays: u32,
+    /// Light / BSDF samples per eye ray (M).
+    pub shadow_rays: u32,
+}
+
+/// Where the samples of one eye ray come from.
+#[derive(Clone, Copy)]
+struct SampleIndex {
+    pixel: UVec2,
+    index: u32,
+    count: u32,
+}
+
+/// The shading state at a camera-ray hit.
+struct Shading {
+    hit: SurfaceHit,
+    bsdf: Bsdf,
+    frame: Frame,
+    wo_local: Vec3,
+    ng: Vec3,
+    ctx: LightSampleContext,
+    sp: ShadingPoint,
+}
+
+impl<'a> DirectLighting<'a> {
+    /// Light sampling mode implied by the strategy.
+    fn mode(&self) -> SamplingMode {
+        match self.strategy {
+            Strategy::LightArea => SamplingMode::Area,
+            _ => SamplingMode::SolidAngle,
+        }
+    }
+
+    #[inline]
+    fn heuristic(&self, f_pdf: f32, g_pdf: f32) -> f32 {
+        match self.mis {
+            MisHeuristic::Power => power_heuristic(1.0, f_pdf, 1.0, g_pdf),
+            MisHeuristic::Balance => balance_heuristic(1.0, f_pdf, 1.0, g_pdf),
+        }
+    }
+
+    /// Radiance along camera ray `ray` for eye sample `eye` of `pixel`; also returns the number
+    /// of rays traced.
+    pub fn li(&self, pixel: UVec2, eye: u32, ray: &Ray) -> (Rgb, u64) {
+        let scene = self.scene;
+        let Some(hit) = scene.geometry.intersect(ray) else {
+            return (self.escaped(ray.d), 1);
+        };
+        let mut rays = 1u64;
+        let wo = -ray.d.normalize();
+        let mut l = Rgb::ZERO;
+        if hit.light != NO_LIGHT {
+            l += scene.lights[hit.light as usize].radiance(hit.p, hit.ng, hit.uv, wo);
+        }
+        let front = ray.d.dot(hit.ng) < 0.0;
+        let ng = if front { hit.ng } else { -hit.ng };
+        let ns = if hit.ns.dot(wo) < 0.0 { -hit.ns } else { hit.ns };
+        let frame = Frame::from_normal(ns);
+        let Some(material) = scene.materials.get(hit.material as usize) else {
+            return (l, rays);
+        };
+        let sh = Shading {
+            bsdf: material.bsdf(&hit, front),
+            wo_local: frame.to_local(wo),
+            frame,
+            ng,
+            ctx: LightSampleContext { p: hit.p, n: ng },
+            sp: ShadingPoint { p: hit.p, n: ng, wo },
+            hit,
+        };
+        let m = self.shadow_rays.max(1);
+        let count = self.eye_rays.max(1) * m;
+        let mut sum = Rgb::ZERO;
+        for j in 0..m {
+            let si = SampleIndex {
+                pixel,
+                index: eye * m + j,
+                count,
+            };
+            match self.strategy {
+                Strategy::LightArea | Strategy::LightSolidAngle => {
+                    sum += self.light_sample(&sh, si, false, &mut rays);
+                }
+                Strategy::Bsdf => sum += self.bsdf_sample(&sh, si, false, &mut rays),
+                Strategy::Mis => {
+                    sum += self.light_sample(&sh, si, true, &mut rays);
+                    sum += self.bsdf_sample(&sh, si, true, &mut rays);
+                }
+            }
+        }
+        l += sum / m as f32;
+        (l, rays)
+    }
+
+    /// Radiance of the infinite lights seen along an escaping ray.
+    fn escaped(&self, d: Vec3) -> Rgb {
+        let w = d.normalize();
+        self.scene
+            .infinite_lights
+            .iter()
+            .map(|&i| {
+                self.scene.lights[i as usize].radiance(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, w)
+            })
+            .sum()
+    }
+
+    /// One light-sampling estimate f·Li·cos / (pmf·pdf), MIS-weighted when `mis`.
+    fn light_sample(&self, sh: &Shading, si: SampleIndex, mis: bool, rays: &mut u64) -> Rgb {
+        let uc = self
+            .pattern
+            .sample_1d(si.pixel, DIM_LIGHT_SELECT, si.index, si.count);
+        let Some(sel) = self.selector.sample(&sh.sp, uc) else {
+            return Rgb::ZERO;
+        };
+        let light = &self.scene.lights[sel.index as usize];
+        let u = self
+            .pattern
+            .sample_2d(si.pixel, DIM_LIGHT, si.index, si.count);
+        let Some(ls) = light.sample_li(&sh.ctx, u, self.mode()) else {
+            return Rgb::ZERO;
+        };
+        if !(ls.pdf > 0.0) || sel.pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(sh.ng) <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let wi_local = sh.frame.to_local(ls.wi);
+        let f = sh.bsdf.f(sh.wo_local, wi_local) * wi_local.z.abs();
+        if f == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        *rays += 1;
+        if self.scene.geometry.occluded(&shadow_ray(&sh.hit, ls.p_light)) {
+            return Rgb::ZERO;
+        }
+        let pdf = sel.pmf * ls.pdf;
+        let w = if mis && !ls.delta {
+            self.heuristic(pdf, sh.bsdf.pdf(sh.wo_local, wi_local))
+        } else {
+            1.0
+        };
+        f * ls.li * (w / pdf)
+    }
+
+    /// One BSDF-sampling estimate f·cos·Le / pdf, MIS-weighted when `mis`.
+    fn bsdf_sample(&self, sh: &Shading, si: SampleIndex, mis: bool, rays: &mut u64) -> Rgb {
+        let uc = self.pattern.sample_1d(si.pixel, DIM_LOBE, si.index, si.count);
+        let u = self.pattern.sample_2d(si.pixel, DIM_BSDF, si.index, si.count);
+        let Some(bs) = sh.bsdf.sample(sh.wo_local, uc, u) else {
+            return Rgb::ZERO;
+        };
+        if !(bs.pdf > 0.0) {
+            return Rgb::ZERO;
+        }
+        let wi = sh.frame.to_world(bs.wi).normalize();
+        if wi.dot(sh.ng) <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let weight = bs.f * (bs.wi.z.abs() / bs.pdf);
+        if weight == Rgb::ZERO || !weight.is_finite() {
+            return Rgb::ZERO;
+        }
+        *rays += 1;
+        let ray = Ray::new(sh.hit.spawn_origin(wi), wi);
+        let mode = self.mode();
+        match self.scene.geometry.intersect(&ray) {
+            Some(h) if h.light != NO_LIGHT => {
+                let light = &self.scene.lights[h.light as usize];
+                let le = light.radiance(h.p, h.ng, h.uv, -wi);
+                if le == Rgb::ZERO {
+                    return Rgb::ZERO;
+                }
+                let w = if mis && !bs.delta {
+                    let pdf_l = self.selector.pmf(&sh.sp, h.light)
+                        * light.pdf_li(&sh.ctx, wi, h.p, h.ng, mode);
+                    self.heuristic(bs.pdf, pdf_l)
+                } else {
+                    1.0
+                };
+                weight * le * w
+            }
+            Some(_) => Rgb::ZERO,
+            None => {
+                let mut sum = Rgb::ZERO;
+                for &i in &self.scene.infinite_lights {
+                    let light = &self.scene.lights[i as usize];
+                    let le = light.radiance(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, wi);
+                    if le == Rgb::ZERO {
+                        continue;
+                    }
+                    let w = if mis && !bs.delta {
+                        let pdf_l = self.selector.pmf(&sh.sp, i)
+                            * light.pdf_li(&sh.ctx, wi, Vec3::ZERO, Vec3::ZERO, mode);
+                        self.heuristic(bs.pdf, pdf_l)
+                    } else {
+                        1.0
+                    };
+                    sum += le * w;
+                }
+                weight * sum
+            }
+        }
+    }
+}
+
+/// A shadow ray from `hit` to just short of `target`: offset at the origin by the hit's error
+/// bound, shortened at the far end by [`SHADOW_EPSILON`].
+#[inline]
+pub fn shadow_ray(hit: &SurfaceHit, target: Vec3) -> Ray {
+    let o = hit.spawn_origin(target - hit.p);
+    Ray {
+        o,
+        d: target - o,
+        t_max: 1.0 - SHADOW_EPSILON,
+    }
+}

@@ -1,0 +1,138 @@
+//! Diffuse emissive disk, sampled by area with the concentric map.
+//!
+//! `SamplingMode::SolidAngle` falls back to area sampling: uniform sampling of the spherical
+//! ellipse a disk subtends (Guillén et al. 2017) is not implemented; the fallback stays consistent
+//! because `pdf_li` ignores the mode in the same way.
+
+use super::{
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
+};
+use crate::sampling::{Frame, concentric_disk};
+use crate::{Rgb, luminance};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// A disk emitting constant radiance `l` on the side of `normal` (both sides if `two_sided`).
+#[derive(Clone, Copy, Debug)]
+pub struct DiskLight {
+    /// Centre.
+    pub center: Vec3,
+    /// Frame whose `n` is the unit emitting normal.
+    pub frame: Frame,
+    /// Radius (> 0).
+    pub radius: f32,
+    /// Emitted radiance.
+    pub l: Rgb,
+    /// Emits on both sides.
+    pub two_sided: bool,
+}
+
+impl DiskLight {
+    /// A disk light; `None` for a zero normal, a non-positive radius or non-finite input.
+    pub fn new(center: Vec3, normal: Vec3, radius: f32, l: Rgb, two_sided: bool) -> Option<Self> {
+        if !(radius > 0.0) || !radius.is_finite() || !center.is_finite() || !l.is_finite() {
+            return None;
+        }
+        let n = normal.try_normalize()?;
+        Some(Self {
+            center,
+            frame: Frame::from_normal(n),
+            radius,
+            l,
+            two_sided,
+        })
+    }
+
+    /// Area π r².
+    #[inline]
+    pub fn area(&self) -> f32 {
+        PI * self.radius * self.radius
+    }
+
+    #[inline]
+    fn emits_toward(&self, w: Vec3) -> bool {
+        self.two_sided || self.frame.n.dot(w) > 0.0
+    }
+
+    /// Whether a receiver at `p` can see the emitting side (none from the plane itself).
+    #[inline]
+    fn faces(&self, p: Vec3) -> bool {
+        let s = self.frame.n.dot(p - self.center);
+        if self.two_sided { s != 0.0 } else { s > 0.0 }
+    }
+}
+
+impl LightSource for DiskLight {
+    fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        _mode: SamplingMode,
+    ) -> Option<LightLiSample> {
+        if !self.faces(ctx.p) {
+            return None;
+        }
+        let q = concentric_disk(u) * self.radius;
+        let p_light = self.center + self.frame.s * q.x + self.frame.t * q.y;
+        let d = p_light - ctx.p;
+        let dist = d.length();
+        if !(dist > 0.0) {
+            return None;
+        }
+        let wi = d / dist;
+        let pdf = area_to_solid_angle(1.0 / self.area(), ctx.p, p_light, self.frame.n);
+        (pdf > 0.0 && pdf.is_finite()).then_some(LightLiSample {
+            wi,
+            li: self.l,
+            pdf,
+            p_light,
+            delta: false,
+        })
+    }
+
+    fn pdf_li(
+        &self,
+        ctx: &LightSampleContext,
+        _wi: Vec3,
+        p_light: Vec3,
+        _n_light: Vec3,
+        _mode: SamplingMode,
+    ) -> f32 {
+        if !self.faces(ctx.p) {
+            return 0.0;
+        }
+        area_to_solid_angle(1.0 / self.area(), ctx.p, p_light, self.frame.n)
+    }
+
+    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
+        if self.emits_toward(w) {
+            self.l
+        } else {
+            Rgb::ZERO
+        }
+    }
+
+    fn power(&self) -> f32 {
+        let sides = if self.two_sided { 2.0 } else { 1.0 };
+        luminance(self.l) * self.area() * PI * sides
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        // Half-extent of a disk along axis i is r·sqrt(1 − n_i²).
+        let n = self.frame.n;
+        let ext = Vec3::new(
+            (1.0 - n.x * n.x).max(0.0).sqrt(),
+            (1.0 - n.y * n.y).max(0.0).sqrt(),
+            (1.0 - n.z * n.z).max(0.0).sqrt(),
+        ) * self.radius;
+        Some(LightBounds {
+            min: self.center - ext,
+            max: self.center + ext,
+            w: n,
+            phi: self.power(),
+            cos_theta_o: 1.0,
+            cos_theta_e: 0.0,
+            two_sided: self.two_sided,
+        })
+    }
+}

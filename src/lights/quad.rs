@@ -1,0 +1,180 @@
+//! Diffuse emissive parallelogram `corner + s·e1 + t·e2`, s, t ∈ [0, 1]: area sampling, or
+//! solid-angle sampling of the spherical rectangle (Ureña et al. 2013,
+//! [`crate::sampling::SphericalRectangle`]) when the edges are perpendicular.
+
+use super::{
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
+    spherical_ok,
+};
+use crate::sampling::SphericalRectangle;
+use crate::{Rgb, luminance};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// A parallelogram emitting constant radiance `l` on the side of `n` (both sides if `two_sided`).
+#[derive(Clone, Copy, Debug)]
+pub struct QuadLight {
+    /// Corner at s = t = 0.
+    pub corner: Vec3,
+    /// First edge.
+    pub e1: Vec3,
+    /// Second edge.
+    pub e2: Vec3,
+    /// Unit geometric normal, oriented to the emitting side given at construction.
+    pub n: Vec3,
+    /// Area |e1 × e2|.
+    pub area: f32,
+    /// Emitted radiance.
+    pub l: Rgb,
+    /// Emits on both sides.
+    pub two_sided: bool,
+    /// Edges perpendicular: the spherical-rectangle sampler applies.
+    pub rectangular: bool,
+}
+
+impl QuadLight {
+    /// A light on the parallelogram `corner + s·e1 + t·e2` emitting toward `n`; `None` for zero
+    /// area, a zero normal, a normal in the quad's plane, or non-finite input.
+    pub fn new(corner: Vec3, e1: Vec3, e2: Vec3, n: Vec3, l: Rgb, two_sided: bool) -> Option<Self> {
+        if !(corner.is_finite() && e1.is_finite() && e2.is_finite() && n.is_finite()) {
+            return None;
+        }
+        if !l.is_finite() {
+            return None;
+        }
+        let c = e1.cross(e2);
+        let area = c.length();
+        if !(area > 0.0) || !area.is_finite() {
+            return None;
+        }
+        // The true geometric normal, turned to the side the caller says emits: cosines and the
+        // inside/outside test must use the plane's own normal even if `n` is slightly off.
+        let mut ng = c / area;
+        let side = ng.dot(n);
+        if side == 0.0 || !side.is_finite() {
+            return None;
+        }
+        if side < 0.0 {
+            ng = -ng;
+        }
+        let cos_edges = e1.dot(e2) / (e1.length() * e2.length());
+        Some(Self {
+            corner,
+            e1,
+            e2,
+            n: ng,
+            area,
+            l,
+            two_sided,
+            rectangular: (cos_edges.abs() as f64) <= SphericalRectangle::MAX_EDGE_COS,
+        })
+    }
+
+    #[inline]
+    fn emits_toward(&self, w: Vec3) -> bool {
+        self.two_sided || self.n.dot(w) > 0.0
+    }
+
+    /// Whether a receiver at `p` can see the emitting side (none from the plane itself).
+    #[inline]
+    fn faces(&self, p: Vec3) -> bool {
+        let s = self.n.dot(p - self.corner);
+        if self.two_sided { s != 0.0 } else { s > 0.0 }
+    }
+
+    /// The spherical rectangle to sample from `p` in solid-angle mode, or `None` where area
+    /// sampling is used instead: skewed parallelograms (the sampler needs right angles) and solid
+    /// angles outside [`spherical_ok`]. `sample_li` and `pdf_li` share this rule.
+    fn spherical(&self, p: Vec3, mode: SamplingMode) -> Option<SphericalRectangle> {
+        if mode != SamplingMode::SolidAngle || !self.rectangular {
+            return None;
+        }
+        let sr = SphericalRectangle::new(p, self.corner, self.e1, self.e2)?;
+        spherical_ok(sr.solid_angle).then_some(sr)
+    }
+}
+
+impl LightSource for QuadLight {
+    fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        mode: SamplingMode,
+    ) -> Option<LightLiSample> {
+        if !self.faces(ctx.p) {
+            return None;
+        }
+        let (p_light, pdf_sa) = match self.spherical(ctx.p, mode) {
+            Some(sr) => (sr.sample(u), Some(1.0 / sr.solid_angle)),
+            None => (self.corner + u.x * self.e1 + u.y * self.e2, None),
+        };
+        let d = p_light - ctx.p;
+        let dist = d.length();
+        if !(dist > 0.0) {
+            return None;
+        }
+        let wi = d / dist;
+        let pdf =
+            pdf_sa.unwrap_or_else(|| area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n));
+        if !(pdf > 0.0) || !pdf.is_finite() {
+            return None;
+        }
+        Some(LightLiSample {
+            wi,
+            li: self.l,
+            pdf,
+            p_light,
+            delta: false,
+        })
+    }
+
+    fn pdf_li(
+        &self,
+        ctx: &LightSampleContext,
+        wi: Vec3,
+        p_light: Vec3,
+        _n_light: Vec3,
+        mode: SamplingMode,
+    ) -> f32 {
+        if !self.faces(ctx.p) {
+            return 0.0;
+        }
+        match self.spherical(ctx.p, mode) {
+            Some(sr) => sr.pdf(wi),
+            None => area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n),
+        }
+    }
+
+    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
+        if self.emits_toward(w) {
+            self.l
+        } else {
+            Rgb::ZERO
+        }
+    }
+
+    fn power(&self) -> f32 {
+        let sides = if self.two_sided { 2.0 } else { 1.0 };
+        luminance(self.l) * self.area * PI * sides
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        let c = [
+            self.corner,
+            self.corner + self.e1,
+            self.corner + self.e2,
+            self.corner + self.e1 + self.e2,
+        ];
+        let min = c[0].min(c[1]).min(c[2]).min(c[3]);
+        let max = c[0].max(c[1]).max(c[2]).max(c[3]);
+        Some(LightBounds {
+            min,
+            max,
+            w: self.n,
+            phi: self.power(),
+            cos_theta_o: 1.0,
+            cos_theta_e: 0.0,
+            two_sided: self.two_sided,
+        })
+    }
+}
