@@ -472,7 +472,9 @@ NamedMaterial "red"
 #[test]
 fn textures_constant_scale_checkerboard_imagemap() {
     let d = tmpdir("tex");
-    std::fs::write(d.join("wood.png"), b"not really a png").unwrap();
+    let mut img = penumbra::image::Image::new(4, 2);
+    img.pixels[0] = Rgb::ONE;
+    penumbra::image::io::write_image(&img, &d.join("wood.png"), 0.0).unwrap();
     let src = format!(
         r#"WorldBegin
 Texture "c" "spectrum" "constant" "rgb value" [0.1 0.2 0.3]
@@ -558,7 +560,8 @@ Shape "sphere" "float radius" 0.5"#,
 #[test]
 fn light_sources_point_spot_distant_infinite() {
     let d = tmpdir("lights");
-    std::fs::write(d.join("sky.exr"), b"x").unwrap();
+    penumbra::image::io::write_image(&penumbra::image::Image::new(8, 4), &d.join("sky.exr"), 0.0)
+        .unwrap();
     let src = r#"WorldBegin
 Translate 0 5 0
 LightSource "point" "rgb I" [1 2 3] "point3 from" [1 0 0]

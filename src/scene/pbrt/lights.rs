@@ -267,9 +267,7 @@ pub fn parse_light(
 
 /// Convert a description into a renderer light (`images` holds what the parser loaded).
 pub fn to_light(desc: &LightDesc, images: &ImageCache) -> anyhow::Result<Light> {
-    use crate::lights::{
-        DistantLight, EnvMapLight, PointLight, SpotLight, UniformInfiniteLight,
-    };
+    use crate::lights::{DistantLight, EnvMapLight, PointLight, SpotLight, UniformInfiniteLight};
     Ok(match desc {
         LightDesc::Point { p, intensity } => Light::Point(PointLight::new(*p, *intensity)),
         LightDesc::Spot {
@@ -288,9 +286,7 @@ pub fn to_light(desc: &LightDesc, images: &ImageCache) -> anyhow::Result<Light> 
         LightDesc::Distant { w_toward_light, l } => {
             Light::Distant(DistantLight::new(*w_toward_light, *l))
         }
-        LightDesc::UniformInfinite { l } => {
-            Light::UniformInfinite(UniformInfiniteLight::new(*l))
-        }
+        LightDesc::UniformInfinite { l } => Light::UniformInfinite(UniformInfiniteLight::new(*l)),
         LightDesc::EnvMap {
             path,
             scale,

@@ -173,12 +173,19 @@ pub fn finish_mesh(raw: RawMesh, ctx: &ShapeCtx, warn: &mut Warn) -> anyhow::Res
             return Err(err_at(loc, format!("non-finite uv at vertex {i}")));
         }
     }
+    // The identity (the common case after WorldBegin) is skipped entirely: no rounding, so a
+    // scene loaded from file matches the same data given to the builder bit for bit (the
+    // builder normalises normals itself).
+    let identity = ctx.ctm.m == Mat4::IDENTITY;
     let m: Mat4 = ctx.ctm.m;
-    let positions: Vec<Vec3> = raw
-        .positions
-        .iter()
-        .map(|&p| m.transform_point3(p))
-        .collect();
+    let positions: Vec<Vec3> = if identity {
+        raw.positions
+    } else {
+        raw.positions
+            .iter()
+            .map(|&p| m.transform_point3(p))
+            .collect()
+    };
     if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
         return Err(err_at(
             loc,
@@ -187,6 +194,9 @@ pub fn finish_mesh(raw: RawMesh, ctx: &ShapeCtx, warn: &mut Warn) -> anyhow::Res
     }
     let nt = ctx.ctm.m_inv.transpose();
     let normals = raw.normals.map(|ns| {
+        if identity {
+            return ns;
+        }
         ns.into_iter()
             .map(|v| nt.transform_vector3(v).normalize_or_zero())
             .collect()
