@@ -818,4 +818,9 @@ fn big_ply_parse_timing() {
         b.len() / 1_000_000
     );
     assert!(tris >= 1_000_000);
+    let t = std::time::Instant::now();
+    let (builder, cam, film, _) = s.into_builder().unwrap();
+    let scene = builder.build(cam, film).unwrap();
+    println!("builder + BVH build in {:.3} s", t.elapsed().as_secs_f64());
+    assert_eq!(scene.materials.len(), 1);
 }

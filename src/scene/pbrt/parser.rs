@@ -255,10 +255,7 @@ impl Parser {
 
     /// Run the whole file (and includes) and finish the scene.
     pub fn run(mut self) -> anyhow::Result<PbrtScene> {
-        loop {
-            let Some(top) = self.files.last_mut() else {
-                break;
-            };
+        while let Some(top) = self.files.last_mut() {
             match top.tok.next_token()? {
                 None => {
                     self.files.pop();

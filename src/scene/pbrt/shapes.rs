@@ -131,7 +131,7 @@ pub fn finish_mesh(raw: RawMesh, ctx: &ShapeCtx, warn: &mut Warn) -> anyhow::Res
             "empty mesh: expected vertices and triangles, found none",
         ));
     }
-    if raw.indices.len() % 3 != 0 {
+    if !raw.indices.len().is_multiple_of(3) {
         return Err(err_at(
             loc,
             format!(
@@ -270,10 +270,10 @@ fn indices_param(
     }
 }
 
-fn mesh_attrs(
-    params: &ParamSet,
-    loc: &Loc,
-) -> anyhow::Result<(Vec<Vec3>, Option<Vec<Vec3>>, Option<Vec<Vec2>>)> {
+/// Positions, optional normals, optional uvs of a mesh directive.
+type MeshAttrs = (Vec<Vec3>, Option<Vec<Vec3>>, Option<Vec<Vec2>>);
+
+fn mesh_attrs(params: &ParamSet, loc: &Loc) -> anyhow::Result<MeshAttrs> {
     let p = params
         .point3s("P")?
         .ok_or_else(|| err_at(loc, "expected \"point3 P\", found none"))?;
@@ -324,7 +324,7 @@ pub fn make_shape(
         "bilinearmesh" => {
             let (p, n, uv) = mesh_attrs(params, loc)?;
             let quads = indices_param(params, "indices", p.len(), 4, loc)?;
-            if quads.len() % 4 != 0 {
+            if !quads.len().is_multiple_of(4) {
                 return Err(err_at(
                     loc,
                     format!(

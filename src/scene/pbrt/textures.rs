@@ -151,6 +151,8 @@ impl TextureTable {
     }
 
     /// Parse a `Texture "name" "spectrum"|"float" "class" params` directive and store it.
+    // The three positional strings of the directive are passed as they appear in the file.
+    #[allow(clippy::too_many_arguments)]
     pub fn define(
         &mut self,
         name: &str,
