@@ -68,6 +68,7 @@ fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> 
         mis: MisHeuristic::Power,
         eye_rays: spp,
         shadow_rays: m,
+        bsdf_sampling: penumbra::bsdf::LobeSampling::Importance,
     };
     // A ray that reaches the origin from the side, clear of lights above it.
     let o = Vec3::new(0.0, -3.0, 1.0);

@@ -71,6 +71,20 @@ pub enum LobeSampling {
     Uniform,
 }
 
+impl std::str::FromStr for LobeSampling {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim() {
+            "importance" | "cosine-power" => Ok(Self::Importance),
+            "cosine" => Ok(Self::Cosine),
+            "uniform" => Ok(Self::Uniform),
+            _ => Err(format!(
+                "unknown BSDF sampling '{s}' (expected importance, cosine or uniform)"
+            )),
+        }
+    }
+}
+
 impl LobeSampling {
     /// Draw from the BSDF-independent hemisphere density of this mode (Importance → cosine).
     #[inline]

@@ -47,6 +47,9 @@ pub struct Args {
     /// Light selection strategy.
     #[arg(long, default_value = "uniform")]
     pub light_selection: String,
+    /// How BSDF lobes are sampled: importance (cosine-power / GGX), cosine or uniform.
+    #[arg(long, default_value = "importance")]
+    pub bsdf_sampling: penumbra::bsdf::LobeSampling,
     /// PNG exposure in stops.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
@@ -108,6 +111,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         mis: args.mis,
         pattern: args.pattern,
         light_selection: args.light_selection.clone(),
+        bsdf_sampling: args.bsdf_sampling,
         progress: !args.quiet,
     };
     anyhow::ensure!(opts.spp >= 1, "--spp must be at least 1");

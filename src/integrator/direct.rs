@@ -8,7 +8,7 @@
 
 use super::{MisHeuristic, Strategy};
 use crate::Rgb;
-use crate::bsdf::{Bsdf, Bxdf};
+use crate::bsdf::{Bsdf, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::{Ray, RayQuery, SurfaceHit};
 use crate::light_selection::{LightSelector, ShadingPoint};
@@ -47,6 +47,8 @@ pub struct DirectLighting<'a> {
     pub eye_rays: u32,
     /// Light / BSDF samples per eye ray (M).
     pub shadow_rays: u32,
+    /// How BSDF lobes are sampled.
+    pub bsdf_sampling: LobeSampling,
 }
 
 /// Where the samples of one eye ray come from.
@@ -109,8 +111,12 @@ impl<'a> DirectLighting<'a> {
         let Some(material) = scene.materials.get(hit.material as usize) else {
             return (l, rays);
         };
+        let mut bsdf = material.bsdf(&hit, front);
+        if self.bsdf_sampling != LobeSampling::Importance {
+            bsdf.set_sampling(self.bsdf_sampling);
+        }
         let sh = Shading {
-            bsdf: material.bsdf(&hit, front),
+            bsdf,
             wo_local: frame.to_local(wo),
             frame,
             ng,
@@ -211,7 +217,9 @@ impl<'a> DirectLighting<'a> {
             return Rgb::ZERO;
         }
         let wi = sh.frame.to_world(bs.wi).normalize();
-        if wi.dot(sh.ng) <= 0.0 {
+        // Only specular transmission (smooth glass) may leave below the geometric surface;
+        // every other sample there is rejected exactly as light sampling rejects it.
+        if wi.dot(sh.ng) <= 0.0 && !bs.delta {
             return Rgb::ZERO;
         }
         let weight = bs.f * (bs.wi.z.abs() / bs.pdf);

@@ -54,8 +54,12 @@ fn mesh(d: &MeshData) -> TriangleMesh {
     }
 }
 
-/// Add the box (walls, blocks, light) to a builder; returns the material indices by name.
-pub fn add_cornell_box(b: &mut SceneBuilder) -> anyhow::Result<Vec<(&'static str, u32)>> {
+/// Add the box (walls, blocks unless `blocks` is false, light) to a builder; returns the
+/// material indices by name.
+pub fn add_cornell_box(
+    b: &mut SceneBuilder,
+    blocks: bool,
+) -> anyhow::Result<Vec<(&'static str, u32)>> {
     let ids: Vec<(&'static str, u32)> = MATERIALS
         .iter()
         .map(|(name, r)| {
@@ -67,6 +71,9 @@ pub fn add_cornell_box(b: &mut SceneBuilder) -> anyhow::Result<Vec<(&'static str
         .collect();
     let id = |name: &str| ids.iter().find(|(n, _)| *n == name).map(|(_, i)| *i);
     for d in MESHES {
+        if !blocks && d.material.ends_with("Box") {
+            continue;
+        }
         b.add_mesh(mesh(d), id(d.material).unwrap_or(0), None)?;
     }
     let emission = AreaEmission {
@@ -84,6 +91,40 @@ pub fn add_cornell_box(b: &mut SceneBuilder) -> anyhow::Result<Vec<(&'static str
 /// Build the default Cornell box.
 pub fn cornell(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
     let mut b = SceneBuilder::new();
-    add_cornell_box(&mut b)?;
+    add_cornell_box(&mut b, true)?;
+    b.build(cornell_camera(), cornell_film())
+}
+
+/// The Cornell box with glossy spheres instead of blocks: modified Phong (front row, exponents
+/// 10, 100, 1000) and GGX conductors (back row: gold α = 0.05, copper α = 0.2, aluminium
+/// α = 0.5), to show how the estimators handle glossy lobes.
+pub fn cornell_phong(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
+    let mut b = SceneBuilder::new();
+    add_cornell_box(&mut b, false)?;
+    let r = 0.28;
+    for (i, n) in [10.0f32, 100.0, 1000.0].into_iter().enumerate() {
+        let m = b.add_material(Material::Phong {
+            kd: Texture::Constant(Rgb::new(0.25, 0.25, 0.35)),
+            ks: Rgb::splat(0.6),
+            n,
+        });
+        let c = Vec3::new(-0.62 + 0.62 * i as f32, r, 0.35);
+        b.add_sphere(Transform::translate(c), r, m, None, false)?;
+    }
+    for (i, (metal, alpha)) in [("Au", 0.05f32), ("Cu", 0.2), ("Al", 0.5)]
+        .into_iter()
+        .enumerate()
+    {
+        let (eta, k) = crate::bsdf::named_metal(metal)
+            .ok_or_else(|| anyhow::anyhow!("missing metal table for {metal}"))?;
+        let m = b.add_material(Material::Conductor {
+            eta,
+            k,
+            alpha: Vec2::splat(alpha),
+            reflectance: None,
+        });
+        let c = Vec3::new(-0.62 + 0.62 * i as f32, r, -0.4);
+        b.add_sphere(Transform::translate(c), r, m, None, false)?;
+    }
     b.build(cornell_camera(), cornell_film())
 }

@@ -6,6 +6,7 @@ use super::spectra::{SpectrumUse, named_glass_ior, sampled_at, to_rgb};
 use super::textures::{ImageCache, TextureDesc, TextureTable, Warn};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
+use crate::bsdf::{named_metal, roughness_to_alpha};
 use crate::material::{Material, Texture};
 use glam::Vec2;
 
@@ -282,31 +283,90 @@ pub fn to_material(
     images: &ImageCache,
     warnings: &mut Vec<String>,
 ) -> anyhow::Result<Material> {
+    let alpha = |r: Vec2, remap: bool| {
+        if remap {
+            Vec2::new(roughness_to_alpha(r.x), roughness_to_alpha(r.y))
+        } else {
+            r
+        }
+    };
     Ok(match desc {
         MaterialDesc::Diffuse { reflectance } => Material::Diffuse {
             reflectance: texture(reflectance, images)?,
         },
-        other => {
-            push_once(
-                warnings,
-                format!(
-                    "warning: material {} not available in this build; using diffuse 0.5",
-                    kind(other)
-                ),
-            );
+        MaterialDesc::Conductor {
+            eta,
+            k,
+            reflectance,
+            roughness,
+            remap,
+        } => {
+            let mut metal = |m: &MetalSpectrum, pick_k: bool| -> Rgb {
+                match m {
+                    MetalSpectrum::Rgb(c) => *c,
+                    MetalSpectrum::Named(name) => match named_metal(name) {
+                        Some((e, kk)) => {
+                            if pick_k {
+                                kk
+                            } else {
+                                e
+                            }
+                        }
+                        None => {
+                            push_once(
+                                warnings,
+                                format!("warning: unknown named spectrum \"{name}\"; using copper"),
+                            );
+                            let (e, kk) = named_metal("metal-Cu-eta").unwrap_or_default();
+                            if pick_k { kk } else { e }
+                        }
+                    },
+                }
+            };
+            let (eta, k) = (metal(eta, false), metal(k, true));
+            let reflectance = match reflectance {
+                Some(t) => Some(texture(t, images)?),
+                None => None,
+            };
+            Material::Conductor {
+                eta,
+                k,
+                alpha: alpha(*roughness, *remap),
+                reflectance,
+            }
+        }
+        MaterialDesc::CoatedDiffuse {
+            reflectance,
+            roughness,
+            eta,
+            remap,
+        } => Material::CoatedDiffuse {
+            reflectance: texture(reflectance, images)?,
+            alpha: alpha(*roughness, *remap),
+            eta: *eta,
+        },
+        MaterialDesc::Dielectric {
+            eta,
+            roughness,
+            remap,
+            thin,
+        } => {
+            if *thin {
+                push_once(
+                    warnings,
+                    "warning: thindielectric approximated by a dielectric".to_string(),
+                );
+            }
+            Material::Dielectric {
+                eta: *eta,
+                alpha: alpha(*roughness, *remap),
+            }
+        }
+        MaterialDesc::Interface => {
+            // Shapes with an interface material are skipped by the parser; never reached.
             Material::Diffuse {
-                reflectance: Texture::Constant(Rgb::splat(0.5)),
+                reflectance: Texture::Constant(Rgb::ZERO),
             }
         }
     })
-}
-
-fn kind(d: &MaterialDesc) -> &'static str {
-    match d {
-        MaterialDesc::Diffuse { .. } => "diffuse",
-        MaterialDesc::Conductor { .. } => "conductor",
-        MaterialDesc::CoatedDiffuse { .. } => "coateddiffuse",
-        MaterialDesc::Dielectric { .. } => "dielectric",
-        MaterialDesc::Interface => "interface",
-    }
 }
