@@ -5,7 +5,10 @@
 
 pub mod builder;
 pub mod builtin;
+pub mod gltf;
 pub mod load;
+pub mod obj;
+pub mod view;
 
 pub use builder::SceneBuilder;
 
