@@ -40,7 +40,6 @@ pub fn load_gltf(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     // The gltf crate and our accessor reads run on untrusted data: a panic becomes an error.
     std::panic::catch_unwind(|| load_inner(path, opts))
         .map_err(|_| anyhow!("{file}: the glTF reader crashed on this file"))?
-        .with_context(|| format!("loading glTF {file}"))
 }
 
 fn load_inner(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
