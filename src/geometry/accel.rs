@@ -1,7 +1,7 @@
 //! [`Geometry`]: every primitive of a scene behind one obvhs compressed-wide BVH (CWBVH).
 
 use super::quadric::Quadric;
-use super::triangle::{barycentric_error, intersect_triangle};
+use super::triangle::{RayShear, barycentric_error};
 use super::{Ray, RayQuery, SurfaceHit};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -34,15 +34,12 @@ pub enum PrimKind {
     Quadric(u32),
 }
 
-/// A primitive: compact triangle vertices for the hot intersection loop plus its ids.
+/// A primitive: triangle vertices inline for the hot intersection loop, plus its ids. Vertices
+/// (not edges) are stored so that neighbours see bit-identical shared vertices (watertight).
 #[derive(Clone, Copy, Debug)]
 pub struct Primitive {
-    /// First vertex (triangles).
-    pub p0: Vec3,
-    /// Edge p1 − p0 (triangles).
-    pub e1: Vec3,
-    /// Edge p2 − p0 (triangles).
-    pub e2: Vec3,
+    /// Triangle vertices (unused for quadrics).
+    pub p: [Vec3; 3],
     /// Shape.
     pub kind: PrimKind,
     /// Material index.
@@ -123,11 +120,11 @@ impl Geometry {
     }
 
     #[inline(always)]
-    fn prim_t(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+    fn prim_t(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> f32 {
         let p = &self.prims[id];
         match p.kind {
-            PrimKind::Triangle { .. } => match intersect_triangle(o, d, t_max, p.p0, p.e1, p.e2) {
-                Some((t, _, _)) => t,
+            PrimKind::Triangle { .. } => match shear.intersect(p.p[0], p.p[1], p.p[2], t_max) {
+                Some((t, ..)) => t,
                 None => f32::INFINITY,
             },
             PrimKind::Quadric(q) => self.quadrics[q as usize]
@@ -140,16 +137,14 @@ impl Geometry {
         let p = &self.prims[id];
         match p.kind {
             PrimKind::Triangle { mesh, v } => {
-                let (b1, b2) = match intersect_triangle(ray.o, ray.d, f32::INFINITY, p.p0, p.e1, p.e2)
-                {
-                    Some((_, b1, b2)) => (b1, b2),
-                    None => (1.0 / 3.0, 1.0 / 3.0),
+                let (b0, b1, b2) = match RayShear::new(ray.o, ray.d).intersect(p.p[0], p.p[1], p.p[2], f32::INFINITY) {
+                    Some((_, b0, b1, b2)) => (b0, b1, b2),
+                    None => (1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0),
                 };
-                let b0 = 1.0 - b1 - b2;
-                let verts = [p.p0, p.p0 + p.e1, p.p0 + p.e2];
+                let verts = p.p;
                 let pos = verts[0] * b0 + verts[1] * b1 + verts[2] * b2;
                 let m = &self.meshes[mesh as usize];
-                let mut ng = p.e1.cross(p.e2).normalize_or_zero();
+                let mut ng = (verts[1] - verts[0]).cross(verts[2] - verts[0]).normalize_or_zero();
                 let ns = match &m.normals {
                     Some(n) => {
                         let ns = (n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2)
@@ -209,8 +204,12 @@ impl Geometry {
 fn prim_bounds(p: &Primitive, quadrics: &[Quadric]) -> (Vec3, Vec3) {
     match p.kind {
         PrimKind::Triangle { .. } => {
-            let (a, b, c) = (p.p0, p.p0 + p.e1, p.p0 + p.e2);
-            (a.min(b).min(c), a.max(b).max(c))
+            let [a, b, c] = p.p;
+            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            // Axis-aligned triangles have flat boxes, which slab tests may reject for rays that
+            // do hit them: pad by a relative epsilon.
+            let pad = (hi - lo).max_element() * 1e-6 + lo.abs().max(hi.abs()).max_element() * 1e-7;
+            (lo - pad, hi + pad)
         }
         PrimKind::Quadric(q) => quadrics[q as usize].bounds(),
     }
@@ -218,15 +217,19 @@ fn prim_bounds(p: &Primitive, quadrics: &[Quadric]) -> (Vec3, Vec3) {
 
 #[inline]
 fn to_obvhs(ray: &Ray) -> obvhs::ray::Ray {
-    obvhs::ray::Ray::new(Vec3A::from(ray.o), Vec3A::from(ray.d), 0.0, ray.t_max)
+    // `+ 0.0` turns −0.0 into +0.0: obvhs derives the child order from the direction's sign
+    // while its slab test inverts −0.0 to −∞, and the two disagree for axis-parallel rays.
+    let d = ray.d + Vec3::ZERO;
+    obvhs::ray::Ray::new(Vec3A::from(ray.o), Vec3A::from(d), 0.0, ray.t_max)
 }
 
 impl RayQuery for Geometry {
     fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
         let bvh = self.bvh.as_ref()?;
         let mut hit = RayHit::none();
+        let shear = RayShear::new(ray.o, ray.d);
         let found = bvh.ray_traverse(to_obvhs(ray), &mut hit, |r, id| {
-            self.prim_t(id, ray.o, ray.d, r.tmax)
+            self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
         });
         if !found {
             return None;
@@ -238,6 +241,9 @@ impl RayQuery for Geometry {
         let Some(bvh) = self.bvh.as_ref() else {
             return false;
         };
-        !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| self.prim_t(id, ray.o, ray.d, r.tmax))
+        let shear = RayShear::new(ray.o, ray.d);
+        !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
+            self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
+        })
     }
 }

@@ -1,38 +1,96 @@
-//! Ray–triangle intersection (Möller–Trumbore) and the hit record of a mesh triangle.
+//! Watertight ray–triangle intersection (Woop, Benthin & Wald 2013, as in pbrt-v4): rays
+//! through a shared edge or vertex of a mesh hit at least one of its triangles (no cracks),
+//! because the edge functions of neighbours are computed from the same vertices in the same
+//! ray-sheared space.
 
 use super::float::gamma;
-use glam::Vec3;
+use glam::{DVec2, Vec3};
 
-/// Intersect the ray (o, d) with triangle (p0, p0+e1, p0+e2); returns (t, b1, b2) with
-/// t in (0, t_max). Edges are inclusive so that rays through a shared edge of a closed mesh hit
-/// one of its two triangles (no cracks).
-#[inline(always)]
-pub fn intersect_triangle(
+/// Per-ray constants of the shear that maps the ray to +z through the origin.
+#[derive(Clone, Copy, Debug)]
+pub struct RayShear {
     o: Vec3,
-    d: Vec3,
-    t_max: f32,
-    p0: Vec3,
-    e1: Vec3,
-    e2: Vec3,
-) -> Option<(f32, f32, f32)> {
-    let pv = d.cross(e2);
-    let det = e1.dot(pv);
-    if det == 0.0 || !det.is_finite() {
-        return None;
+    k: [usize; 3],
+    s: Vec3,
+}
+
+impl RayShear {
+    /// Precompute the shear for ray (o, d); `d` must be non-zero.
+    #[inline]
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        let a = d.abs();
+        let kz = if a.x > a.y {
+            if a.x > a.z { 0 } else { 2 }
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let dz = d[kz];
+        Self {
+            o,
+            k: [kx, ky, kz],
+            s: Vec3::new(d[kx] / dz, d[ky] / dz, 1.0 / dz),
+        }
     }
-    let inv = 1.0 / det;
-    let tv = o - p0;
-    let b1 = tv.dot(pv) * inv;
-    if !(0.0..=1.0).contains(&b1) {
-        return None;
+
+    /// Intersect triangle (p0, p1, p2); returns (t, b0, b1, b2) with t in (0, t_max).
+    #[inline(always)]
+    pub fn intersect(&self, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<(f32, f32, f32, f32)> {
+        let [kx, ky, kz] = self.k;
+        let a = p0 - self.o;
+        let b = p1 - self.o;
+        let c = p2 - self.o;
+        let (ax, ay) = (a[kx] - self.s.x * a[kz], a[ky] - self.s.y * a[kz]);
+        let (bx, by) = (b[kx] - self.s.x * b[kz], b[ky] - self.s.y * b[kz]);
+        let (cx, cy) = (c[kx] - self.s.x * c[kz], c[ky] - self.s.y * c[kz]);
+        let mut e0 = bx * cy - by * cx;
+        let mut e1 = cx * ay - cy * ax;
+        let mut e2 = ax * by - ay * bx;
+        if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+            // Exactly on an edge in f32: decide in f64 so neighbours agree.
+            let (a2, b2, c2) = (
+                DVec2::new(ax as f64, ay as f64),
+                DVec2::new(bx as f64, by as f64),
+                DVec2::new(cx as f64, cy as f64),
+            );
+            e0 = (b2.x * c2.y - b2.y * c2.x) as f32;
+            e1 = (c2.x * a2.y - c2.y * a2.x) as f32;
+            e2 = (a2.x * b2.y - a2.y * b2.x) as f32;
+        }
+        if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+            return None;
+        }
+        let det = e0 + e1 + e2;
+        if det == 0.0 {
+            return None;
+        }
+        let (az, bz, cz) = (self.s.z * a[kz], self.s.z * b[kz], self.s.z * c[kz]);
+        let t_scaled = e0 * az + e1 * bz + e2 * cz;
+        if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+            return None;
+        }
+        if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let t = t_scaled * inv;
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        Some((t, e0 * inv, e1 * inv, e2 * inv))
     }
-    let qv = tv.cross(e1);
-    let b2 = d.dot(qv) * inv;
-    if b2 < 0.0 || b1 + b2 > 1.0 {
-        return None;
-    }
-    let t = e2.dot(qv) * inv;
-    if t > 0.0 && t < t_max { Some((t, b1, b2)) } else { None }
+}
+
+/// Intersect the ray (o, d) with triangle (p0, p1, p2); returns (t, b0, b1, b2).
+#[inline]
+pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p: [Vec3; 3]) -> Option<(f32, f32, f32, f32)> {
+    RayShear::new(o, d).intersect(p[0], p[1], p[2], t_max)
 }
 
 /// Conservative absolute error of the barycentric point b0·p0 + b1·p1 + b2·p2 (pbrt-v4's

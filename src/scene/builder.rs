@@ -141,9 +141,7 @@ impl SceneBuilder {
                 None => NO_LIGHT,
             };
             self.prims.push(Primitive {
-                p0: p[0],
-                e1,
-                e2,
+                p,
                 kind: PrimKind::Triangle { mesh: mesh_id, v },
                 material,
                 light,
@@ -211,9 +209,7 @@ impl SceneBuilder {
         };
         self.quadrics.push(q);
         self.prims.push(Primitive {
-            p0: Vec3::ZERO,
-            e1: Vec3::ZERO,
-            e2: Vec3::ZERO,
+            p: [Vec3::ZERO; 3],
             kind: PrimKind::Quadric((self.quadrics.len() - 1) as u32),
             material,
             light,
