@@ -426,3 +426,64 @@ fn broken_gltf_inputs_are_errors_naming_the_file() {
     let p = write(&d, "garbage.gltf", b"{ this is not json");
     assert_err_names_file(load_gltf(&p, &LoadOptions::default()), &p);
 }
+
+// ---------------------------------------------------------------- material mapping
+
+#[test]
+fn obj_ks_maps_to_energy_conserving_phong() {
+    use penumbra::material::{Material, Texture};
+    let d = scratch("phong");
+    write(&d, "m.mtl", b"newmtl floor\nKd 0.8 0.8 0.8\nKs 0.5 0.5 0.5\nNs 20\nnewmtl lamp\nKd 0.3 0.2 0.1\nKe 1 1 1\n");
+    let p = write(&d, "s.obj", QUAD_OBJ.as_bytes());
+    let loaded = load_obj(&p, &LoadOptions::default()).expect("load");
+    match &loaded.scene.materials[0] {
+        Material::Phong { kd: Texture::Constant(kd), ks, n } => {
+            assert!((*kd - Vec3::splat(0.8 / 1.3)).abs().max_element() < 1e-6, "kd {kd}");
+            assert!((*ks - Vec3::splat(0.5 / 1.3)).abs().max_element() < 1e-6, "ks {ks}");
+            assert_eq!(*n, 20.0);
+        }
+        other => panic!("expected Phong, got {other:?}"),
+    }
+    match &loaded.scene.materials[1] {
+        Material::Diffuse { reflectance: Texture::Constant(c) } => {
+            assert_eq!(*c, Vec3::new(0.3, 0.2, 0.1))
+        }
+        other => panic!("expected diffuse, got {other:?}"),
+    }
+}
+
+#[test]
+fn gltf_metallic_roughness_mapping() {
+    use penumbra::material::{Material, Texture};
+    let d = scratch("gltf-materials");
+    write(&d, "t.bin", &triangle_bin([0, 1, 2]));
+    let base = gltf_json(r#"{"byteLength": 44, "uri": "t.bin"}"#);
+    let with = |metallic: &str| {
+        let json = base.replace(
+            r#""metallicFactor": 0"#,
+            &format!(r#""metallicFactor": {metallic}, "roughnessFactor": 0.6"#),
+        );
+        let p = write(&d, &format!("m{metallic}.gltf"), json.as_bytes());
+        load_gltf(&p, &LoadOptions::default()).expect("load").scene.materials[0].clone()
+    };
+    let c = Vec3::new(0.2, 0.4, 0.6);
+    match with("0") {
+        Material::Diffuse { reflectance: Texture::Constant(r) } => assert_eq!(r, c),
+        other => panic!("metallic 0 should be diffuse, got {other:?}"),
+    }
+    match with("0.25") {
+        Material::CoatedDiffuse { reflectance: Texture::Constant(r), alpha, eta } => {
+            assert!((r - 0.75 * c).abs().max_element() < 1e-6);
+            assert!((alpha - Vec2::splat(0.36)).abs().max_element() < 1e-6, "alpha {alpha}");
+            assert_eq!(eta, 1.5);
+        }
+        other => panic!("metallic 0.25 should be coated diffuse, got {other:?}"),
+    }
+    match with("1") {
+        Material::Conductor { alpha, reflectance: Some(Texture::Constant(r)), .. } => {
+            assert_eq!(r, c);
+            assert!((alpha - Vec2::splat(0.36)).abs().max_element() < 1e-6, "alpha {alpha}");
+        }
+        other => panic!("metallic 1 should be a conductor, got {other:?}"),
+    }
+}

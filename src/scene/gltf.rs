@@ -306,10 +306,17 @@ pub fn punctual_light(kind: Kind, color: Rgb, intensity: f32, world: Mat4) -> Li
 
 /// Map a glTF material to ours plus its emission (the one place the mapping lives).
 ///
-/// Base colour = `baseColorFactor` × `baseColorTexture` (sRGB-decoded); emission =
-/// `emissiveFactor` × `emissiveStrength`, two-sided if the material is double-sided.
-/// TODO(bsdf merge): metallic-roughness → Conductor / CoatedDiffuse (alpha = roughness²);
-/// until then every material is diffuse.
+/// Base colour = `baseColorFactor` × `baseColorTexture` (sRGB-decoded); GGX alpha =
+/// roughness² (the glTF/Disney remapping). By `metallicFactor` m (textures are not read):
+/// - m = 0 → Lambertian diffuse with the base colour (glTF's ~4 % dielectric specular is
+///   dropped, so diffuse scenes compare exactly with diffuse references);
+/// - 0 < m < 0.5 → coated diffuse (IOR 1.5 coat, base colour × (1 − m)), the closest of our
+///   materials to glTF's dielectric/metal blend that stays mostly dielectric;
+/// - m ≥ 0.5 → GGX conductor whose normal-incidence reflectance is the base colour (glTF's
+///   metal F0).
+///
+/// Emission = `emissiveFactor` × `emissiveStrength`, two-sided if the material is
+/// double-sided.
 fn gltf_material(
     m: &::gltf::Material,
     buffers: &[Vec<u8>],
@@ -367,14 +374,40 @@ fn gltf_material(
         l: le.max(Rgb::ZERO),
         two_sided: m.double_sided(),
     });
-    let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
-    let _alpha = roughness * roughness;
-    if metallic > 0.0 {
+    let finite01 = |x: f32, d: f32| if x.is_finite() { x.clamp(0.0, 1.0) } else { d };
+    let metallic = finite01(pbr.metallic_factor(), 1.0);
+    let roughness = finite01(pbr.roughness_factor(), 1.0);
+    if pbr.metallic_roughness_texture().is_some() {
         warnings.push(format!(
-            "{file}: material '{name}': metallic {metallic} rendered diffuse (conductors not on main yet)"
+            "{file}: material '{name}': metallicRoughnessTexture ignored (factors only)"
         ));
     }
-    (Material::Diffuse { reflectance: base }, emission)
+    let alpha = Vec2::splat(roughness * roughness);
+    let material = if metallic == 0.0 {
+        Material::Diffuse { reflectance: base }
+    } else if metallic < 0.5 {
+        let reflectance = match base {
+            Texture::Image { image, scale } => Texture::Image {
+                image,
+                scale: scale * (1.0 - metallic),
+            },
+            Texture::Constant(c) => Texture::Constant(c * (1.0 - metallic)),
+            other => other,
+        };
+        Material::CoatedDiffuse {
+            reflectance,
+            alpha,
+            eta: 1.5,
+        }
+    } else {
+        Material::Conductor {
+            eta: Rgb::ONE,
+            k: Rgb::ZERO,
+            alpha,
+            reflectance: Some(base),
+        }
+    };
+    (material, emission)
 }
 
 /// Bytes of every buffer: the GLB blob, a file next to the asset, or a base64 `data:` URI.

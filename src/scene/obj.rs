@@ -168,13 +168,7 @@ pub fn obj_material(
     };
     let ns = m.shininess.filter(|n| n.is_finite() && *n >= 0.0).unwrap_or(1.0);
     let material = if ks.max_element() > 0.0 {
-        // TODO(bsdf merge): Material::Phong { kd: kd_tex, ks, n: ns } once it is on main.
-        let _ = ns;
-        warnings.push(format!(
-            "{file}: material '{}': Phong specular not available yet, rendered diffuse",
-            m.name
-        ));
-        Material::Diffuse { reflectance: kd_tex }
+        Material::Phong { kd: kd_tex, ks, n: ns }
     } else {
         Material::Diffuse { reflectance: kd_tex }
     };
