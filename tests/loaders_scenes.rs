@@ -11,7 +11,9 @@ use penumbra::scene::view::ViewOptions;
 use std::path::PathBuf;
 
 fn shared(rel: &str) -> String {
-    let p: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", "shared", "scenes", rel].iter().collect();
+    let p: PathBuf = [env!("CARGO_MANIFEST_DIR"), "..", "shared", "scenes", rel]
+        .iter()
+        .collect();
     assert!(
         p.exists(),
         "{} is missing: these tests need the shared scenes in ../shared/scenes",
@@ -43,7 +45,10 @@ fn check_render(scene: &Scene, what: &str) {
     };
     let (img, stats) = render(scene, res, &opts).expect("render");
     assert_eq!(stats.non_finite, 0, "{what}: non-finite samples");
-    assert!(img.pixels.iter().all(|p| p.is_finite()), "{what}: non-finite pixel");
+    assert!(
+        img.pixels.iter().all(|p| p.is_finite()),
+        "{what}: non-finite pixel"
+    );
     let mean: f32 = img.pixels.iter().map(|p| p.x + p.y + p.z).sum::<f32>() / (3.0 * 4096.0);
     assert!(mean > 1e-3, "{what}: image is black (mean {mean})");
     let (bx, by) = brightest_block(&img, 4);
@@ -81,11 +86,20 @@ fn brightest_block(img: &Image, k: u32) -> (u32, u32) {
 
 #[test]
 fn mcguire_obj_loads_and_renders() {
-    let loaded = load(&shared("cornell-box-mcguire-obj/CornellBox-Original.obj"), &LoadOptions::default())
-        .expect("load");
+    let loaded = load(
+        &shared("cornell-box-mcguire-obj/CornellBox-Original.obj"),
+        &LoadOptions::default(),
+    )
+    .expect("load");
     // Ke on the light quad only: two triangles, each its own light.
     assert_eq!(loaded.scene.lights.len(), 2);
-    assert!(loaded.scene.lights.iter().all(|l| matches!(l, Light::Triangle(_))));
+    assert!(
+        loaded
+            .scene
+            .lights
+            .iter()
+            .all(|l| matches!(l, Light::Triangle(_)))
+    );
     check_render(&loaded.scene, "McGuire OBJ (auto framing)");
 }
 
@@ -93,7 +107,11 @@ fn mcguire_obj_loads_and_renders() {
 fn tinyobjloader_obj_with_ka_emission_loads_and_renders() {
     let path = shared("cornell-box-tinyobjloader/cornell_box.obj");
     let plain = load(&path, &LoadOptions::default()).expect("load");
-    assert_eq!(plain.scene.lights.len(), 0, "without the flag Ka is not emission");
+    assert_eq!(
+        plain.scene.lights.len(),
+        0,
+        "without the flag Ka is not emission"
+    );
     let opts = LoadOptions {
         obj_ka_emission: true,
         // The original Cornell data is viewed from −z (its open side): the classic camera.
@@ -106,18 +124,32 @@ fn tinyobjloader_obj_with_ka_emission_loads_and_renders() {
         ..Default::default()
     };
     let loaded = load(&path, &opts).expect("load");
-    assert_eq!(loaded.scene.lights.len(), 2, "Ka 20 20 20 on the light quad");
+    assert_eq!(
+        loaded.scene.lights.len(),
+        2,
+        "Ka 20 20 20 on the light quad"
+    );
     check_render(&loaded.scene, "tinyobjloader OBJ (--obj-ka-emission)");
 }
 
 #[test]
 fn bevy_glb_loads_and_renders() {
-    let loaded = load(&shared("cornell-box-gltf-bevy/CornellBox.glb"), &LoadOptions::default())
-        .expect("load");
-    assert!(!loaded.scene.lights.is_empty(), "emissive light mesh became area lights");
+    let loaded = load(
+        &shared("cornell-box-gltf-bevy/CornellBox.glb"),
+        &LoadOptions::default(),
+    )
+    .expect("load");
+    assert!(
+        !loaded.scene.lights.is_empty(),
+        "emissive light mesh became area lights"
+    );
     if let Light::Triangle(t) = &loaded.scene.lights[0] {
         // emissiveFactor 1 × KHR_materials_emissive_strength 100.
-        assert!((t.l - Vec3::splat(100.0)).abs().max_element() < 1e-3, "emission {}", t.l);
+        assert!(
+            (t.l - Vec3::splat(100.0)).abs().max_element() < 1e-3,
+            "emission {}",
+            t.l
+        );
     } else {
         panic!("expected triangle lights");
     }

@@ -47,18 +47,37 @@ fn gltf_camera_projects_known_points_landscape_and_square() {
     let (cam, res) = gltf_camera(w, yfov, None).expect("camera");
     assert_eq!(res, UVec2::new(512, 512));
     let px = |p: Vec3| cam.project(p, res).expect("in front of the camera");
-    assert!(close(px(local(0.0, 0.0, -5.0)), Vec2::new(256.0, 256.0), 1e-2));
+    assert!(close(
+        px(local(0.0, 0.0, -5.0)),
+        Vec2::new(256.0, 256.0),
+        1e-2
+    ));
     // Local +x is image right, local +y is image up (raster y down).
-    assert!(close(px(local(5.0 * t, 0.0, -5.0)), Vec2::new(512.0, 256.0), 1e-2));
-    assert!(close(px(local(0.0, 2.5 * t, -5.0)), Vec2::new(256.0, 128.0), 1e-2));
-    assert!(cam.project(local(0.0, 0.0, 5.0), res).is_none(), "behind the camera");
+    assert!(close(
+        px(local(5.0 * t, 0.0, -5.0)),
+        Vec2::new(512.0, 256.0),
+        1e-2
+    ));
+    assert!(close(
+        px(local(0.0, 2.5 * t, -5.0)),
+        Vec2::new(256.0, 128.0),
+        1e-2
+    ));
+    assert!(
+        cam.project(local(0.0, 0.0, 5.0), res).is_none(),
+        "behind the camera"
+    );
 
     // Landscape 2:1: yfov stays vertical, film 512×256.
     let (cam, res) = gltf_camera(w, yfov, Some(2.0)).expect("camera");
     assert_eq!(res, UVec2::new(512, 256));
-    let p = cam.project(local(0.0, 5.0 * t, -5.0), res).expect("visible");
+    let p = cam
+        .project(local(0.0, 5.0 * t, -5.0), res)
+        .expect("visible");
     assert!(close(p, Vec2::new(256.0, 0.0), 1e-2), "top edge: {p}");
-    let p = cam.project(local(10.0 * t, 0.0, -5.0), res).expect("visible");
+    let p = cam
+        .project(local(10.0 * t, 0.0, -5.0), res)
+        .expect("visible");
     assert!(close(p, Vec2::new(512.0, 128.0), 1e-2), "right edge: {p}");
 }
 
@@ -71,10 +90,17 @@ fn gltf_camera_portrait_keeps_vertical_fov() {
     let local = |x: f32, y: f32, z: f32| w.transform_point3(Vec3::new(x, y, z));
     let (cam, res) = gltf_camera(w, yfov, Some(0.5)).expect("camera");
     assert_eq!(res, UVec2::new(256, 512));
-    let top = cam.project(local(0.0, 5.0 * t, -5.0), res).expect("visible");
+    let top = cam
+        .project(local(0.0, 5.0 * t, -5.0), res)
+        .expect("visible");
     assert!(close(top, Vec2::new(128.0, 0.0), 1e-2), "top edge: {top}");
-    let right = cam.project(local(2.5 * t, 0.0, -5.0), res).expect("visible");
-    assert!(close(right, Vec2::new(256.0, 256.0), 1e-2), "right edge: {right}");
+    let right = cam
+        .project(local(2.5 * t, 0.0, -5.0), res)
+        .expect("visible");
+    assert!(
+        close(right, Vec2::new(256.0, 256.0), 1e-2),
+        "right edge: {right}"
+    );
 }
 
 #[test]
@@ -93,7 +119,11 @@ fn punctual_lights_convert_photometric_units() {
     // 2 × 683 cd → 2 W/sr.
     match punctual_light(Kind::Point, color, 2.0 * LUMENS_PER_WATT, w) {
         Light::Point(p) => {
-            assert!((p.intensity - 2.0 * color).abs().max_element() < 1e-6, "{}", p.intensity);
+            assert!(
+                (p.intensity - 2.0 * color).abs().max_element() < 1e-6,
+                "{}",
+                p.intensity
+            );
             assert!((p.p - Vec3::new(1.0, 2.0, 3.0)).length() < 1e-6);
         }
         other => panic!("expected a point light, got {other:?}"),
@@ -121,7 +151,11 @@ fn punctual_lights_convert_photometric_units() {
     match punctual_light(Kind::Directional, Vec3::ONE, LUMENS_PER_WATT, ws) {
         Light::Distant(d) => {
             assert!((d.l - Vec3::ONE).abs().max_element() < 1e-6);
-            assert!((d.w_light - Vec3::Y).length() < 1e-5, "w_light {}", d.w_light);
+            assert!(
+                (d.w_light - Vec3::Y).length() < 1e-5,
+                "w_light {}",
+                d.w_light
+            );
         }
         other => panic!("expected a distant light, got {other:?}"),
     }
@@ -155,22 +189,33 @@ fn auto_framing_keeps_the_box_in_the_image() {
             }
             // Not absurdly small either: the box spans a good part of the shorter axis.
             let short = res.x.min(res.y) as f32;
-            assert!(max_extent > 0.15 * short, "box {lo}..{hi} is tiny in the image");
+            assert!(
+                max_extent > 0.15 * short,
+                "box {lo}..{hi} is tiny in the image"
+            );
         }
         // Centre of the box at the image centre.
-        let c = cam.project(0.5 * (lo + hi), UVec2::new(64, 64)).expect("centre");
-        assert!(close(c, Vec2::new(32.0, 32.0), 1e-2), "centre projects to {c}");
+        let c = cam
+            .project(0.5 * (lo + hi), UVec2::new(64, 64))
+            .expect("centre");
+        assert!(
+            close(c, Vec2::new(32.0, 32.0), 1e-2),
+            "centre projects to {c}"
+        );
     }
 }
 
 #[test]
 fn right_handed_look_at_puts_plus_x_on_the_right() {
     // Looking from +z toward the origin with +y up (OpenGL default view): +x is image right.
-    let cam = right_handed_look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0)
-        .expect("camera");
+    let cam =
+        right_handed_look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0).expect("camera");
     let res = UVec2::new(64, 64);
     let p = cam.project(Vec3::new(1.0, 0.0, 0.0), res).expect("visible");
-    assert!(p.x > 32.5 && (p.y - 32.0).abs() < 1e-3, "+x projects to {p}");
+    assert!(
+        p.x > 32.5 && (p.y - 32.0).abs() < 1e-3,
+        "+x projects to {p}"
+    );
     let p = cam.project(Vec3::new(0.0, 1.0, 0.0), res).expect("visible");
     assert!(p.y < 31.5, "+y projects to {p}");
     assert!(right_handed_look_at(Vec3::ZERO, Vec3::ZERO, Vec3::Y, 40.0).is_err());
@@ -188,7 +233,11 @@ usemtl lamp\nf 5 8 7 6\n";
 #[test]
 fn obj_ka_emission_flag_turns_ambient_into_lights() {
     let d = scratch("ka");
-    write(&d, "m.mtl", b"newmtl floor\nKd 0.5 0.5 0.5\nKa 0 0 0\nnewmtl lamp\nKd 0 0 0\nKa 3 2 1\n");
+    write(
+        &d,
+        "m.mtl",
+        b"newmtl floor\nKd 0.5 0.5 0.5\nKa 0 0 0\nnewmtl lamp\nKd 0 0 0\nKa 3 2 1\n",
+    );
     let p = write(&d, "s.obj", QUAD_OBJ.as_bytes());
     let off = load_obj(&p, &LoadOptions::default()).expect("load");
     assert_eq!(off.scene.lights.len(), 0);
@@ -200,7 +249,11 @@ fn obj_ka_emission_flag_turns_ambient_into_lights() {
         },
     )
     .expect("load");
-    assert_eq!(on.scene.lights.len(), 2, "one light per triangle of the lamp quad");
+    assert_eq!(
+        on.scene.lights.len(),
+        2,
+        "one light per triangle of the lamp quad"
+    );
     for l in &on.scene.lights {
         match l {
             Light::Triangle(t) => {
@@ -233,11 +286,18 @@ fn obj_ke_is_emission_and_missing_texture_warns() {
 #[test]
 fn obj_kd_plus_ks_is_clamped_with_a_warning() {
     let d = scratch("ks");
-    write(&d, "m.mtl", b"newmtl floor\nKd 0.8 0.8 0.8\nKs 0.5 0.5 0.5\nNs 20\nnewmtl lamp\nKe 1 1 1\n");
+    write(
+        &d,
+        "m.mtl",
+        b"newmtl floor\nKd 0.8 0.8 0.8\nKs 0.5 0.5 0.5\nNs 20\nnewmtl lamp\nKe 1 1 1\n",
+    );
     let p = write(&d, "s.obj", QUAD_OBJ.as_bytes());
     let loaded = load_obj(&p, &LoadOptions::default()).expect("load");
     assert!(
-        loaded.warnings.iter().any(|w| w.contains("floor") && w.contains("Kd + Ks")),
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("floor") && w.contains("Kd + Ks")),
         "warnings: {:?}",
         loaded.warnings
     );
@@ -259,7 +319,10 @@ fn broken_obj_inputs_are_errors_naming_the_file() {
     let d = scratch("broken-obj");
     let missing = d.join("missing.obj");
     assert_err_names_file(load_obj(&missing, &LoadOptions::default()), &missing);
-    assert_err_names_file(load(missing.to_str().expect("utf8"), &LoadOptions::default()), &missing);
+    assert_err_names_file(
+        load(missing.to_str().expect("utf8"), &LoadOptions::default()),
+        &missing,
+    );
     let cases: [(&str, &str); 5] = [
         ("empty.obj", ""),
         ("truncated.obj", "v 0 0 0\nv 1 0 0\nv 0 1"),
@@ -327,7 +390,9 @@ fn base64(bytes: &[u8]) -> String {
     const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::new();
     for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
+        let n = (c[0] as u32) << 16
+            | (*c.get(1).unwrap_or(&0) as u32) << 8
+            | *c.get(2).unwrap_or(&0) as u32;
         for k in 0..4 {
             if k <= c.len() {
                 out.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
@@ -342,7 +407,7 @@ fn base64(bytes: &[u8]) -> String {
 /// A GLB container around `json` and `bin`.
 fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
     let mut j = json.as_bytes().to_vec();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let total = 12 + 8 + j.len() + 8 + bin.len();
@@ -361,7 +426,11 @@ fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
 
 fn check_generated_scene(loaded: &penumbra::scene::load::Loaded) {
     let scene = &loaded.scene;
-    assert_eq!(scene.film.resolution, UVec2::new(256, 512), "aspect 0.5 film");
+    assert_eq!(
+        scene.film.resolution,
+        UVec2::new(256, 512),
+        "aspect 0.5 film"
+    );
     // One emissive triangle + the point light.
     assert_eq!(scene.lights.len(), 2);
     let point = scene
@@ -373,13 +442,23 @@ fn check_generated_scene(loaded: &penumbra::scene::load::Loaded) {
         })
         .expect("point light");
     // Node chain: parent translation (1,2,3) ∘ rot_y(90°) ∘ translation (0,1,0).
-    assert!((point.p - Vec3::new(1.0, 3.0, 3.0)).length() < 1e-5, "light at {}", point.p);
+    assert!(
+        (point.p - Vec3::new(1.0, 3.0, 3.0)).length() < 1e-5,
+        "light at {}",
+        point.p
+    );
     assert!((point.intensity - Vec3::ONE).abs().max_element() < 1e-6);
     // The triangle's first vertex sits 5 units straight ahead of the camera: image centre.
     let w = camera_world();
     let v0 = w.transform_point3(Vec3::new(0.0, 0.0, -5.0));
-    let p = scene.camera.project(v0, scene.film.resolution).expect("visible");
-    assert!(close(p, Vec2::new(128.0, 256.0), 1e-2), "vertex 0 projects to {p}");
+    let p = scene
+        .camera
+        .project(v0, scene.film.resolution)
+        .expect("visible");
+    assert!(
+        close(p, Vec2::new(128.0, 256.0), 1e-2),
+        "vertex 0 projects to {p}"
+    );
 }
 
 #[test]
@@ -414,14 +493,28 @@ fn broken_gltf_inputs_are_errors_naming_the_file() {
     let d = scratch("broken-gltf");
     let missing = d.join("missing.glb");
     assert_err_names_file(load_gltf(&missing, &LoadOptions::default()), &missing);
-    let good = glb(&gltf_json(r#"{"byteLength": 44}"#), &triangle_bin([0, 1, 2]));
+    let good = glb(
+        &gltf_json(r#"{"byteLength": 44}"#),
+        &triangle_bin([0, 1, 2]),
+    );
     for cut in [10, good.len() / 2, good.len() - 8] {
         let p = write(&d, &format!("truncated{cut}.glb"), &good[..cut]);
         assert_err_names_file(load_gltf(&p, &LoadOptions::default()), &p);
     }
-    let p = write(&d, "badindex.glb", &glb(&gltf_json(r#"{"byteLength": 44}"#), &triangle_bin([0, 1, 7])));
+    let p = write(
+        &d,
+        "badindex.glb",
+        &glb(
+            &gltf_json(r#"{"byteLength": 44}"#),
+            &triangle_bin([0, 1, 7]),
+        ),
+    );
     assert_err_names_file(load_gltf(&p, &LoadOptions::default()), &p);
-    let p = write(&d, "nobin.gltf", gltf_json(r#"{"byteLength": 44, "uri": "absent.bin"}"#).as_bytes());
+    let p = write(
+        &d,
+        "nobin.gltf",
+        gltf_json(r#"{"byteLength": 44, "uri": "absent.bin"}"#).as_bytes(),
+    );
     assert_err_names_file(load_gltf(&p, &LoadOptions::default()), &p);
     let p = write(&d, "garbage.gltf", b"{ this is not json");
     assert_err_names_file(load_gltf(&p, &LoadOptions::default()), &p);
@@ -437,15 +530,27 @@ fn obj_ks_maps_to_energy_conserving_phong() {
     let p = write(&d, "s.obj", QUAD_OBJ.as_bytes());
     let loaded = load_obj(&p, &LoadOptions::default()).expect("load");
     match &loaded.scene.materials[0] {
-        Material::Phong { kd: Texture::Constant(kd), ks, n } => {
-            assert!((*kd - Vec3::splat(0.8 / 1.3)).abs().max_element() < 1e-6, "kd {kd}");
-            assert!((*ks - Vec3::splat(0.5 / 1.3)).abs().max_element() < 1e-6, "ks {ks}");
+        Material::Phong {
+            kd: Texture::Constant(kd),
+            ks,
+            n,
+        } => {
+            assert!(
+                (*kd - Vec3::splat(0.8 / 1.3)).abs().max_element() < 1e-6,
+                "kd {kd}"
+            );
+            assert!(
+                (*ks - Vec3::splat(0.5 / 1.3)).abs().max_element() < 1e-6,
+                "ks {ks}"
+            );
             assert_eq!(*n, 20.0);
         }
         other => panic!("expected Phong, got {other:?}"),
     }
     match &loaded.scene.materials[1] {
-        Material::Diffuse { reflectance: Texture::Constant(c) } => {
+        Material::Diffuse {
+            reflectance: Texture::Constant(c),
+        } => {
             assert_eq!(*c, Vec3::new(0.3, 0.2, 0.1))
         }
         other => panic!("expected diffuse, got {other:?}"),
@@ -464,26 +569,135 @@ fn gltf_metallic_roughness_mapping() {
             &format!(r#""metallicFactor": {metallic}, "roughnessFactor": 0.6"#),
         );
         let p = write(&d, &format!("m{metallic}.gltf"), json.as_bytes());
-        load_gltf(&p, &LoadOptions::default()).expect("load").scene.materials[0].clone()
+        load_gltf(&p, &LoadOptions::default())
+            .expect("load")
+            .scene
+            .materials[0]
+            .clone()
     };
     let c = Vec3::new(0.2, 0.4, 0.6);
     match with("0") {
-        Material::Diffuse { reflectance: Texture::Constant(r) } => assert_eq!(r, c),
+        Material::Diffuse {
+            reflectance: Texture::Constant(r),
+        } => assert_eq!(r, c),
         other => panic!("metallic 0 should be diffuse, got {other:?}"),
     }
     match with("0.25") {
-        Material::CoatedDiffuse { reflectance: Texture::Constant(r), alpha, eta } => {
+        Material::CoatedDiffuse {
+            reflectance: Texture::Constant(r),
+            alpha,
+            eta,
+        } => {
             assert!((r - 0.75 * c).abs().max_element() < 1e-6);
-            assert!((alpha - Vec2::splat(0.36)).abs().max_element() < 1e-6, "alpha {alpha}");
+            assert!(
+                (alpha - Vec2::splat(0.36)).abs().max_element() < 1e-6,
+                "alpha {alpha}"
+            );
             assert_eq!(eta, 1.5);
         }
         other => panic!("metallic 0.25 should be coated diffuse, got {other:?}"),
     }
     match with("1") {
-        Material::Conductor { alpha, reflectance: Some(Texture::Constant(r)), .. } => {
+        Material::Conductor {
+            alpha,
+            reflectance: Some(Texture::Constant(r)),
+            ..
+        } => {
             assert_eq!(r, c);
-            assert!((alpha - Vec2::splat(0.36)).abs().max_element() < 1e-6, "alpha {alpha}");
+            assert!(
+                (alpha - Vec2::splat(0.36)).abs().max_element() < 1e-6,
+                "alpha {alpha}"
+            );
         }
         other => panic!("metallic 1 should be a conductor, got {other:?}"),
     }
+}
+
+// ---------------------------------------------------------------- image textures
+
+/// A 1×2 PNG: top pixel sRGB (255, 128, 0), bottom (0, 0, 255).
+fn two_pixel_png() -> Vec<u8> {
+    let mut img = image::RgbImage::new(1, 2);
+    img.put_pixel(0, 0, image::Rgb([255, 128, 0]));
+    img.put_pixel(0, 1, image::Rgb([0, 0, 255]));
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png)
+        .expect("encode png");
+    out.into_inner()
+}
+
+/// The texture of material `i`, checked to be an sRGB-decoded copy of [`two_pixel_png`].
+fn check_two_pixel_texture(m: &penumbra::material::Material, scale: Vec3) {
+    use penumbra::material::{Material, Texture};
+    let tex = match m {
+        Material::Diffuse { reflectance } => reflectance,
+        other => panic!("expected diffuse, got {other:?}"),
+    };
+    match tex {
+        Texture::Image { image, scale: s } => {
+            assert_eq!((image.width, image.height), (1, 2));
+            assert!((*s - scale).abs().max_element() < 1e-6, "scale {s}");
+            // sRGB 128 → linear 0.2158; v = 1 is the top row (pbrt convention).
+            let top = tex.eval(Vec2::new(0.5, 0.75)) / scale;
+            assert!(
+                (top - Vec3::new(1.0, 0.2158, 0.0)).abs().max_element() < 1e-3,
+                "top {top}"
+            );
+            let bottom = tex.eval(Vec2::new(0.5, 0.25)) / scale;
+            assert!(
+                (bottom - Vec3::Z).abs().max_element() < 1e-3,
+                "bottom {bottom}"
+            );
+        }
+        other => panic!("expected an image texture, got {other:?}"),
+    }
+}
+
+#[test]
+fn obj_map_kd_becomes_an_image_texture() {
+    let d = scratch("map-kd");
+    write(&d, "tex.png", &two_pixel_png());
+    write(
+        &d,
+        "m.mtl",
+        b"newmtl floor\nKd 1 1 1\nmap_Kd tex.png\nnewmtl lamp\nKe 1 1 1\n",
+    );
+    let p = write(&d, "s.obj", QUAD_OBJ.as_bytes());
+    let loaded = load_obj(&p, &LoadOptions::default()).expect("load");
+    assert!(
+        loaded.warnings.is_empty(),
+        "warnings: {:?}",
+        loaded.warnings
+    );
+    check_two_pixel_texture(&loaded.scene.materials[0], Vec3::ONE);
+}
+
+#[test]
+fn gltf_base_color_texture_from_a_data_uri() {
+    let d = scratch("gltf-texture");
+    write(&d, "t.bin", &triangle_bin([0, 1, 2]));
+    let json = gltf_json(r#"{"byteLength": 44, "uri": "t.bin"}"#)
+        .replace(
+            r#""metallicFactor": 0}"#,
+            r#""metallicFactor": 0, "baseColorTexture": {"index": 0}}"#,
+        )
+        .replace(
+            r#""buffers":"#,
+            &format!(
+                r#""textures": [{{"source": 0}}], "images": [{{"uri": "data:image/png;base64,{}"}}], "buffers":"#,
+                base64(&two_pixel_png())
+            ),
+        );
+    let p = write(&d, "s.gltf", json.as_bytes());
+    let loaded = load_gltf(&p, &LoadOptions::default()).expect("load");
+    check_two_pixel_texture(&loaded.scene.materials[0], Vec3::new(0.2, 0.4, 0.6));
+    // A missing image only warns and falls back to the factor.
+    let broken = json.replace("data:image/png;base64,", "missing.png#");
+    let p = write(&d, "broken.gltf", broken.as_bytes());
+    let loaded = load_gltf(&p, &LoadOptions::default()).expect("missing images only warn");
+    assert!(
+        loaded.warnings.iter().any(|w| w.contains("image 0")),
+        "{:?}",
+        loaded.warnings
+    );
 }

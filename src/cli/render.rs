@@ -82,7 +82,9 @@ pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
         .collect::<Result<_, _>>()
         .map_err(|_| format!("expected X,Y,Z (e.g. 0,1,5), got '{s}'"))?;
     match v[..] {
-        [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => Ok(glam::Vec3::new(x, y, z)),
+        [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => {
+            Ok(glam::Vec3::new(x, y, z))
+        }
         _ => Err(format!("expected three finite numbers X,Y,Z, got '{s}'")),
     }
 }

@@ -55,8 +55,7 @@ fn load_inner(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     // Materials: one per glTF material (same index), plus the spec's default material.
     let mut mats = Vec::new();
     for m in doc.materials() {
-        let (mat, emission) =
-            gltf_material(&m, &buffers, dir, &mut images, &file, &mut warnings);
+        let (mat, emission) = gltf_material(&m, &buffers, dir, &mut images, &file, &mut warnings);
         mats.push((b.add_material(mat), emission));
     }
 
@@ -86,7 +85,10 @@ fn load_inner(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
         bail!("{file}: the scene has no triangles");
     }
     if b.degenerate_triangles > 0 {
-        warnings.push(format!("{file}: skipped {} zero-area triangles", b.degenerate_triangles));
+        warnings.push(format!(
+            "{file}: skipped {} zero-area triangles",
+            b.degenerate_triangles
+        ));
     }
     let (lo, hi) = bounds_of(&all_points).ok_or_else(|| anyhow!("{file}: no vertices"))?;
     let mut film = default_film();
@@ -98,7 +100,9 @@ fn load_inner(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
         }
         _ => flag_or_auto_camera(&opts.view, lo, hi).with_context(|| format!("{file}: camera"))?,
     };
-    let scene = b.build(camera, film).with_context(|| format!("{file}: building the scene"))?;
+    let scene = b
+        .build(camera, film)
+        .with_context(|| format!("{file}: building the scene"))?;
     Ok(Loaded { scene, warnings })
 }
 
@@ -158,7 +162,10 @@ struct Walk<'a> {
 impl Walk<'_> {
     fn visit(&mut self, node: &::gltf::Node, parent: Mat4, depth: usize) -> anyhow::Result<()> {
         let file = self.file;
-        ensure!(depth < MAX_DEPTH, "{file}: node hierarchy deeper than {MAX_DEPTH} (a cycle?)");
+        ensure!(
+            depth < MAX_DEPTH,
+            "{file}: node hierarchy deeper than {MAX_DEPTH} (a cycle?)"
+        );
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let world = parent * local;
         ensure!(
@@ -193,8 +200,12 @@ impl Walk<'_> {
                 ));
             }
             let color = Rgb::from_array(light.color());
-            self.b
-                .add_light(punctual_light(light.kind(), color, light.intensity(), world));
+            self.b.add_light(punctual_light(
+                light.kind(),
+                color,
+                light.intensity(),
+                world,
+            ));
         }
         if let Some(mesh) = node.mesh() {
             self.add_mesh(&mesh, world)
@@ -223,7 +234,12 @@ impl Walk<'_> {
             let reader = prim.reader(|buf| buffers.get(buf.index()).map(|v| v.as_slice()));
             let positions: Vec<Vec3> = reader
                 .read_positions()
-                .ok_or_else(|| anyhow!("primitive {}: POSITION missing or out of range", prim.index()))?
+                .ok_or_else(|| {
+                    anyhow!(
+                        "primitive {}: POSITION missing or out of range",
+                        prim.index()
+                    )
+                })?
                 .map(|p| xf.point(Vec3::from_array(p)))
                 .collect();
             let nv = positions.len();
@@ -284,7 +300,11 @@ impl Walk<'_> {
 /// A `KHR_lights_punctual` light at the node with world matrix `world` (lights shine down
 /// their local −z). Intensities are photometric: see [`LUMENS_PER_WATT`].
 pub fn punctual_light(kind: Kind, color: Rgb, intensity: f32, world: Mat4) -> Light {
-    let intensity = if intensity.is_finite() { intensity.max(0.0) } else { 0.0 };
+    let intensity = if intensity.is_finite() {
+        intensity.max(0.0)
+    } else {
+        0.0
+    };
     let radiometric = color.max(Rgb::ZERO) * intensity / LUMENS_PER_WATT;
     let p = world.transform_point3(Vec3::ZERO);
     let dir = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
@@ -332,7 +352,11 @@ fn gltf_material(
     let pbr = m.pbr_metallic_roughness();
     let [r, g, bl, _a] = pbr.base_color_factor();
     let factor = Rgb::new(r, g, bl);
-    let factor = if factor.is_finite() { factor.max(Rgb::ZERO) } else { Rgb::ONE };
+    let factor = if factor.is_finite() {
+        factor.max(Rgb::ZERO)
+    } else {
+        Rgb::ONE
+    };
     let base = match pbr.base_color_texture() {
         Some(info) => {
             let img = info.texture().source();
@@ -368,7 +392,10 @@ fn gltf_material(
         }
         None => Texture::Constant(factor),
     };
-    let strength = m.emissive_strength().filter(|s| s.is_finite()).unwrap_or(1.0);
+    let strength = m
+        .emissive_strength()
+        .filter(|s| s.is_finite())
+        .unwrap_or(1.0);
     let le = Rgb::from_array(m.emissive_factor()) * strength;
     let emission = (le.is_finite() && le.max_element() > 0.0).then(|| AreaEmission {
         l: le.max(Rgb::ZERO),
@@ -415,12 +442,15 @@ fn load_buffers(doc: &::gltf::Gltf, dir: &Path, file: &str) -> anyhow::Result<Ve
     let mut out = Vec::new();
     for buf in doc.buffers() {
         let data = match buf.source() {
-            ::gltf::buffer::Source::Bin => doc
-                .blob
-                .clone()
-                .ok_or_else(|| anyhow!("{file}: buffer {} refers to a missing GLB binary chunk", buf.index()))?,
-            ::gltf::buffer::Source::Uri(uri) => read_uri(uri, dir)
-                .with_context(|| format!("{file}: buffer {}", buf.index()))?,
+            ::gltf::buffer::Source::Bin => doc.blob.clone().ok_or_else(|| {
+                anyhow!(
+                    "{file}: buffer {} refers to a missing GLB binary chunk",
+                    buf.index()
+                )
+            })?,
+            ::gltf::buffer::Source::Uri(uri) => {
+                read_uri(uri, dir).with_context(|| format!("{file}: buffer {}", buf.index()))?
+            }
         };
         ensure!(
             data.len() >= buf.length(),
@@ -519,7 +549,13 @@ fn decode_image(img: &::gltf::Image, buffers: &[Vec<u8>], dir: &Path) -> anyhow:
     let (w, h) = rgb.dimensions();
     let pixels = rgb
         .pixels()
-        .map(|p| Rgb::new(srgb_to_linear(p[0]), srgb_to_linear(p[1]), srgb_to_linear(p[2])))
+        .map(|p| {
+            Rgb::new(
+                srgb_to_linear(p[0]),
+                srgb_to_linear(p[1]),
+                srgb_to_linear(p[2]),
+            )
+        })
         .collect();
     Ok(ImageRgb {
         width: w,

@@ -72,7 +72,11 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
         if m.indices.is_empty() {
             continue;
         }
-        let positions: Vec<Vec3> = m.positions.chunks_exact(3).map(|c| Vec3::from_slice(c)).collect();
+        let positions: Vec<Vec3> = m
+            .positions
+            .chunks_exact(3)
+            .map(|c| Vec3::from_slice(c))
+            .collect();
         let nv = positions.len();
         // With single_index, normals/uvs are per vertex when present (else empty).
         let normals = (m.normals.len() == 3 * nv && nv > 0)
@@ -118,7 +122,8 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     if b.primitive_count() == 0 {
         bail!("{file}: every triangle has zero area");
     }
-    let camera = flag_or_auto_camera(&opts.view, lo, hi).with_context(|| format!("{file}: camera"))?;
+    let camera =
+        flag_or_auto_camera(&opts.view, lo, hi).with_context(|| format!("{file}: camera"))?;
     let scene = b
         .build(camera, default_film())
         .with_context(|| format!("{file}: building the scene"))?;
@@ -138,7 +143,9 @@ pub fn obj_material(
     warnings: &mut Vec<String>,
 ) -> (Material, Option<AreaEmission>) {
     let rgb = |c: Option<[f32; 3]>| c.map(Rgb::from_array).filter(|c| c.is_finite());
-    let mut kd = rgb(m.diffuse).unwrap_or(Rgb::splat(DEFAULT_KD)).max(Rgb::ZERO);
+    let mut kd = rgb(m.diffuse)
+        .unwrap_or(Rgb::splat(DEFAULT_KD))
+        .max(Rgb::ZERO);
     let mut ks = rgb(m.specular).unwrap_or(Rgb::ZERO).max(Rgb::ZERO);
     let sum = (kd + ks).max_element();
     if ks.max_element() > 0.0 && sum > 1.0 {
@@ -166,11 +173,20 @@ pub fn obj_material(
         },
         None => Texture::Constant(kd),
     };
-    let ns = m.shininess.filter(|n| n.is_finite() && *n >= 0.0).unwrap_or(1.0);
+    let ns = m
+        .shininess
+        .filter(|n| n.is_finite() && *n >= 0.0)
+        .unwrap_or(1.0);
     let material = if ks.max_element() > 0.0 {
-        Material::Phong { kd: kd_tex, ks, n: ns }
+        Material::Phong {
+            kd: kd_tex,
+            ks,
+            n: ns,
+        }
     } else {
-        Material::Diffuse { reflectance: kd_tex }
+        Material::Diffuse {
+            reflectance: kd_tex,
+        }
     };
     let mut le = rgb(m.emissive).unwrap_or(Rgb::ZERO);
     if opts.obj_ka_emission {
@@ -206,7 +222,11 @@ impl TextureCache {
             .entry(name.to_string())
             .or_insert_with(|| {
                 // The file name is the last token: MTL map options precede it.
-                let fname = name.split_whitespace().last().unwrap_or(name).replace('\\', "/");
+                let fname = name
+                    .split_whitespace()
+                    .last()
+                    .unwrap_or(name)
+                    .replace('\\', "/");
                 let p = dir.join(fname);
                 crate::image::io::read_image(&p)
                     .map(|img| {

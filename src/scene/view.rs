@@ -48,7 +48,12 @@ pub fn default_film() -> FilmSpec {
 
 /// A right-handed look-at camera: `target` at the image centre, `up` up, and the viewer's
 /// right equal to `(target − eye) × up` (OpenGL convention).
-pub fn right_handed_look_at(eye: Vec3, target: Vec3, up: Vec3, fov_deg: f32) -> anyhow::Result<Camera> {
+pub fn right_handed_look_at(
+    eye: Vec3,
+    target: Vec3,
+    up: Vec3,
+    fov_deg: f32,
+) -> anyhow::Result<Camera> {
     ensure!(
         eye.is_finite() && target.is_finite() && up.is_finite(),
         "camera eye {eye}, target {target} and up {up} must be finite"
