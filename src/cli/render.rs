@@ -6,6 +6,7 @@ use penumbra::integrator::{MisHeuristic, RenderOptions, Strategy, render};
 use penumbra::sampling::PatternKind;
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
+use penumbra::scene::view::ViewOptions;
 use std::path::PathBuf;
 
 /// Arguments of `penumbra render`.
@@ -59,6 +60,36 @@ pub struct Args {
     /// Rooms per side of `many-rooms`.
     #[arg(long)]
     pub rooms: Option<u32>,
+    /// OBJ: treat the MTL ambient colour Ka as emitted radiance (Embree Cornell-box files).
+    #[arg(long)]
+    pub obj_ka_emission: bool,
+    /// OBJ/glTF camera eye X,Y,Z (overrides the file's camera / automatic framing).
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
+    pub look_from: Option<glam::Vec3>,
+    /// OBJ/glTF camera target X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
+    pub look_at: Option<glam::Vec3>,
+    /// OBJ/glTF camera up vector X,Y,Z (default 0,1,0).
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
+    pub up: Option<glam::Vec3>,
+    /// OBJ/glTF field of view in degrees along the shorter image axis (default 40).
+    #[arg(long)]
+    pub fov: Option<f32>,
+}
+
+/// Parse `X,Y,Z` (finite numbers).
+pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|c| c.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected X,Y,Z (e.g. 0,1,5), got '{s}'"))?;
+    match v[..] {
+        [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => {
+            Ok(glam::Vec3::new(x, y, z))
+        }
+        _ => Err(format!("expected three finite numbers X,Y,Z, got '{s}'")),
+    }
 }
 
 /// Parse `WxH`.
@@ -89,6 +120,13 @@ pub fn load_options(a: &Args) -> LoadOptions {
             light_count: a.light_count,
             rooms: a.rooms,
             triangles: None,
+        },
+        obj_ka_emission: a.obj_ka_emission,
+        view: ViewOptions {
+            look_from: a.look_from,
+            look_at: a.look_at,
+            up: a.up,
+            fov: a.fov,
         },
     }
 }
