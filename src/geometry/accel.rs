@@ -136,6 +136,21 @@ impl Geometry {
         }
     }
 
+    /// The same geometry behind a freshly built BVH of `backend` (benchmarks, backend tests).
+    pub fn rebuild(&self, backend: Backend) -> Self {
+        Self::with_backend(
+            self.prims.clone(),
+            self.meshes.clone(),
+            self.quadrics.clone(),
+            backend,
+        )
+    }
+
+    /// Primitive `id` (the `prim` of a [`SurfaceHit`]); ids depend on the backend's leaf order.
+    pub fn primitive(&self, id: u32) -> Option<&Primitive> {
+        self.prims.get(id as usize)
+    }
+
     /// Which backend was built (`None` for an empty scene).
     pub fn backend(&self) -> Option<Backend> {
         match self.accel {

@@ -6,7 +6,7 @@
 //! reorders its primitive array by [`Bvh::indices`] so that a leaf is a contiguous range.
 //!
 //! Box tests are conservative: the far distance of each slab interval is widened by 2γ(3)
-//! (pbrt-v4's bound), so rounding never culls a box that the exact ray touches — this matters
+//! (pbrt-v4's bound) and the near distance shrunk by as much, so rounding never culls a box that the exact ray touches — this matters
 //! for the zero-thickness boxes of axis-aligned walls.
 
 use super::float::gamma;
@@ -41,7 +41,7 @@ impl Node {
         // SSE: both slabs of all three axes in two subtractions and two multiplications.
         let t0 = (Vec3A::from_array(self.lo) - r.o) * r.inv;
         let t1 = (Vec3A::from_array(self.hi) - r.o) * r.inv;
-        let near = max(t0.min(t1).max_element(), 0.0);
+        let near = max(t0.min(t1).max_element(), 0.0) * NEAR_SLACK;
         let far = t0.max(t1).min_element() * ROUNDING_SLACK;
         if near <= min(far, t_max) {
             near
@@ -63,6 +63,10 @@ fn min(a: f32, b: f32) -> f32 {
 fn max(a: f32, b: f32) -> f32 {
     if a > b { a } else { b }
 }
+
+/// 1 − 2γ(3): the entry distance is shrunk just as conservatively, because closest-hit
+/// traversal culls boxes whose entry lies beyond the best hit (a triangle in a box face).
+const NEAR_SLACK: f32 = 1.0 - 2.0 * gamma(3);
 
 /// 1 + 2γ(3): the widening of the slab test's far distance that keeps it conservative.
 const ROUNDING_SLACK: f32 = 1.0 + 2.0 * gamma(3);
