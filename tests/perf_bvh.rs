@@ -33,7 +33,11 @@ fn rays(bounds: (Vec3, Vec3), n: u32) -> Vec<Ray> {
             let r = (1.0 - z * z).max(0.0).sqrt();
             let phi = std::f32::consts::TAU * c.x;
             let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            let t_max = if i % 3 == 0 { c.y * ext.length() } else { f32::INFINITY };
+            let t_max = if i % 3 == 0 {
+                c.y * ext.length()
+            } else {
+                f32::INFINITY
+            };
             Ray { o, d, t_max }
         })
         .collect()
@@ -48,7 +52,11 @@ fn check_agreement(g: &Geometry, n: u32) {
     for ray in rays(g.bounds(), n) {
         let (a, b) = (own.intersect(&ray), obvhs.intersect(&ray));
         if let Some(a) = &a {
-            assert_eq!(Some(a.t), brute_force_t(&own, &ray), "own BVH t for {ray:?}");
+            assert_eq!(
+                Some(a.t),
+                brute_force_t(&own, &ray),
+                "own BVH t for {ray:?}"
+            );
         } else {
             assert_eq!(brute_force_t(&own, &ray), None, "own BVH missed {ray:?}");
         }
@@ -64,11 +72,17 @@ fn check_agreement(g: &Geometry, n: u32) {
             _ => differ += 1,
         }
         let occ = own.occluded(&ray);
-        assert_eq!(occ, a.is_some(), "any-hit disagrees with closest hit for {ray:?}");
+        assert_eq!(
+            occ,
+            a.is_some(),
+            "any-hit disagrees with closest hit for {ray:?}"
+        );
         differ += (occ != obvhs.occluded(&ray)) as u32;
         blocked += occ as u32;
     }
-    eprintln!("{n} rays: {hits} hits ({ties} ties on equal t), {blocked} blocked, {differ} obvhs differences");
+    eprintln!(
+        "{n} rays: {hits} hits ({ties} ties on equal t), {blocked} blocked, {differ} obvhs differences"
+    );
     assert!(hits > n / 10 && ties < n / 1000 && differ < n / 1000);
 }
 

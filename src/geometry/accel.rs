@@ -113,8 +113,10 @@ impl Geometry {
                     (std::mem::take(&mut bvh.indices), Accel::Own(bvh))
                 }
                 Backend::Obvhs => {
-                    let aabbs: Vec<Aabb> =
-                        boxes.iter().map(|(lo, hi)| Aabb::new((*lo).into(), (*hi).into())).collect();
+                    let aabbs: Vec<Aabb> = boxes
+                        .iter()
+                        .map(|(lo, hi)| Aabb::new((*lo).into(), (*hi).into()))
+                        .collect();
                     let mut t = Duration::ZERO;
                     let bvh = obvhs::cwbvh::builder::build_cwbvh(
                         &aabbs,
@@ -193,11 +195,11 @@ impl Geometry {
         let p = &self.prims[id];
         match p.kind {
             PrimKind::Triangle { mesh, v } => {
-                let (b1, b2) = match intersect_triangle(ray.o, ray.d, f32::INFINITY, p.p0, p.e1, p.e2)
-                {
-                    Some((_, b1, b2)) => (b1, b2),
-                    None => (1.0 / 3.0, 1.0 / 3.0),
-                };
+                let (b1, b2) =
+                    match intersect_triangle(ray.o, ray.d, f32::INFINITY, p.p0, p.e1, p.e2) {
+                        Some((_, b1, b2)) => (b1, b2),
+                        None => (1.0 / 3.0, 1.0 / 3.0),
+                    };
                 let b0 = 1.0 - b1 - b2;
                 let verts = [p.p0, p.p0 + p.e1, p.p0 + p.e2];
                 let pos = verts[0] * b0 + verts[1] * b1 + verts[2] * b2;
@@ -205,8 +207,9 @@ impl Geometry {
                 let mut ng = p.e1.cross(p.e2).normalize_or_zero();
                 let ns = match &m.normals {
                     Some(n) => {
-                        let ns = (n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2)
-                            .normalize_or_zero();
+                        let ns =
+                            (n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2)
+                                .normalize_or_zero();
                         if ns == Vec3::ZERO {
                             ng
                         } else {
@@ -224,7 +227,9 @@ impl Geometry {
                     }
                 };
                 let uv = match &m.uvs {
-                    Some(uv) => uv[v[0] as usize] * b0 + uv[v[1] as usize] * b1 + uv[v[2] as usize] * b2,
+                    Some(uv) => {
+                        uv[v[0] as usize] * b0 + uv[v[1] as usize] * b1 + uv[v[2] as usize] * b2
+                    }
                     // pbrt-v4's default parameterisation (0,0), (1,0), (1,1).
                     None => Vec2::new(b1 + b2, b2),
                 };
@@ -301,8 +306,9 @@ impl RayQuery for Geometry {
             Accel::Own(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
                 self.prim_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
             }),
-            Accel::Obvhs(bvh) => !bvh
-                .ray_traverse_miss(to_obvhs(ray), |r, id| self.prim_t(id, ray.o, ray.d, r.tmax)),
+            Accel::Obvhs(bvh) => {
+                !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| self.prim_t(id, ray.o, ray.d, r.tmax))
+            }
         }
     }
 }

@@ -341,8 +341,11 @@ fn find_split(
     cb: &Aabb,
 ) -> Option<(f32, usize, usize)> {
     let mut best: Option<(f32, usize, usize)> = None;
+    // `axis` indexes vector components and is part of the result, not an iterator position.
+    #[allow(clippy::needless_range_loop)]
     for axis in 0..3 {
-        if !(cb.hi[axis] - cb.lo[axis] > 0.0) {
+        // Boxes are finite, so the extent is never NaN.
+        if cb.hi[axis] - cb.lo[axis] <= 0.0 {
             continue;
         }
         let (lo, scale) = bin_map(cb, axis);

@@ -100,7 +100,11 @@ impl<'a> DirectLighting<'a> {
         }
         let front = ray.d.dot(hit.ng) < 0.0;
         let ng = if front { hit.ng } else { -hit.ng };
-        let ns = if hit.ns.dot(wo) < 0.0 { -hit.ns } else { hit.ns };
+        let ns = if hit.ns.dot(wo) < 0.0 {
+            -hit.ns
+        } else {
+            hit.ns
+        };
         let frame = Frame::from_normal(ns);
         let Some(material) = scene.materials.get(hit.material as usize) else {
             return (l, rays);
@@ -111,7 +115,11 @@ impl<'a> DirectLighting<'a> {
             frame,
             ng,
             ctx: LightSampleContext { p: hit.p, n: ng },
-            sp: ShadingPoint { p: hit.p, n: ng, wo },
+            sp: ShadingPoint {
+                p: hit.p,
+                n: ng,
+                wo,
+            },
             hit,
         };
         let m = self.shadow_rays.max(1);
@@ -144,9 +152,7 @@ impl<'a> DirectLighting<'a> {
         self.scene
             .infinite_lights
             .iter()
-            .map(|&i| {
-                self.scene.lights[i as usize].radiance(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, w)
-            })
+            .map(|&i| self.scene.lights[i as usize].radiance(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, w))
             .sum()
     }
 
@@ -170,7 +176,11 @@ impl<'a> DirectLighting<'a> {
             return Rgb::ZERO;
         }
         *rays += 1;
-        if self.scene.geometry.occluded(&shadow_ray(&sh.hit, ls.p_light)) {
+        if self
+            .scene
+            .geometry
+            .occluded(&shadow_ray(&sh.hit, ls.p_light))
+        {
             return Rgb::ZERO;
         }
         let pdf = sel.pmf * ls.pdf;

@@ -80,7 +80,9 @@ impl FromStr for MisHeuristic {
         match s.trim() {
             "power" => Ok(Self::Power),
             "balance" => Ok(Self::Balance),
-            _ => Err(format!("unknown MIS heuristic '{s}' (expected power or balance)")),
+            _ => Err(format!(
+                "unknown MIS heuristic '{s}' (expected power or balance)"
+            )),
         }
     }
 }

@@ -355,7 +355,9 @@ mod tests {
                         );
                         assert_eq!(
                             px.sample_2d(dim, index, count).to_array().map(f32::to_bits),
-                            pat.sample_2d(pixel, dim, index, count).to_array().map(f32::to_bits),
+                            pat.sample_2d(pixel, dim, index, count)
+                                .to_array()
+                                .map(f32::to_bits),
                             "{kind} dim {dim} index {index}"
                         );
                     }
