@@ -19,11 +19,7 @@ fn scratch(name: &str) -> PathBuf {
 fn test_image() -> Image {
     Image::from_fn(7, 5, |x, y| {
         let t = (y * 7 + x) as f32;
-        Rgb::new(
-            t * 0.37 - 2.0,
-            (t * 0.11).exp() * 1e-3,
-            1.0 / (t + 1.0) * 40.0,
-        )
+        Rgb::new(t * 0.37 - 2.0, (t * 0.11).exp() * 1e-3, 1.0 / (t + 1.0) * 40.0)
     })
 }
 
@@ -34,10 +30,7 @@ fn no_temp_files_left(dir: &Path) {
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .filter(|n| n.contains(".tmp-"))
         .collect();
-    assert!(
-        leftovers.is_empty(),
-        "temp files left behind: {leftovers:?}"
-    );
+    assert!(leftovers.is_empty(), "temp files left behind: {leftovers:?}");
 }
 
 #[test]
@@ -74,10 +67,7 @@ fn pfm_big_endian_and_grey_decode() {
         be.extend_from_slice(&v.to_be_bytes());
     }
     let img = decode_pfm(&be).unwrap();
-    assert_eq!(
-        img.pixels,
-        vec![Rgb::new(1.0, 2.0, 3.0), Rgb::new(4.0, 5.0, 6.0)]
-    );
+    assert_eq!(img.pixels, vec![Rgb::new(1.0, 2.0, 3.0), Rgb::new(4.0, 5.0, 6.0)]);
 
     let mut grey = b"Pf\n1 2\n-1.0\n".to_vec();
     for v in [0.25f32, 0.75] {
@@ -87,14 +77,8 @@ fn pfm_big_endian_and_grey_decode() {
     assert_eq!(img.get(0, 1), Rgb::splat(0.25));
     assert_eq!(img.get(0, 0), Rgb::splat(0.75));
 
-    assert!(
-        decode_pfm(b"PF\n2 2\n-1.0\n\0\0").is_err(),
-        "truncated raster accepted"
-    );
-    assert!(
-        decode_pfm(b"P6\n2 2\n255\n").is_err(),
-        "wrong magic accepted"
-    );
+    assert!(decode_pfm(b"PF\n2 2\n-1.0\n\0\0").is_err(), "truncated raster accepted");
+    assert!(decode_pfm(b"P6\n2 2\n255\n").is_err(), "wrong magic accepted");
 }
 
 #[test]
@@ -155,10 +139,7 @@ fn failed_writes_leave_existing_file_untouched() {
     let bad = dir.join("a.bmp");
     std::fs::write(&bad, b"keep me").unwrap();
     let err = write_image(&img, &bad, 0.0).unwrap_err().to_string();
-    assert!(
-        err.contains("bmp") && err.contains("exr") && err.contains("png"),
-        "{err}"
-    );
+    assert!(err.contains("bmp") && err.contains("exr") && err.contains("png"), "{err}");
     assert_eq!(std::fs::read(&bad).unwrap(), b"keep me");
 
     // Rename onto a directory fails after the temp file was written: the temp must vanish and

@@ -9,8 +9,7 @@ use penumbra::image::metrics::ERROR_IMAGE_LOG10_RANGE;
 use penumbra::image::{Image, compare, error_image, write_image};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("penumbra-image-met-{}-{name}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("penumbra-image-met-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -41,12 +40,7 @@ fn metrics_match_hand_computation() {
     let b = [1.0, 1.0, 1.0, f(0.1), 0.0, 0.0];
     let mse = d.iter().map(|x| x * x).sum::<f64>() / 6.0;
     let mae = d.iter().map(|x: &f64| x.abs()).sum::<f64>() / 6.0;
-    let rel = d
-        .iter()
-        .zip(&b)
-        .map(|(d, b)| d * d / (b * b + 0.01))
-        .sum::<f64>()
-        / 6.0;
+    let rel = d.iter().zip(&b).map(|(d, b)| d * d / (b * b + 0.01)).sum::<f64>() / 6.0;
     assert!((s.mse - mse).abs() < 1e-12, "{s:?}");
     assert!((s.mae - mae).abs() < 1e-12, "{s:?}");
     assert!((s.rel_mse - rel).abs() < 1e-12, "{s:?}");
@@ -106,11 +100,7 @@ fn error_image_is_log_scaled_viridis() {
     let t = Image {
         width: 3,
         height: 1,
-        pixels: vec![
-            Rgb::ONE,
-            Rgb::splat(1.0 + mid.sqrt() as f32),
-            Rgb::splat(100.0),
-        ],
+        pixels: vec![Rgb::ONE, Rgb::splat(1.0 + mid.sqrt() as f32), Rgb::splat(100.0)],
     };
     let e = error_image(&t, &r).unwrap();
     let enc = |p: Rgb| penumbra::image::io::linear_to_srgb(p.x);
@@ -136,11 +126,7 @@ fn compare_cli_prints_metrics_and_fails_on_mismatch() {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout} {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "{stdout} {}", String::from_utf8_lossy(&out.stderr));
     let value = |name: &str| -> f64 {
         let line = stdout
             .lines()

@@ -9,17 +9,14 @@ use penumbra::image::montage::{montage, save_png_atomic};
 use penumbra::image::plot::convergence_plot;
 
 fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("penumbra-image-mon-{}-{name}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("penumbra-image-mon-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
 
 fn gradient(w: u32, h: u32) -> Image {
-    Image::from_fn(w, h, |x, y| {
-        Rgb::new(x as f32 / w as f32, y as f32 / h as f32, 0.25)
-    })
+    Image::from_fn(w, h, |x, y| Rgb::new(x as f32 / w as f32, y as f32 / h as f32, 0.25))
 }
 
 #[test]
@@ -68,19 +65,10 @@ fn embedded_font_measures_text() {
 fn convergence_plot_writes_svg_and_png() {
     let dir = scratch("plot");
     let series: Vec<(String, Vec<(f64, f64)>)> = vec![
-        (
-            "bsdf".into(),
-            (1..=8).map(|k| (k as f64 * 0.1, 1.0 / k as f64)).collect(),
-        ),
-        (
-            "mis".into(),
-            (1..=8).map(|k| (k as f64 * 0.12, 0.1 / k as f64)).collect(),
-        ),
+        ("bsdf".into(), (1..=8).map(|k| (k as f64 * 0.1, 1.0 / k as f64)).collect()),
+        ("mis".into(), (1..=8).map(|k| (k as f64 * 0.12, 0.1 / k as f64)).collect()),
         // Non-positive points cannot be shown on log axes and must be skipped, not crash.
-        (
-            "broken".into(),
-            vec![(0.0, 1.0), (1.0, 0.0), (f64::NAN, 1.0)],
-        ),
+        ("broken".into(), vec![(0.0, 1.0), (1.0, 0.0), (f64::NAN, 1.0)]),
     ];
     let (svg, png) = (dir.join("c.svg"), dir.join("c.png"));
     convergence_plot(&series, "relMSE vs time", &svg, &png).unwrap();

@@ -63,18 +63,10 @@ pub fn parse_res(s: &str) -> Result<UVec2, String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WxH (e.g. 512x512), got '{s}'"))?;
-    let w: u32 = w
-        .trim()
-        .parse()
-        .map_err(|_| format!("bad width in '{s}'"))?;
-    let h: u32 = h
-        .trim()
-        .parse()
-        .map_err(|_| format!("bad height in '{s}'"))?;
+    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
     if w == 0 || h == 0 || w > 65536 || h > 65536 {
-        return Err(format!(
-            "resolution must be between 1 and 65536 per axis, got '{s}'"
-        ));
+        return Err(format!("resolution must be between 1 and 65536 per axis, got '{s}'"));
     }
     Ok(UVec2::new(w, h))
 }

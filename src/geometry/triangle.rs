@@ -32,11 +32,7 @@ pub fn intersect_triangle(
         return None;
     }
     let t = e2.dot(qv) * inv;
-    if t > 0.0 && t < t_max {
-        Some((t, b1, b2))
-    } else {
-        None
-    }
+    if t > 0.0 && t < t_max { Some((t, b1, b2)) } else { None }
 }
 
 /// Conservative absolute error of the barycentric point b0·p0 + b1·p1 + b2·p2 (pbrt-v4's

@@ -85,11 +85,7 @@ pub fn error_image(test: &Image, reference: &Image) -> anyhow::Result<Image> {
             }
             let t = ((e.max(1e-30).log10() - lo) / (hi - lo)) as f32;
             let s = viridis(t);
-            Rgb::new(
-                srgb_to_linear(s.x),
-                srgb_to_linear(s.y),
-                srgb_to_linear(s.z),
-            )
+            Rgb::new(srgb_to_linear(s.x), srgb_to_linear(s.y), srgb_to_linear(s.z))
         })
         .collect();
     Ok(Image {

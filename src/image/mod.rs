@@ -14,6 +14,7 @@ pub mod plot;
 pub use io::{read_image, save_png_atomic, write_image};
 pub use metrics::{ErrorStats, compare, error_image};
 
+
 use crate::Rgb;
 
 /// A linear-RGB float image, row-major, top row first.
@@ -55,10 +56,7 @@ impl Image {
     /// Linear index of (x, y); usize arithmetic so large images cannot overflow u32.
     #[inline]
     fn index(&self, x: u32, y: u32) -> usize {
-        debug_assert!(
-            x < self.width && y < self.height,
-            "pixel ({x}, {y}) out of range"
-        );
+        debug_assert!(x < self.width && y < self.height, "pixel ({x}, {y}) out of range");
         y as usize * self.width as usize + x as usize
     }
 

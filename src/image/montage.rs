@@ -21,12 +21,7 @@ const INK: [u8; 3] = [235, 235, 235];
 /// with `2^exposure` and sRGB, its label (lines separated by `\n`) centred beneath it, and
 /// `title` (if non-empty) above the grid. Cells are sized to the largest panel; smaller panels
 /// are centred in theirs.
-pub fn montage(
-    panels: &[(Image, String)],
-    cols: usize,
-    exposure: f32,
-    title: &str,
-) -> image::RgbImage {
+pub fn montage(panels: &[(Image, String)], cols: usize, exposure: f32, title: &str) -> image::RgbImage {
     let n = panels.len();
     let cols = cols.clamp(1, n.max(1));
     let rows = n.div_ceil(cols);
@@ -38,16 +33,8 @@ pub fn montage(
         .map(|(_, l)| if l.is_empty() { 0 } else { l.lines().count() })
         .max()
         .unwrap_or(0) as u32;
-    let label_h = if max_lines > 0 {
-        max_lines * label_line + PAD / 2
-    } else {
-        0
-    };
-    let title_h = if title.is_empty() {
-        0
-    } else {
-        line_height(TITLE_PX).ceil() as u32 + PAD
-    };
+    let label_h = if max_lines > 0 { max_lines * label_line + PAD / 2 } else { 0 };
+    let title_h = if title.is_empty() { 0 } else { line_height(TITLE_PX).ceil() as u32 + PAD };
 
     // Cells must also be wide enough for their labels, or text would spill into neighbours.
     let widest_label = panels
@@ -58,25 +45,14 @@ pub fn montage(
         .unwrap_or(0);
     let cell_w = cell_w.max(widest_label);
     let grid_w = PAD + cols as u32 * (cell_w + PAD);
-    let title_w = if title.is_empty() {
-        0
-    } else {
-        text_width(title, TITLE_PX).ceil() as u32 + 2 * PAD
-    };
+    let title_w = if title.is_empty() { 0 } else { text_width(title, TITLE_PX).ceil() as u32 + 2 * PAD };
     let width = grid_w.max(title_w).max(1);
     let height = (PAD + title_h + rows as u32 * (cell_h + label_h + PAD)).max(1);
 
     let mut out = image::RgbImage::from_pixel(width, height, image::Rgb(BACKGROUND));
     if !title.is_empty() {
         let x = (width as f32 - text_width(title, TITLE_PX)) / 2.0;
-        draw_text(
-            &mut out,
-            x.max(PAD as f32),
-            PAD as f32,
-            title,
-            TITLE_PX,
-            INK,
-        );
+        draw_text(&mut out, x.max(PAD as f32), PAD as f32, title, TITLE_PX, INK);
     }
     for (k, (img, label)) in panels.iter().enumerate() {
         let (col, row) = ((k % cols) as u32, (k / cols) as u32);

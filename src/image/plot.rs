@@ -46,18 +46,12 @@ fn plottable(points: &[(f64, f64)]) -> impl Iterator<Item = (f64, f64)> + '_ {
 
 /// Log-axis range covering `values` with a little headroom; a fallback when there are none.
 fn log_range(values: impl Iterator<Item = f64>, fallback: (f64, f64)) -> std::ops::Range<f64> {
-    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
-        (lo.min(v), hi.max(v))
-    });
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
     if !lo.is_finite() {
         return fallback.0..fallback.1;
     }
     // A single decade or less looks degenerate on log axes; pad multiplicatively.
-    let (lo, hi) = if hi / lo < 1.5 {
-        (lo / 2.0, hi * 2.0)
-    } else {
-        (lo / 1.2, hi * 1.2)
-    };
+    let (lo, hi) = if hi / lo < 1.5 { (lo / 2.0, hi * 2.0) } else { (lo / 1.2, hi * 1.2) };
     lo..hi
 }
 
@@ -94,9 +88,7 @@ where
         chart
             .draw_series(LineSeries::new(plottable(points), color.stroke_width(2)))?
             .label(name.as_str())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2))
-            });
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2)));
         chart.draw_series(plottable(points).map(|p| Circle::new(p, 3, color.filled())))?;
     }
     if !series.is_empty() {

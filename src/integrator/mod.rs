@@ -80,9 +80,7 @@ impl FromStr for MisHeuristic {
         match s.trim() {
             "power" => Ok(Self::Power),
             "balance" => Ok(Self::Balance),
-            _ => Err(format!(
-                "unknown MIS heuristic '{s}' (expected power or balance)"
-            )),
+            _ => Err(format!("unknown MIS heuristic '{s}' (expected power or balance)")),
         }
     }
 }

@@ -2,11 +2,11 @@
 
 use super::cornell_data::{LIGHT, LIGHT_L, MATERIALS, MESHES, MeshData};
 use super::{BuiltinOptions, Scene};
-use crate::Rgb;
 use crate::camera::Camera;
 use crate::geometry::Transform;
 use crate::material::{Material, Texture};
 use crate::scene::{AreaEmission, FilmSpec, Filter, SceneBuilder, TriangleMesh};
+use crate::Rgb;
 use glam::{Mat4, UVec2, Vec2, Vec3};
 
 /// The pbrt file's `Transform` (column-major, camera-from-world).
@@ -29,26 +29,20 @@ pub fn cornell_camera() -> Camera {
 pub fn cornell_film() -> FilmSpec {
     FilmSpec {
         resolution: UVec2::new(512, 512),
-        filter: Filter::Triangle { radius: Vec2::ONE },
+        filter: Filter::Triangle {
+            radius: Vec2::ONE,
+        },
         filename: None,
         spp: Some(64),
     }
 }
 
 fn mesh(d: &MeshData) -> TriangleMesh {
-    let v3 = |a: &[f32]| {
-        a.chunks_exact(3)
-            .map(|c| Vec3::new(c[0], c[1], c[2]))
-            .collect()
-    };
+    let v3 = |a: &[f32]| a.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
     TriangleMesh {
         positions: v3(d.p),
         normals: Some(v3(d.n)),
-        uvs: Some(
-            d.uv.chunks_exact(2)
-                .map(|c| Vec2::new(c[0], c[1]))
-                .collect(),
-        ),
+        uvs: Some(d.uv.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect()),
         indices: d.indices.to_vec(),
         flip_normals: false,
     }
@@ -73,11 +67,7 @@ pub fn add_cornell_box(b: &mut SceneBuilder) -> anyhow::Result<Vec<(&'static str
         l: Rgb::from_array(LIGHT_L),
         two_sided: false,
     };
-    b.add_mesh(
-        mesh(&LIGHT),
-        id(LIGHT.material).unwrap_or(0),
-        Some(emission),
-    )?;
+    b.add_mesh(mesh(&LIGHT), id(LIGHT.material).unwrap_or(0), Some(emission))?;
     Ok(ids)
 }
 
