@@ -92,12 +92,13 @@ pub fn render(
             for y in y0..y1 {
                 for x in x0..x1 {
                     let pixel = UVec2::new(x, y);
+                    let px = pattern.pixel(pixel);
                     let mut sum = Rgb::ZERO;
                     for i in 0..opts.spp {
-                        let u = pattern.sample_2d(pixel, DIM_FILTER, i, opts.spp);
+                        let u = px.sample_2d(DIM_FILTER, i, opts.spp);
                         let p = filter_sample(&scene.film.filter, pixel, u);
                         let ray = scene.camera.generate_ray(p, res);
-                        let (l, r) = est.li(pixel, i, &ray);
+                        let (l, r) = est.li(&px, i, &ray);
                         tile_rays += r;
                         if l.is_finite() {
                             sum += l;
