@@ -90,8 +90,8 @@ fn check_agreement(g: &Geometry, n: u32) {
 fn brute_force_t(g: &Geometry, ray: &Ray) -> Option<f32> {
     (0..g.len() as u32)
         .filter_map(|id| g.primitive(id))
-        .filter_map(|p| intersect_triangle(ray.o, ray.d, ray.t_max, p.p0, p.e1, p.e2))
-        .map(|(t, _, _)| t)
+        .filter_map(|p| intersect_triangle(ray.o, ray.d, ray.t_max, p.p))
+        .map(|(t, ..)| t)
         .min_by(f32::total_cmp)
 }
 
@@ -115,9 +115,7 @@ fn backends_agree_on_a_triangle_soup() {
             let p0 = p(0);
             let (p1, p2) = (p0 + (p(2) - p0) * 0.2, p0 + (p(4) - p0) * 0.2);
             Primitive {
-                p0,
-                e1: p1 - p0,
-                e2: p2 - p0,
+                p: [p0, p1, p2],
                 kind: PrimKind::Triangle {
                     mesh: 0,
                     v: [i, i, i],

@@ -48,6 +48,9 @@ pub struct Args {
     /// Light selection strategy.
     #[arg(long, default_value = "uniform")]
     pub light_selection: String,
+    /// Light sampling technique inside `mis`: solid-angle (default) or area.
+    #[arg(long, default_value = "solid-angle", value_parser = parse_mode)]
+    pub mis_light: penumbra::lights::SamplingMode,
     /// How BSDF lobes are sampled: importance (cosine-power / GGX), cosine or uniform.
     #[arg(long, default_value = "importance")]
     pub bsdf_sampling: penumbra::bsdf::LobeSampling,
@@ -89,6 +92,15 @@ pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
             Ok(glam::Vec3::new(x, y, z))
         }
         _ => Err(format!("expected three finite numbers X,Y,Z, got '{s}'")),
+    }
+}
+
+/// Parse a light sampling mode name.
+pub fn parse_mode(s: &str) -> Result<penumbra::lights::SamplingMode, String> {
+    match s {
+        "area" => Ok(penumbra::lights::SamplingMode::Area),
+        "solid-angle" => Ok(penumbra::lights::SamplingMode::SolidAngle),
+        _ => Err(format!("expected area or solid-angle, got '{s}'")),
     }
 }
 
@@ -150,6 +162,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         pattern: args.pattern,
         light_selection: args.light_selection.clone(),
         bsdf_sampling: args.bsdf_sampling,
+        mis_light: args.mis_light,
         progress: !args.quiet,
     };
     anyhow::ensure!(opts.spp >= 1, "--spp must be at least 1");

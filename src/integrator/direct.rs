@@ -49,6 +49,8 @@ pub struct DirectLighting<'a> {
     pub shadow_rays: u32,
     /// How BSDF lobes are sampled.
     pub bsdf_sampling: LobeSampling,
+    /// Light sampling technique of `mis`.
+    pub mis_light: SamplingMode,
 }
 
 /// Where the samples of one eye ray come from.
@@ -75,6 +77,7 @@ impl<'a> DirectLighting<'a> {
     fn mode(&self) -> SamplingMode {
         match self.strategy {
             Strategy::LightArea => SamplingMode::Area,
+            Strategy::Mis => self.mis_light,
             _ => SamplingMode::SolidAngle,
         }
     }

@@ -61,6 +61,7 @@ pub fn render(
         eye_rays: opts.spp,
         shadow_rays: opts.shadow_rays.max(1),
         bsdf_sampling: opts.bsdf_sampling,
+        mis_light: opts.mis_light,
     };
     let tiles_x = res.x.div_ceil(TILE);
     let tiles_y = res.y.div_ceil(TILE);
