@@ -17,18 +17,19 @@ use penumbra::sampling::chi2::Chi2Config;
 use std::sync::Arc;
 
 /// Number of chi-square tests in this file (for the Šidák correction); keep in sync.
-const NUM_TESTS: usize = 30;
+const NUM_TESTS: usize = 23;
 
 fn cfg() -> Chi2Config {
     Chi2Config {
-        samples: 400_000,
-        res: (48, 96),
+        samples: 300_000,
+        res: (32, 64),
         num_tests: NUM_TESTS,
         ..Default::default()
     }
 }
 
 const MODES: [SamplingMode; 2] = [SamplingMode::Area, SamplingMode::SolidAngle];
+const SA: [SamplingMode; 1] = [SamplingMode::SolidAngle];
 
 fn tri_vertices() -> [Vec3; 3] {
     [
@@ -43,7 +44,16 @@ fn chi2_triangle(name: &str, p: Vec3, two_sided: bool, modes: &[SamplingMode]) {
     let light = Light::Triangle(TriangleLight::new(v, Vec3::Z, Vec3::ONE, two_sided).unwrap());
     let centre = (v[0] + v[1] + v[2]) / 3.0;
     for &mode in modes {
-        chi2_light(name, &cfg(), &light, p, mode, |p, d| hit_triangle(p, d, v), centre, &v);
+        chi2_light(
+            name,
+            &cfg(),
+            &light,
+            p,
+            mode,
+            |p, d| hit_triangle(p, d, v),
+            centre,
+            &v,
+        );
     }
 }
 
@@ -54,13 +64,13 @@ fn chi2_triangle_light() {
     chi2_triangle("triangle far", Vec3::new(0.2, 0.1, 3.0), false, &MODES);
     chi2_triangle("triangle near", Vec3::new(0.1, 0.0, 0.05), false, &MODES);
     chi2_triangle("triangle grazing", Vec3::new(2.0, 0.5, 0.05), false, &MODES);
-    chi2_triangle("triangle tiny", Vec3::new(3.0, 2.0, 60.0), false, &MODES);
+    chi2_triangle("triangle tiny", Vec3::new(3.0, 2.0, 60.0), false, &SA);
     // Two-sided, seen from below.
     chi2_triangle(
         "triangle two-sided below",
         Vec3::new(0.3, -0.2, -0.4),
         true,
-        &[SamplingMode::SolidAngle],
+        &SA,
     );
 }
 
@@ -70,7 +80,16 @@ fn chi2_quad(name: &str, p: Vec3, e2: Vec3, modes: &[SamplingMode]) {
     let outline = [c, c + e1, c + e2, c + e1 + e2];
     let centre = c + 0.5 * (e1 + e2);
     for &mode in modes {
-        chi2_light(name, &cfg(), &light, p, mode, |p, d| hit_quad(p, d, c, e1, e2), centre, &outline);
+        chi2_light(
+            name,
+            &cfg(),
+            &light,
+            p,
+            mode,
+            |p, d| hit_quad(p, d, c, e1, e2),
+            centre,
+            &outline,
+        );
     }
 }
 
@@ -79,13 +98,13 @@ fn chi2_quad_light() {
     let e2 = Vec3::new(0.0, 0.7, 0.0);
     chi2_quad("quad far", Vec3::new(0.3, 0.2, -2.0), e2, &MODES);
     chi2_quad("quad near", Vec3::new(0.1, 0.2, 0.95), e2, &MODES);
-    chi2_quad("quad grazing", Vec3::new(2.5, 0.2, 0.9), e2, &MODES);
+    chi2_quad("quad grazing", Vec3::new(2.5, 0.2, 0.9), e2, &SA);
     // A skewed parallelogram: solid-angle mode must fall back to area sampling consistently.
     chi2_quad(
         "parallelogram",
         Vec3::new(0.1, 0.2, 0.3),
         Vec3::new(0.4, 0.7, 0.0),
-        &[SamplingMode::SolidAngle],
+        &SA,
     );
 }
 
@@ -109,20 +128,33 @@ fn chi2_sphere(name: &str, p: Vec3, inward: bool, modes: &[SamplingMode]) {
     };
     for &mode in modes {
         // pdf_li recomputes the hit point from wi, so any point will do.
-        chi2_light(name, &cfg(), &light, p, mode, |p, d| Some(p + d), c, &outline);
+        chi2_light(
+            name,
+            &cfg(),
+            &light,
+            p,
+            mode,
+            |p, d| Some(p + d),
+            c,
+            &outline,
+        );
     }
 }
 
 #[test]
 fn chi2_sphere_light() {
-    chi2_sphere("sphere far", Vec3::new(4.0, 3.0, 1.0), false, &MODES);
+    chi2_sphere("sphere far", Vec3::new(4.0, 3.0, 1.0), false, &SA);
     chi2_sphere("sphere mid", Vec3::ZERO, false, &MODES);
     chi2_sphere("sphere near", Vec3::new(0.3, 0.0, 1.3), false, &MODES);
-    chi2_sphere("sphere inward, inside", Vec3::new(0.1, 0.2, 2.1), true, &[SamplingMode::SolidAngle]);
+    chi2_sphere("sphere inward, inside", Vec3::new(0.1, 0.2, 2.1), true, &SA);
 }
 
 fn chi2_disk(name: &str, p: Vec3, modes: &[SamplingMode]) {
-    let (c, n, r) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.2, 0.0, -1.0).normalize(), 0.6);
+    let (c, n, r) = (
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(0.2, 0.0, -1.0).normalize(),
+        0.6,
+    );
     let light = Light::Disk(DiskLight::new(c, n, r, Vec3::ONE, false).unwrap());
     let f = penumbra::sampling::Frame::from_normal(n);
     let outline: Vec<Vec3> = (0..32)
@@ -132,15 +164,32 @@ fn chi2_disk(name: &str, p: Vec3, modes: &[SamplingMode]) {
         })
         .collect();
     for &mode in modes {
-        chi2_light(name, &cfg(), &light, p, mode, |p, d| hit_disk(p, d, c, n, r), c, &outline);
+        chi2_light(
+            name,
+            &cfg(),
+            &light,
+            p,
+            mode,
+            |p, d| hit_disk(p, d, c, n, r),
+            c,
+            &outline,
+        );
     }
 }
 
 #[test]
 fn chi2_disk_light() {
-    chi2_disk("disk on axis", Vec3::new(0.0, 0.0, -0.5), &MODES);
+    chi2_disk(
+        "disk on axis",
+        Vec3::new(0.0, 0.0, -0.5),
+        &[SamplingMode::Area],
+    );
     chi2_disk("disk near", Vec3::new(0.1, 0.1, 0.9), &[SamplingMode::Area]);
-    chi2_disk("disk grazing", Vec3::new(2.0, 0.3, 1.3), &[SamplingMode::Area]);
+    chi2_disk(
+        "disk grazing",
+        Vec3::new(2.0, 0.3, 1.3),
+        &[SamplingMode::Area],
+    );
 }
 
 /// A 16×8 map with a gradient, a bright spot, a black band and a black pixel.
@@ -170,9 +219,24 @@ pub fn test_image() -> ImageRgb {
 fn chi2_envmap_light() {
     let rot = Mat4::from_rotation_z(0.7) * Mat4::from_rotation_x(0.5);
     let light = Light::EnvMap(Box::new(
-        EnvMapLight::new(Arc::new(test_image()), Vec3::ONE, Transform::new(rot).unwrap()).unwrap(),
+        EnvMapLight::new(
+            Arc::new(test_image()),
+            Vec3::ONE,
+            Transform::new(rot).unwrap(),
+        )
+        .unwrap(),
     ));
-    for &mode in &MODES {
-        chi2_light("envmap", &cfg(), &light, Vec3::ZERO, mode, |p, d| Some(p + d), Vec3::Z, &[-Vec3::Z]);
+    // Infinite lights ignore the mode.
+    for &mode in &SA {
+        chi2_light(
+            "envmap",
+            &cfg(),
+            &light,
+            Vec3::ZERO,
+            mode,
+            |p, d| Some(p + d),
+            Vec3::Z,
+            &[-Vec3::Z],
+        );
     }
 }

@@ -86,7 +86,11 @@ pub fn chi2_light(
         let s = light.sample_li(&ctx, v2(u), mode)?;
         // The shadow-ray target must lie along the sampled direction.
         let to = (s.p_light - p).normalize();
-        assert!(to.dot(s.wi) > 0.9999, "{name}: p_light off wi: {to} vs {}", s.wi);
+        assert!(
+            to.dot(s.wi) > 0.9999,
+            "{name}: p_light off wi: {to} vs {}",
+            s.wi
+        );
         assert!(s.pdf > 0.0 && s.pdf.is_finite(), "{name}: pdf {}", s.pdf);
         Some(s.wi)
     };
@@ -95,6 +99,7 @@ pub fn chi2_light(
         let l = frame.to_local(v - p);
         l.z > 0.5 * l.length()
     });
+    let t0 = std::time::Instant::now();
     let r = if small {
         let mut b = [f32::MAX, f32::MIN, f32::MAX, f32::MIN];
         for &v in outline {
@@ -106,7 +111,7 @@ pub fn chi2_light(
         let domain = [b[0] - m, b[1] + m, b[2] - m, b[3] + m];
         chi2_points(
             &Chi2Config {
-                res: (64, 64),
+                res: (32, 32),
                 ..cfg.clone()
             },
             domain,
@@ -117,13 +122,16 @@ pub fn chi2_light(
             |q| {
                 let q = q.as_dvec2();
                 let d = frame.to_world(Vec3::new(q.x as f32, q.y as f32, 1.0));
-                pdf(d) * (1.0 + q.length_squared()).powf(-1.5)
+                let s = 1.0 + q.length_squared();
+                pdf(d) / (s * s.sqrt())
             },
         )
     } else {
         chi2_directions(cfg, sample, pdf)
     };
-    check(&format!("{name} [{mode:?}{}]", if small { ", zoomed" } else { "" }), &r);
+    let label = format!("{name} [{mode:?}{}]", if small { ", zoomed" } else { "" });
+    eprintln!("{label}: {:.2} s", t0.elapsed().as_secs_f64());
+    check(&label, &r);
 }
 
 /// Monte Carlo estimate of irradiance E = ∫ Li cos θ dω at (p, n) from `n_samples` light
