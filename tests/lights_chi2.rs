@@ -6,14 +6,18 @@
 
 mod lights_support;
 
-use glam::{Mat4, Vec3};
-use lights_support::{chi2_light, hit_disk, hit_quad, hit_triangle};
+use glam::{Mat4, Vec2, Vec3};
+use lights_support::{check, chi2_light, hit_disk, hit_quad, hit_triangle, v2};
 use penumbra::geometry::Transform;
 use penumbra::lights::{
-    DiskLight, EnvMapLight, Light, QuadLight, SamplingMode, SphereLight, TriangleLight,
+    DiskLight, EnvMapLight, Light, LightSampleContext, LightSource, QuadLight, SamplingMode,
+    SphereLight, TriangleLight,
 };
 use penumbra::material::texture::ImageRgb;
+use penumbra::sampling::Frame;
 use penumbra::sampling::chi2::Chi2Config;
+use penumbra::sampling::chi2::{chi2_directions, chi2_points};
+use std::f64::consts::PI;
 use std::sync::Arc;
 
 /// Number of chi-square tests in this file (for the Šidák correction); keep in sync.
@@ -21,8 +25,8 @@ const NUM_TESTS: usize = 23;
 
 fn cfg() -> Chi2Config {
     Chi2Config {
-        samples: 300_000,
-        res: (32, 64),
+        samples: 200_000,
+        res: (24, 48),
         num_tests: NUM_TESTS,
         ..Default::default()
     }
@@ -96,8 +100,9 @@ fn chi2_quad(name: &str, p: Vec3, e2: Vec3, modes: &[SamplingMode]) {
 #[test]
 fn chi2_quad_light() {
     let e2 = Vec3::new(0.0, 0.7, 0.0);
-    chi2_quad("quad far", Vec3::new(0.3, 0.2, -2.0), e2, &MODES);
-    chi2_quad("quad near", Vec3::new(0.1, 0.2, 0.95), e2, &MODES);
+    // Area sampling of quads is covered by the parallelogram (which always falls back to it).
+    chi2_quad("quad far", Vec3::new(0.3, 0.2, -2.0), e2, &SA);
+    chi2_quad("quad near", Vec3::new(0.1, 0.2, 0.95), e2, &SA);
     chi2_quad("quad grazing", Vec3::new(2.5, 0.2, 0.9), e2, &SA);
     // A skewed parallelogram: solid-angle mode must fall back to area sampling consistently.
     chi2_quad(
@@ -111,22 +116,50 @@ fn chi2_quad_light() {
 fn chi2_sphere(name: &str, p: Vec3, inward: bool, modes: &[SamplingMode]) {
     let (c, r) = (Vec3::new(0.0, 0.0, 2.0), 0.5);
     let light = Light::Sphere(SphereLight::new(c, r, Vec3::ONE, inward).unwrap());
-    // Silhouette circle seen from p (for the zoomed plot); empty from inside.
     let to_c = c - p;
     let d = to_c.length();
-    let outline: Vec<Vec3> = if d > r {
-        let f = penumbra::sampling::Frame::from_normal(to_c / d);
-        let (sa, ca) = (r / d, (1.0 - (r / d) * (r / d)).sqrt());
-        (0..32)
-            .map(|k| {
-                let phi = k as f32 * std::f32::consts::TAU / 32.0;
-                p + f.to_world(Vec3::new(sa * phi.cos(), sa * phi.sin(), ca))
-            })
-            .collect()
-    } else {
-        vec![p - to_c]
-    };
     for &mode in modes {
+        if mode == SamplingMode::Area && d > r {
+            // Area sampling from outside: the solid-angle pdf r²/cos has an integrable
+            // singularity at the silhouette that quadrature cannot resolve, so test the sampled
+            // points on the sphere instead: uniform by area (1/4π over outward normals) on the
+            // visible cap n·(p − c) > r, and nothing on the hidden side.
+            let ctx = LightSampleContext { p, n: Vec3::ZERO };
+            let bad = std::cell::Cell::new(0usize);
+            let r2 = chi2_directions(
+                &cfg(),
+                |u| {
+                    let s = light.sample_li(&ctx, v2(u), mode)?;
+                    let q = light.pdf_li(&ctx, s.wi, s.p_light, Vec3::ZERO, mode);
+                    // f32 rounding grows near the silhouette (cos → 0): count, do not assert.
+                    if (q - s.pdf).abs() > 1e-2 * s.pdf {
+                        bad.set(bad.get() + 1);
+                    }
+                    Some((s.p_light - c).normalize())
+                },
+                |n| if n.dot(p - c) > r { 0.25 / PI } else { 0.0 },
+            );
+            check(&format!("{name} [Area, points]"), &r2);
+            assert!(
+                bad.get() <= cfg().samples / 1000,
+                "{name}: {} pdf mismatches",
+                bad.get()
+            );
+            continue;
+        }
+        // Silhouette circle seen from p (for the zoomed plot); a far point from inside.
+        let outline: Vec<Vec3> = if d > r {
+            let f = Frame::from_normal(to_c / d);
+            let (sa, ca) = (r / d, (1.0 - (r / d) * (r / d)).sqrt());
+            (0..32)
+                .map(|k| {
+                    let phi = k as f32 * std::f32::consts::TAU / 32.0;
+                    p + f.to_world(Vec3::new(sa * phi.cos(), sa * phi.sin(), ca))
+                })
+                .collect()
+        } else {
+            vec![p - to_c]
+        };
         // pdf_li recomputes the hit point from wi, so any point will do.
         chi2_light(
             name,
@@ -156,7 +189,7 @@ fn chi2_disk(name: &str, p: Vec3, modes: &[SamplingMode]) {
         0.6,
     );
     let light = Light::Disk(DiskLight::new(c, n, r, Vec3::ONE, false).unwrap());
-    let f = penumbra::sampling::Frame::from_normal(n);
+    let f = Frame::from_normal(n);
     let outline: Vec<Vec3> = (0..32)
         .map(|k| {
             let phi = k as f32 * std::f32::consts::TAU / 32.0;
@@ -215,28 +248,57 @@ pub fn test_image() -> ImageRgb {
     }
 }
 
+/// The environment map is tested in its own (u, v) chart, which the test computes from the
+/// sampled world direction independently of the light: there the pdf is
+/// pdf_ω · 2π² sin θ and piecewise constant across pixels, and a grid aligned with the pixels
+/// keeps the quadrature exact and cheap.
 #[test]
 fn chi2_envmap_light() {
     let rot = Mat4::from_rotation_z(0.7) * Mat4::from_rotation_x(0.5);
+    let img = test_image();
+    let (w, h) = (img.width as usize, img.height as usize);
     let light = Light::EnvMap(Box::new(
-        EnvMapLight::new(
-            Arc::new(test_image()),
-            Vec3::ONE,
-            Transform::new(rot).unwrap(),
-        )
-        .unwrap(),
+        EnvMapLight::new(Arc::new(img), Vec3::ONE, Transform::new(rot).unwrap()).unwrap(),
     ));
-    // Infinite lights ignore the mode.
-    for &mode in &SA {
-        chi2_light(
-            "envmap",
-            &cfg(),
-            &light,
-            Vec3::ZERO,
-            mode,
-            |p, d| Some(p + d),
-            Vec3::Z,
-            &[-Vec3::Z],
-        );
-    }
+    let inv = rot.inverse();
+    let to_uv = |wd: Vec3| {
+        let d = inv.transform_vector3(wd).normalize();
+        let phi = d.y.atan2(d.x).rem_euclid(std::f32::consts::TAU);
+        let theta = d.z.clamp(-1.0, 1.0).acos();
+        Vec2::new(phi / std::f32::consts::TAU, theta / std::f32::consts::PI)
+    };
+    let ctx = LightSampleContext {
+        p: Vec3::ZERO,
+        n: Vec3::ZERO,
+    };
+    let bad = std::cell::Cell::new(0usize);
+    let r = chi2_points(
+        &Chi2Config {
+            res: (4 * w, 4 * h),
+            ..cfg()
+        },
+        [0.0, 1.0, 0.0, 1.0],
+        |u| {
+            let s = light.sample_li(&ctx, v2(u), SamplingMode::SolidAngle)?;
+            let q = light.pdf_li(&ctx, s.wi, s.p_light, Vec3::ZERO, SamplingMode::SolidAngle);
+            // sin θ is recomputed from the direction: allow f32 rounding near the poles.
+            if (q - s.pdf).abs() > 1e-2 * s.pdf {
+                bad.set(bad.get() + 1);
+            }
+            Some(to_uv(s.wi))
+        },
+        |uv| {
+            let (sp, cp) = (uv.x * std::f32::consts::TAU).sin_cos();
+            let (st, ct) = (uv.y * std::f32::consts::PI).sin_cos();
+            let wd = rot.transform_vector3(Vec3::new(st * cp, st * sp, ct));
+            let pdf = light.pdf_li(&ctx, wd, Vec3::ZERO, Vec3::ZERO, SamplingMode::SolidAngle);
+            pdf as f64 * 2.0 * PI * PI * st as f64
+        },
+    );
+    check("envmap (u, v)", &r);
+    assert!(
+        bad.get() <= cfg().samples / 1000,
+        "envmap: {} pdf mismatches",
+        bad.get()
+    );
 }

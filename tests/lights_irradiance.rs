@@ -99,7 +99,7 @@ fn irradiance_quad() {
 
 #[test]
 fn irradiance_sphere() {
-    let (c, r, l) = (Vec3::new(0.0, 0.0, 2.0), 0.5f32, 3.0);
+    let (c, r, l) = (Vec3::new(0.0, 0.0, 2.0), 0.5f32, 3.0f32);
     let light = Light::Sphere(SphereLight::new(c, r, Vec3::splat(l), false).unwrap());
     for (name, p, tilt) in [
         ("far", Vec3::new(3.0, 4.0, -6.0), 0.0f32),
@@ -114,7 +114,7 @@ fn irradiance_sphere() {
         let side = axis.cross(Vec3::X).normalize();
         let n = (axis * tilt.cos() + side * tilt.sin()).normalize();
         let sin2 = (r as f64 / d as f64).powi(2);
-        let exact = PI * l * sin2 * (tilt as f64).cos();
+        let exact = PI * l as f64 * sin2 * (tilt as f64).cos();
         for mode in MODES {
             let est = irradiance(&light, p, n, mode, N, 3);
             check_estimate(&format!("sphere {name} {mode:?}"), est, exact);
@@ -128,7 +128,7 @@ fn irradiance_sphere() {
     );
     for mode in MODES {
         let est = irradiance(&inward, p, n, mode, N, 4);
-        check_estimate(&format!("sphere inward {mode:?}"), est, PI * l);
+        check_estimate(&format!("sphere inward {mode:?}"), est, PI * l as f64);
     }
 }
 

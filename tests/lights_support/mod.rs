@@ -82,6 +82,9 @@ pub fn chi2_light(
             None => 0.0,
         }
     };
+    // Samples whose returned pdf disagrees with pdf_li (allowed only for the odd sample that
+    // rounds onto the far side of a support edge).
+    let mismatches = std::cell::Cell::new(0usize);
     let sample = |u: [f32; 3]| {
         let s = light.sample_li(&ctx, v2(u), mode)?;
         // The shadow-ray target must lie along the sampled direction.
@@ -92,6 +95,10 @@ pub fn chi2_light(
             s.wi
         );
         assert!(s.pdf > 0.0 && s.pdf.is_finite(), "{name}: pdf {}", s.pdf);
+        let q = pdf(s.wi);
+        if (q - s.pdf as f64).abs() > 1e-2 * s.pdf as f64 {
+            mismatches.set(mismatches.get() + 1);
+        }
         Some(s.wi)
     };
     let frame = Frame::from_normal((centre - p).normalize());
@@ -129,6 +136,11 @@ pub fn chi2_light(
     } else {
         chi2_directions(cfg, sample, pdf)
     };
+    let bad = mismatches.get();
+    assert!(
+        bad <= 5 + cfg.samples / 1000,
+        "{name} [{mode:?}]: {bad} samples whose pdf differs from pdf_li"
+    );
     let label = format!("{name} [{mode:?}{}]", if small { ", zoomed" } else { "" });
     eprintln!("{label}: {:.2} s", t0.elapsed().as_secs_f64());
     check(&label, &r);
