@@ -21,7 +21,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 /// Number of chi-square tests in this file (for the Šidák correction); keep in sync.
-const NUM_TESTS: usize = 23;
+const NUM_TESTS: usize = 22;
 
 fn cfg() -> Chi2Config {
     Chi2Config {
