@@ -235,6 +235,13 @@ impl LightSource for Light {
     }
 }
 
+/// `x > 0`, false for NaN: guards written as `!is_positive(x)` reject NaN along with
+/// non-positive values (a plain `x <= 0.0` would let NaN through).
+#[inline]
+pub(crate) fn is_positive(x: f32) -> bool {
+    x > 0.0
+}
+
 /// Endpoint of a shadow ray toward a light at infinity: twice the scene radius along `wi`,
 /// safely outside the scene's bounding sphere from any point inside it.
 #[inline]

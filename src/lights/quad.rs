@@ -4,7 +4,7 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
-    spherical_ok,
+    is_positive, spherical_ok,
 };
 use crate::sampling::SphericalRectangle;
 use crate::{Rgb, luminance};
@@ -44,7 +44,7 @@ impl QuadLight {
         }
         let c = e1.cross(e2);
         let area = c.length();
-        if !(area > 0.0) || !area.is_finite() {
+        if !is_positive(area) || !area.is_finite() {
             return None;
         }
         // The true geometric normal, turned to the side the caller says emits: cosines and the
@@ -110,13 +110,13 @@ impl LightSource for QuadLight {
         };
         let d = p_light - ctx.p;
         let dist = d.length();
-        if !(dist > 0.0) {
+        if !is_positive(dist) {
             return None;
         }
         let wi = d / dist;
         let pdf =
             pdf_sa.unwrap_or_else(|| area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n));
-        if !(pdf > 0.0) || !pdf.is_finite() {
+        if !is_positive(pdf) || !pdf.is_finite() {
             return None;
         }
         Some(LightLiSample {

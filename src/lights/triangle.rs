@@ -3,7 +3,7 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
-    spherical_ok,
+    is_positive, spherical_ok,
 };
 use crate::sampling::{SphericalTriangle, uniform_triangle_point};
 use crate::{Rgb, luminance};
@@ -29,7 +29,7 @@ impl TriangleLight {
     /// A light on triangle (p0, p1, p2) with emitting normal `n`; `None` if the area is zero.
     pub fn new(p: [Vec3; 3], n: Vec3, l: Rgb, two_sided: bool) -> Option<Self> {
         let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
-        if !(area > 0.0) || !area.is_finite() {
+        if !is_positive(area) || !area.is_finite() {
             return None;
         }
         Some(Self {
@@ -81,7 +81,7 @@ impl LightSource for TriangleLight {
             // Where the sampled direction meets the triangle's plane (the shadow-ray target).
             let denom = self.n.dot(wi);
             let t = self.n.dot(self.p[0] - ctx.p) / denom;
-            if !(t > 0.0) || !t.is_finite() {
+            if !is_positive(t) || !t.is_finite() {
                 return None;
             }
             return Some(LightLiSample {
@@ -100,7 +100,7 @@ impl LightSource for TriangleLight {
         }
         let wi = d / dist;
         let pdf = area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n);
-        if !(pdf > 0.0) || !pdf.is_finite() {
+        if !is_positive(pdf) || !pdf.is_finite() {
             return None;
         }
         Some(LightLiSample {

@@ -50,7 +50,7 @@ pub fn hit_quad(p: Vec3, d: Vec3, corner: Vec3, e1: Vec3, e2: Vec3) -> Option<Ve
 pub fn hit_disk(p: Vec3, d: Vec3, c: Vec3, n: Vec3, r: f32) -> Option<Vec3> {
     let (o, d, c, n) = (p.as_dvec3(), d.as_dvec3(), c.as_dvec3(), n.as_dvec3());
     let t = n.dot(c - o) / n.dot(d);
-    if !(t > 0.0) || !t.is_finite() {
+    if t.is_nan() || t <= 0.0 || !t.is_finite() {
         return None;
     }
     let h: DVec3 = o + d * t;
