@@ -41,7 +41,7 @@ impl RenderStats {
 pub fn render(scene: &Scene, res: UVec2, opts: &RenderOptions) -> anyhow::Result<(Image, RenderStats)> {
     anyhow::ensure!(res.x > 0 && res.y > 0, "resolution must be positive, got {}x{}", res.x, res.y);
     anyhow::ensure!(opts.spp > 0, "--spp must be at least 1");
-    let selector = make_selector(&opts.light_selection, scene)?;
+    let selector = make_selector(&opts.light_selection, scene, opts.seed)?;
     let pattern = make_pattern(opts.pattern, opts.seed);
     let est = DirectLighting {
         scene,
