@@ -2,6 +2,10 @@
 
 mod cornell;
 mod cornell_data;
+mod many_mesh;
+mod many_open;
+mod many_rooms;
+mod many_util;
 
 use super::Scene;
 
@@ -27,11 +31,28 @@ pub struct Builtin {
 }
 
 /// Every built-in scene, default first.
-pub const BUILTINS: &[Builtin] = &[Builtin {
-    name: "cornell",
-    description: "Cornell box of ../shared/scenes/cornell-box-bitterli/scene-v4.pbrt (default), 512x512",
-    build: cornell::cornell,
-}];
+pub const BUILTINS: &[Builtin] = &[
+    Builtin {
+        name: "cornell",
+        description: "Cornell box of ../shared/scenes/cornell-box-bitterli/scene-v4.pbrt (default), 512x512",
+        build: cornell::cornell,
+    },
+    Builtin {
+        name: "many-open",
+        description: "10k small area lights over an open floor with occluders (--light-count up to 1M)",
+        build: many_open::many_open,
+    },
+    Builtin {
+        name: "many-rooms",
+        description: "8x8 rooms with doorways, 4 ceiling lights each (--rooms, --light-count)",
+        build: many_rooms::many_rooms,
+    },
+    Builtin {
+        name: "many-mesh",
+        description: "emissive torus of 8192 triangle lights plus strip lights (--light-count)",
+        build: many_mesh::many_mesh,
+    },
+];
 
 /// The built-in scene called `name`, if there is one.
 pub fn find(name: &str) -> Option<&'static Builtin> {
