@@ -60,7 +60,7 @@ pub fn many_open(opts: &BuiltinOptions) -> anyhow::Result<Scene> {
             uniform(&mut rng, -half, half),
         );
         let size = uniform(&mut rng, 0.1, 0.4);
-        let phi = log_uniform(&mut rng, 0.1, 100.0);
+        let phi = log_uniform(&mut rng, 0.02, 20.0);
         let c = random_colour(&mut rng);
         // X × Z = −Y: both kinds face the floor.
         let (ex, ez) = (Vec3::X * size, Vec3::Z * size);
