@@ -139,21 +139,36 @@ fn unknown_selector_is_an_error() {
     assert!(err.to_string().contains("bvh"), "{err}");
 }
 
+/// The pmf sums to 1 over all lights — except for the light BVH, which (like pbrt-v4's) can
+/// reach a node whose children both have zero importance although the node itself did not;
+/// `sample` then returns `None`, so its pmf sums to P(sample is `Some`) ≤ 1. That loses a
+/// little efficiency, never correctness (the chi² test checks the "nowhere" mass too).
 #[test]
 fn pmf_sums_to_one_over_lights() {
     let scene = test_scene();
     let n = scene.lights.len() as u32;
     for sel in selectors(&scene) {
+        let mut worst = 1.0f64;
         for sp in shading_points(20, 5) {
             let sum: f64 = (0..n).map(|l| sel.pmf(&sp, l) as f64).sum();
-            // A selector may find that no light can contribute (sum 0, sample None).
-            let any = sel.sample(&sp, 0.5).is_some();
-            if any {
+            let m = 4000;
+            let some = (0..m)
+                .filter(|&k| sel.sample(&sp, (k as f32 + 0.5) / m as f32).is_some())
+                .count() as f64
+                / m as f64;
+            assert!(sum <= 1.0 + 1e-4, "{}: sum {sum} at {sp:?}", sel.name());
+            if sel.name() == "bvh" {
+                // Stratified u: P(Some) is known to about 1/m.
+                assert!((sum - some).abs() < 2e-3, "{}: sum {sum} but P(Some) {some}", sel.name());
+                assert!(sum > 0.5, "{}: sum {sum} at {sp:?}", sel.name());
+            } else if some > 0.0 {
                 assert!((sum - 1.0).abs() < 1e-4, "{}: sum {sum} at {sp:?}", sel.name());
             } else {
                 assert!(sum < 1e-6, "{}: sample None but pmf sum {sum}", sel.name());
             }
+            worst = worst.min(sum);
         }
+        eprintln!("{}: smallest pmf sum {worst:.6}", sel.name());
     }
 }
 
@@ -312,7 +327,8 @@ fn renders_agree_with_uniform_within_noise() {
     let res = UVec2::new(48, 36);
     let run = |name: &str, seed: u64| {
         let opts = RenderOptions {
-            spp: 16,
+            // Uniform selection has heavy-tailed noise here: give it more samples.
+            spp: if name == "uniform" { 48 } else { 16 },
             seed,
             light_selection: name.into(),
             ..RenderOptions::default()
@@ -327,3 +343,4 @@ fn renders_agree_with_uniform_within_noise() {
         assert!((m - mu).abs() < 5.0 * sigma, "{name}: mean {m} vs uniform {mu} (σ {sigma})");
     }
 }
+
