@@ -103,9 +103,10 @@ fn oct_decode(q: [u16; 2]) -> Vec3 {
     Vec3::new(x, y, z).normalize_or(Vec3::Z)
 }
 
-/// Cost of a node with bounds `b` split along `dim` (pbrt-v4's SAOH: power × orientation
-/// measure × surface area × aspect penalty).
-fn saoh_cost(b: &LightBounds, dim: usize) -> f32 {
+/// Cost of a child with bounds `b` of a node of extent `parent` split along `dim` (pbrt-v4's
+/// SAOH: power × orientation measure × surface area × the parent's aspect penalty, which
+/// discourages splitting along the node's short axes).
+fn saoh_cost(b: &LightBounds, parent: Vec3, dim: usize) -> f32 {
     let theta_o = b.cos_theta_o.clamp(-1.0, 1.0).acos();
     let theta_e = b.cos_theta_e.clamp(-1.0, 1.0).acos();
     let theta_w = (theta_o + theta_e).min(PI);
@@ -115,7 +116,7 @@ fn saoh_cost(b: &LightBounds, dim: usize) -> f32 {
             * (2.0 * theta_w * sin_o - (theta_o - 2.0 * theta_w).cos() - 2.0 * theta_o * sin_o
                 + b.cos_theta_o);
     let d = b.max - b.min;
-    let kr = if d[dim] > 0.0 { d.max_element() / d[dim] } else { 1.0 };
+    let kr = if parent[dim] > 0.0 { parent.max_element() / parent[dim] } else { 1.0 };
     let area = 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
     // A tiny area floor keeps coplanar point-like groups comparable.
     b.phi.max(1e-30) * m_omega * kr * area.max(1e-12)
@@ -223,6 +224,29 @@ impl BvhSelector {
         importance(ctx.p, ctx.n, &self.bounds(i))
     }
 
+    /// Path of `light` from the root: (bounds of the node taken, its importance, its sibling's
+    /// importance) per level — for diagnosing selection quality.
+    pub fn path(&self, ctx: &ShadingPoint, light: u32) -> Vec<(LightBounds, f32, f32)> {
+        let mut out = Vec::new();
+        let Some(&trail) = self.trails.get(light as usize) else {
+            return out;
+        };
+        let mut i = 0usize;
+        let mut depth = 0;
+        while self.nodes[i].child & LEAF == 0 {
+            let c1 = (self.nodes[i].child & INDEX_MASK) as usize;
+            let (take, other) = if trail >> depth & 1 == 0 { (i + 1, c1) } else { (c1, i + 1) };
+            out.push((
+                self.bounds(take),
+                self.node_importance(ctx, take),
+                self.node_importance(ctx, other),
+            ));
+            i = take;
+            depth += 1;
+        }
+        out
+    }
+
     /// Importance of the lowest-level bounds (the leaf) of every light — for tests comparing
     /// against the exact bounds.
     pub fn leaf_importance(&self, ctx: &ShadingPoint, light: u32) -> f32 {
@@ -316,6 +340,12 @@ fn split(items: &mut [Item], depth: u32) -> usize {
             (lo.min(it.centroid), hi.max(it.centroid))
         });
     let ext = chi - clo;
+    let (blo, bhi) = items
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), it| {
+            (lo.min(it.b.min), hi.max(it.b.max))
+        });
+    let parent = bhi - blo;
     let by_count = |items: &mut [Item]| {
         let dim = ext.max_position();
         let mid = items.len() / 2;
@@ -352,7 +382,7 @@ fn split(items: &mut [Item], depth: u32) -> usize {
         for k in 0..BUCKETS - 1 {
             prefix = merge(prefix, buckets[k]);
             if let (Some(a), Some(b)) = (prefix, suffix[k + 1]) {
-                let cost = saoh_cost(&a, dim) + saoh_cost(&b, dim);
+                let cost = saoh_cost(&a, parent, dim) + saoh_cost(&b, parent, dim);
                 if cost < best.0 {
                     best = (cost, dim, k);
                 }

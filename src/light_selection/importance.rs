@@ -50,10 +50,12 @@ pub fn importance_sphere(center: Vec3, radius: f32, n: Vec3, b: &LightBounds) ->
     let rl = (b.max - b.min).length() * 0.5;
     let to_p = center - pc;
     let d = to_p.length();
-    // Distance from the receiver region to the light's centre, floored by the light's and the
-    // region's size so nearby lights do not get unbounded weight.
+    // Distance from the receiver region to the light's centre, floored so nearby lights do not
+    // get unbounded weight. The floor is pbrt-v4's half diagonal (a length compared with a
+    // squared length: deliberately weak, since flooring by its square makes every large node
+    // that contains the receiver look equally far away), and a quarter of the region's size.
     let d_eff = (d - radius).max(0.0);
-    let d2 = (d_eff * d_eff).max(rl * rl).max(0.25 * radius * radius).max(1e-12);
+    let d2 = (d_eff * d_eff).max(rl).max(0.25 * radius * radius).max(1e-12);
     // Angle subtended by the light's bounding sphere as seen from anywhere in the region.
     let r_sum = rl + radius;
     let (sin_b, cos_b) = if d <= r_sum || d == 0.0 {
