@@ -8,8 +8,10 @@
 //! contribution. Occluded lights average to zero, which the spatial bound cannot know.
 //!
 //! Unbiasedness: cells with too little training data use the spatial table alone; trained
-//! cells mix p = β·p_spatial + (1 − β)·p_learned with β = [`AdaptiveConfig::beta`] (default
-//! 20%), and p_spatial itself keeps its power floor, so every light keeps p > 0.
+//! cells mix p = β·p_spatial + (1 − β)·p_learned with β = max([`AdaptiveConfig::beta`]
+//! (default 20%), spatial mass of the lights never measured in the cell) — the learned table
+//! only takes over the probability of lights it has measured — and p_spatial itself keeps its
+//! power floor, so every light keeps p > 0.
 
 use super::estimate::{contribution, estimate_resolution, eye_hit, next_2d, pixel_rng};
 use super::spatial::{CellTable, SpatialSelector};
@@ -53,8 +55,8 @@ impl AdaptiveConfig {
 /// Spatial grid plus learned per-cell tables.
 pub struct AdaptiveSelector {
     spatial: SpatialSelector,
-    learned: Vec<Option<CellTable>>,
-    beta: f32,
+    /// Per cell: learned table and the spatial share β kept there.
+    learned: Vec<Option<(CellTable, f32)>>,
     /// Number of cells with a learned table.
     pub trained_cells: usize,
 }
@@ -63,7 +65,7 @@ impl AdaptiveSelector {
     /// Build the grid and train it on `scene`.
     pub fn new(scene: &Scene, set: &LightSet, cfg: &AdaptiveConfig) -> Self {
         let spatial = SpatialSelector::new(scene, set);
-        let mut learned: Vec<Option<CellTable>> = vec![None; spatial.grid().len()];
+        let mut learned: Vec<Option<(CellTable, f32)>> = vec![None; spatial.grid().len()];
         let mut trained_cells = 0;
         if !set.finite.is_empty() {
             let res = estimate_resolution(scene, cfg.resolution);
@@ -98,9 +100,21 @@ impl AdaptiveSelector {
                 let end = start + records[start..].partition_point(|r| r.0 == cell);
                 if end - start >= cfg.min_records {
                     let (ids, weights) = average(&records[start..end]);
+                    // Spatial probability mass of the lights measured here (occluded ones
+                    // included): what the training has an opinion about.
+                    let (c, _) = spatial.grid().sphere(cell as usize);
+                    let sp = ShadingPoint {
+                        p: c,
+                        n: glam::Vec3::ZERO,
+                        wo: glam::Vec3::ZERO,
+                    };
+                    let mut tested: Vec<u32> = records[start..end].iter().map(|r| r.1).collect();
+                    tested.dedup();
+                    let mass: f32 = tested.iter().map(|&l| spatial.pmf(&sp, l)).sum();
+                    let beta = cfg.beta.max(1.0 - mass).clamp(0.0, 1.0);
                     let t = CellTable::new(ids, &weights);
-                    if t.is_usable() {
-                        learned[cell as usize] = Some(t);
+                    if t.is_usable() && beta < 1.0 {
+                        learned[cell as usize] = Some((t, beta));
                         trained_cells += 1;
                     }
                 }
@@ -110,7 +124,6 @@ impl AdaptiveSelector {
         Self {
             spatial,
             learned,
-            beta: cfg.beta.clamp(0.0, 1.0),
             trained_cells,
         }
     }
@@ -119,8 +132,8 @@ impl AdaptiveSelector {
     fn learned(&self, ctx: &ShadingPoint) -> (Option<&CellTable>, f32) {
         let cell = self.spatial.grid().cell(ctx.p);
         match self.learned.get(cell).and_then(|t| t.as_ref()) {
-            Some(t) if self.beta < 1.0 => (Some(t), self.beta),
-            _ => (None, 1.0),
+            Some((t, beta)) => (Some(t), *beta),
+            None => (None, 1.0),
         }
     }
 }

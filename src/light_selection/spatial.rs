@@ -9,7 +9,7 @@
 //! Each cell keeps its [`SpatialConfig::max_lights`] most important lights. Unbiasedness: every
 //! other light — and any light the bound misjudges — keeps probability through defensive
 //! mixing with power selection, p = α·p_Φ + (1 − α)·p_cell with α = [`SpatialConfig::alpha`]
-//! (default 10%).
+//! (default 10%), raised in cells where the left-out lights carry more than α of the bound.
 
 use super::importance::importance_sphere;
 use super::power::PowerSelector;
@@ -114,6 +114,8 @@ impl Grid {
 pub struct CellTable {
     ids: Vec<u32>,
     table: Option<AliasTable>,
+    /// Fraction of the cell's total bound carried by lights left out of the table.
+    pub rest: f32,
 }
 
 impl CellTable {
@@ -124,7 +126,11 @@ impl CellTable {
         } else {
             AliasTable::new(weights)
         };
-        Self { ids, table }
+        Self {
+            ids,
+            table,
+            rest: 0.0,
+        }
     }
 
     /// True if the table can be sampled.
@@ -213,18 +219,28 @@ impl SpatialSelector {
             .filter(|&(_, w)| w > 0.0)
             .collect();
         let k = self.cfg.max_lights.max(1);
+        let total: f64 = w.iter().map(|&(_, x)| x as f64).sum();
         if w.len() > k {
             w.select_nth_unstable_by(k, |a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
             w.truncate(k);
         }
+        let kept: f64 = w.iter().map(|&(_, x)| x as f64).sum();
         w.sort_unstable_by_key(|&(l, _)| l);
         let weights: Vec<f32> = w.iter().map(|&(_, x)| x).collect();
-        CellTable::new(w.into_iter().map(|(l, _)| l).collect(), &weights)
+        let mut t = CellTable::new(w.into_iter().map(|(l, _)| l).collect(), &weights);
+        t.rest = if total > 0.0 { (1.0 - kept / total) as f32 } else { 0.0 };
+        t
     }
 
-    /// Share of power selection in a cell (all of it if the cell's table is empty).
+    /// Share of power selection in a cell: α, or more when the lights left out of the table
+    /// carry more of the cell's bound (they are reached through power selection); all of it if
+    /// the table is empty.
     fn alpha(&self, t: &CellTable) -> f32 {
-        if t.is_usable() { self.cfg.alpha } else { 1.0 }
+        if t.is_usable() {
+            self.cfg.alpha.max(t.rest.min(0.9))
+        } else {
+            1.0
+        }
     }
 }
 
