@@ -45,14 +45,36 @@ fn test_scene() -> Scene {
     let grey = b.add_material(Material::Diffuse {
         reflectance: Texture::Constant(Rgb::splat(0.5)),
     });
-    b.add_quad(Vec3::new(-6.0, 0.0, -6.0), Vec3::Z * 12.0, Vec3::X * 12.0, grey, None)
-        .unwrap();
-    b.add_quad(Vec3::new(-1.0, 0.0, 0.0), Vec3::Y * 2.0, Vec3::X * 2.0, grey, None)
-        .unwrap();
-    b.add_quad(Vec3::new(2.0, 0.0, -2.0), Vec3::Y * 1.5, Vec3::Z * 1.0, grey, None)
-        .unwrap();
+    b.add_quad(
+        Vec3::new(-6.0, 0.0, -6.0),
+        Vec3::Z * 12.0,
+        Vec3::X * 12.0,
+        grey,
+        None,
+    )
+    .unwrap();
+    b.add_quad(
+        Vec3::new(-1.0, 0.0, 0.0),
+        Vec3::Y * 2.0,
+        Vec3::X * 2.0,
+        grey,
+        None,
+    )
+    .unwrap();
+    b.add_quad(
+        Vec3::new(2.0, 0.0, -2.0),
+        Vec3::Y * 1.5,
+        Vec3::Z * 1.0,
+        grey,
+        None,
+    )
+    .unwrap();
     for i in 0..150 {
-        let p = Vec3::new(u(&mut rng, -5.0, 5.0), u(&mut rng, 0.2, 3.0), u(&mut rng, -5.0, 5.0));
+        let p = Vec3::new(
+            u(&mut rng, -5.0, 5.0),
+            u(&mut rng, 0.2, 3.0),
+            u(&mut rng, -5.0, 5.0),
+        );
         let mut n = unit(&mut rng);
         if n.y > 0.3 {
             n.y = -n.y;
@@ -61,7 +83,11 @@ fn test_scene() -> Scene {
         let s = n.cross(t);
         let size = u(&mut rng, 0.05, 0.5);
         let power = (u(&mut rng, -2.0, 1.0) * std::f32::consts::LN_10).exp();
-        let col = Rgb::new(u(&mut rng, 0.2, 1.0), u(&mut rng, 0.2, 1.0), u(&mut rng, 0.2, 1.0));
+        let col = Rgb::new(
+            u(&mut rng, 0.2, 1.0),
+            u(&mut rng, 0.2, 1.0),
+            u(&mut rng, 0.2, 1.0),
+        );
         let e = AreaEmission {
             l: col * power,
             two_sided: i % 7 == 0,
@@ -79,7 +105,10 @@ fn test_scene() -> Scene {
             b.add_mesh(mesh, grey, Some(e)).unwrap();
         }
     }
-    b.add_light(Light::Point(PointLight::new(Vec3::new(0.0, 2.5, -3.0), Rgb::splat(2.0))));
+    b.add_light(Light::Point(PointLight::new(
+        Vec3::new(0.0, 2.5, -3.0),
+        Rgb::splat(2.0),
+    )));
     b.add_light(Light::Spot(SpotLight::new(
         Vec3::new(3.0, 3.0, 3.0),
         Vec3::new(-1.0, -2.0, -1.0),
@@ -87,10 +116,16 @@ fn test_scene() -> Scene {
         0.9,
         0.8,
     )));
-    b.add_light(Light::UniformInfinite(UniformInfiniteLight::new(Rgb::splat(0.05))));
-    let camera =
-        Camera::look_at(Vec3::new(0.0, 4.0, -8.0), Vec3::new(0.0, 0.5, 0.0), Vec3::Y, 60.0)
-            .unwrap();
+    b.add_light(Light::UniformInfinite(UniformInfiniteLight::new(
+        Rgb::splat(0.05),
+    )));
+    let camera = Camera::look_at(
+        Vec3::new(0.0, 4.0, -8.0),
+        Vec3::new(0.0, 0.5, 0.0),
+        Vec3::Y,
+        60.0,
+    )
+    .unwrap();
     let film = FilmSpec {
         resolution: UVec2::new(48, 36),
         filter: Filter::Box {
@@ -109,18 +144,21 @@ fn shading_points(n: usize, seed: u64) -> Vec<ShadingPoint> {
     (0..n)
         .map(|i| {
             let (p, nrm) = if i % 2 == 0 {
-                (Vec3::new(u(&mut rng, -6.0, 6.0), 0.0, u(&mut rng, -6.0, 6.0)), Vec3::Y)
+                (
+                    Vec3::new(u(&mut rng, -6.0, 6.0), 0.0, u(&mut rng, -6.0, 6.0)),
+                    Vec3::Y,
+                )
             } else {
                 (
-                    Vec3::new(u(&mut rng, -6.0, 6.0), u(&mut rng, 0.0, 3.0), u(&mut rng, -6.0, 6.0)),
+                    Vec3::new(
+                        u(&mut rng, -6.0, 6.0),
+                        u(&mut rng, 0.0, 3.0),
+                        u(&mut rng, -6.0, 6.0),
+                    ),
                     unit(&mut rng),
                 )
             };
-            ShadingPoint {
-                p,
-                n: nrm,
-                wo: nrm,
-            }
+            ShadingPoint { p, n: nrm, wo: nrm }
         })
         .collect()
 }
@@ -159,10 +197,18 @@ fn pmf_sums_to_one_over_lights() {
             assert!(sum <= 1.0 + 1e-4, "{}: sum {sum} at {sp:?}", sel.name());
             if sel.name() == "bvh" {
                 // Stratified u: P(Some) is known to about 1/m.
-                assert!((sum - some).abs() < 2e-3, "{}: sum {sum} but P(Some) {some}", sel.name());
+                assert!(
+                    (sum - some).abs() < 2e-3,
+                    "{}: sum {sum} but P(Some) {some}",
+                    sel.name()
+                );
                 assert!(sum > 0.5, "{}: sum {sum} at {sp:?}", sel.name());
             } else if some > 0.0 {
-                assert!((sum - 1.0).abs() < 1e-4, "{}: sum {sum} at {sp:?}", sel.name());
+                assert!(
+                    (sum - 1.0).abs() < 1e-4,
+                    "{}: sum {sum} at {sp:?}",
+                    sel.name()
+                );
             } else {
                 assert!(sum < 1e-6, "{}: sample None but pmf sum {sum}", sel.name());
             }
@@ -208,7 +254,9 @@ fn chi2_sampled_light_indices_match_pmf() {
     for sel in selectors(&scene) {
         for sp in shading_points(2, 11) {
             let pmf: Vec<f64> = (0..n).map(|l| sel.pmf(&sp, l) as f64).collect();
-            let r = chi2_discrete(&cfg, &pmf, |u| sel.sample(&sp, u[0]).map(|s| s.index as usize));
+            let r = chi2_discrete(&cfg, &pmf, |u| {
+                sel.sample(&sp, u[0]).map(|s| s.index as usize)
+            });
             eprintln!("{}: {}", sel.name(), r.summary());
             assert!(r.passed, "{}: {}", sel.name(), r.summary());
         }
@@ -227,7 +275,9 @@ fn random_lights(rng: &mut Pcg32, n: usize) -> Vec<Light> {
             let l = Rgb::splat((u(rng, -3.0, 3.0) * std::f32::consts::LN_10).exp());
             match i % 5 {
                 0 | 1 => Light::Quad(QuadLight::new(p, t, s, nrm, l, i % 3 == 0).unwrap()),
-                2 | 3 => Light::Triangle(TriangleLight::new([p, p + t, p + s], nrm, l, i % 4 == 0).unwrap()),
+                2 | 3 => Light::Triangle(
+                    TriangleLight::new([p, p + t, p + s], nrm, l, i % 4 == 0).unwrap(),
+                ),
                 _ if i % 2 == 0 => Light::Point(PointLight::new(p, l)),
                 _ => Light::Spot(SpotLight::new(p, nrm, l, 0.8, 0.5)),
             }
@@ -243,14 +293,24 @@ fn contributes(light: &Light, p: Vec3, n: Vec3) -> bool {
         Light::Quad(q) => (0..grid * grid)
             .map(|k| {
                 let (a, b) = ((k % grid) as f32 + 0.5, (k / grid) as f32 + 0.5);
-                (q.corner + q.e1 * (a / grid as f32) + q.e2 * (b / grid as f32), q.n, q.two_sided)
+                (
+                    q.corner + q.e1 * (a / grid as f32) + q.e2 * (b / grid as f32),
+                    q.n,
+                    q.two_sided,
+                )
             })
             .collect(),
         Light::Triangle(t) => (0..grid * grid)
             .filter_map(|k| {
                 let (a, b) = ((k % grid) as f32 + 0.5, (k / grid) as f32 + 0.5);
                 let (a, b) = (a / grid as f32, b / grid as f32);
-                (a + b < 1.0).then(|| (t.p[0] + (t.p[1] - t.p[0]) * a + (t.p[2] - t.p[0]) * b, t.n, t.two_sided))
+                (a + b < 1.0).then(|| {
+                    (
+                        t.p[0] + (t.p[1] - t.p[0]) * a + (t.p[2] - t.p[0]) * b,
+                        t.n,
+                        t.two_sided,
+                    )
+                })
             })
             .collect(),
         Light::Point(l) => return (l.p - p).dot(n) > 0.0,
@@ -258,7 +318,11 @@ fn contributes(light: &Light, p: Vec3, n: Vec3) -> bool {
             // A spot emits within its cone: use the light's own sampler from here.
             let ctx = penumbra::lights::LightSampleContext { p, n };
             return light
-                .sample_li(&ctx, Vec2::splat(0.5), penumbra::lights::SamplingMode::SolidAngle)
+                .sample_li(
+                    &ctx,
+                    Vec2::splat(0.5),
+                    penumbra::lights::SamplingMode::SolidAngle,
+                )
                 .is_some_and(|s| s.li != Rgb::ZERO && s.wi.dot(n) > 0.0);
         }
         _ => return false,
@@ -278,7 +342,11 @@ fn bvh_importance_never_zero_for_contributing_light() {
         let bvh = BvhSelector::new(&bounds);
         let ex = ExhaustiveSelector::new(&bounds);
         for _ in 0..40 {
-            let p = Vec3::new(u(&mut rng, -5.0, 5.0), u(&mut rng, -5.0, 5.0), u(&mut rng, -5.0, 5.0));
+            let p = Vec3::new(
+                u(&mut rng, -5.0, 5.0),
+                u(&mut rng, -5.0, 5.0),
+                u(&mut rng, -5.0, 5.0),
+            );
             let n = unit(&mut rng);
             let sp = ShadingPoint { p, n, wo: n };
             for (i, l) in lights.iter().enumerate() {
@@ -287,8 +355,14 @@ fn bvh_importance_never_zero_for_contributing_light() {
                 }
                 let pb = bvh.pmf(&sp, i as u32);
                 let pe = ex.pmf(&sp, i as u32);
-                assert!(pe > 0.0, "exhaustive: light {i} ({l:?}) contributes at {p}, n {n}, pmf 0");
-                assert!(pb > 0.0, "bvh: light {i} ({l:?}) contributes at {p}, n {n}, pmf 0 (exhaustive {pe})");
+                assert!(
+                    pe > 0.0,
+                    "exhaustive: light {i} ({l:?}) contributes at {p}, n {n}, pmf 0"
+                );
+                assert!(
+                    pb > 0.0,
+                    "bvh: light {i} ({l:?}) contributes at {p}, n {n}, pmf 0 (exhaustive {pe})"
+                );
             }
         }
     }
@@ -301,7 +375,11 @@ fn bvh_is_compact() {
     let bounds: Vec<LightBounds> = lights.iter().map(|l| l.bounds().unwrap()).collect();
     let bvh = BvhSelector::new(&bounds);
     assert_eq!(bvh.node_count(), 2 * bounds.len() - 1);
-    assert!(bvh.bytes_per_light() <= 64.0, "{} B/light", bvh.bytes_per_light());
+    assert!(
+        bvh.bytes_per_light() <= 64.0,
+        "{} B/light",
+        bvh.bytes_per_light()
+    );
 }
 
 /// Mean of all channels of all pixels, and the variance of that mean from the per-pixel
@@ -339,8 +417,13 @@ fn renders_agree_with_uniform_within_noise() {
     for name in SELECTORS.iter().filter(|&&n| n != "uniform") {
         let (m, v) = mean_and_variance(&run(name, 3), &run(name, 4));
         let sigma = (v + vu).sqrt();
-        eprintln!("{name}: mean {m:.5} vs uniform {mu:.5}, sigma {sigma:.2e}, noise var ratio {:.3}", v / vu);
-        assert!((m - mu).abs() < 5.0 * sigma, "{name}: mean {m} vs uniform {mu} (σ {sigma})");
+        eprintln!(
+            "{name}: mean {m:.5} vs uniform {mu:.5}, sigma {sigma:.2e}, noise var ratio {:.3}",
+            v / vu
+        );
+        assert!(
+            (m - mu).abs() < 5.0 * sigma,
+            "{name}: mean {m} vs uniform {mu} (σ {sigma})"
+        );
     }
 }
-

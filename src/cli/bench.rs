@@ -101,7 +101,11 @@ const MANY: &[&str] = &["many-open", "many-rooms", "many-mesh"];
 
 /// The strategy the reference of `scene` is rendered with (the best one there, at high spp).
 fn reference_selector(scene: &str) -> &'static str {
-    if scene == "many-rooms" { "adaptive" } else { "bvh" }
+    if scene == "many-rooms" {
+        "adaptive"
+    } else {
+        "bvh"
+    }
 }
 
 /// Where references are cached: `target/many-bench/` next to the executable's target dir when
@@ -142,9 +146,14 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
     };
     let dir = cache_dir();
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    println!("{}x{}, {spp} spp, MIS, reference {}x spp", res.x, res.y, args.reference_factor);
+    println!(
+        "{}x{}, {spp} spp, MIS, reference {}x spp",
+        res.x, res.y, args.reference_factor
+    );
     println!();
-    println!("| scene | lights | strategy | build (s) | render (s) | relMSE | efficiency vs power |");
+    println!(
+        "| scene | lights | strategy | build (s) | render (s) | relMSE | efficiency vs power |"
+    );
     println!("|---|---|---|---|---|---|---|");
     for name in &names {
         let scene = load(name, &lopts)?.scene;
@@ -198,9 +207,13 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
             .map(|(b, t, r)| eff(b, t, r));
         for (sel, r) in rows {
             match r {
-                None => println!("| {name} | {n} | {sel} | – | – | – | skipped (> {} lights) |", args.max_exhaustive_lights),
+                None => println!(
+                    "| {name} | {n} | {sel} | – | – | – | skipped (> {} lights) |",
+                    args.max_exhaustive_lights
+                ),
                 Some((b, t, rel)) => {
-                    let e = power.map_or("–".to_string(), |p| format!("{:.2}", eff(b, t, rel) / p));
+                    let e =
+                        power.map_or("–".to_string(), |p| format!("{:.2}", eff(b, t, rel) / p));
                     println!("| {name} | {n} | {sel} | {b:.3} | {t:.3} | {rel:.4e} | {e} |");
                 }
             }

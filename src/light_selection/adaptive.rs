@@ -84,7 +84,12 @@ impl AdaptiveSelector {
                         (0..cfg.lights_per_pixel)
                             .filter_map(|_| {
                                 let (i, _) = spatial.sample(&eh.sp, next_f32(&mut rng))?;
-                                let c = contribution(scene, &eh, set.finite[i as usize], next_2d(&mut rng));
+                                let c = contribution(
+                                    scene,
+                                    &eh,
+                                    set.finite[i as usize],
+                                    next_2d(&mut rng),
+                                );
                                 Some((cell, i, c))
                             })
                             .collect()

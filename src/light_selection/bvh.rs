@@ -77,7 +77,11 @@ fn dequantize_cos(q: u16) -> f32 {
 /// Octahedral encoding of a unit vector.
 fn oct_encode(v: Vec3) -> [u16; 2] {
     let l1 = v.x.abs() + v.y.abs() + v.z.abs();
-    let (mut x, mut y) = if l1 > 0.0 { (v.x / l1, v.y / l1) } else { (0.0, 0.0) };
+    let (mut x, mut y) = if l1 > 0.0 {
+        (v.x / l1, v.y / l1)
+    } else {
+        (0.0, 0.0)
+    };
     if v.z < 0.0 {
         let (ox, oy) = (x, y);
         x = (1.0 - oy.abs()) * if ox >= 0.0 { 1.0 } else { -1.0 };
@@ -116,7 +120,11 @@ fn saoh_cost(b: &LightBounds, parent: Vec3, dim: usize) -> f32 {
             * (2.0 * theta_w * sin_o - (theta_o - 2.0 * theta_w).cos() - 2.0 * theta_o * sin_o
                 + b.cos_theta_o);
     let d = b.max - b.min;
-    let kr = if parent[dim] > 0.0 { parent.max_element() / parent[dim] } else { 1.0 };
+    let kr = if parent[dim] > 0.0 {
+        parent.max_element() / parent[dim]
+    } else {
+        1.0
+    };
     let area = 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
     // A tiny area floor keeps coplanar point-like groups comparable.
     b.phi.max(1e-30) * m_omega * kr * area.max(1e-12)
@@ -186,7 +194,11 @@ impl BvhSelector {
                 self.trails[(n.child & INDEX_MASK) as usize] = trail;
             } else {
                 stack.push((i + 1, trail, depth + 1));
-                stack.push(((n.child & INDEX_MASK) as usize, trail | (1 << depth), depth + 1));
+                stack.push((
+                    (n.child & INDEX_MASK) as usize,
+                    trail | (1 << depth),
+                    depth + 1,
+                ));
             }
         }
     }
@@ -235,7 +247,11 @@ impl BvhSelector {
         let mut depth = 0;
         while self.nodes[i].child & LEAF == 0 {
             let c1 = (self.nodes[i].child & INDEX_MASK) as usize;
-            let (take, other) = if trail >> depth & 1 == 0 { (i + 1, c1) } else { (c1, i + 1) };
+            let (take, other) = if trail >> depth & 1 == 0 {
+                (i + 1, c1)
+            } else {
+                (c1, i + 1)
+            };
             out.push((
                 self.bounds(take),
                 self.node_importance(ctx, take),
@@ -357,12 +373,11 @@ fn split(items: &mut [Item], depth: u32) -> usize {
     }
     let mut best = (f32::INFINITY, 0usize, 0usize);
     for dim in 0..3 {
-        if !(ext[dim] > 0.0) {
+        if ext[dim].is_nan() || ext[dim] <= 0.0 {
             continue;
         }
-        let bucket_of = |c: Vec3| {
-            (((c[dim] - clo[dim]) / ext[dim] * BUCKETS as f32) as usize).min(BUCKETS - 1)
-        };
+        let bucket_of =
+            |c: Vec3| (((c[dim] - clo[dim]) / ext[dim] * BUCKETS as f32) as usize).min(BUCKETS - 1);
         let mut buckets: [Option<LightBounds>; BUCKETS] = [None; BUCKETS];
         for it in items.iter() {
             let k = bucket_of(it.centroid);
@@ -396,7 +411,11 @@ fn split(items: &mut [Item], depth: u32) -> usize {
     let bucket_of =
         |c: Vec3| (((c[dim] - clo[dim]) / ext[dim] * BUCKETS as f32) as usize).min(BUCKETS - 1);
     let mid = partition(items, |it| bucket_of(it.centroid) <= k);
-    if mid == 0 || mid == n { by_count(items) } else { mid }
+    if mid == 0 || mid == n {
+        by_count(items)
+    } else {
+        mid
+    }
 }
 
 fn merge(a: Option<LightBounds>, b: Option<LightBounds>) -> Option<LightBounds> {
@@ -440,7 +459,7 @@ impl FiniteSelector for BvhSelector {
             let i0 = self.node_importance(ctx, i + 1) as f64;
             let i1 = self.node_importance(ctx, c1) as f64;
             let total = i0 + i1;
-            if !(total > 0.0) {
+            if total.is_nan() || total <= 0.0 {
                 return None;
             }
             let p0 = i0 / total;
@@ -478,7 +497,7 @@ impl FiniteSelector for BvhSelector {
             let i0 = self.node_importance(ctx, i + 1) as f64;
             let i1 = self.node_importance(ctx, c1) as f64;
             let total = i0 + i1;
-            if !(total > 0.0) {
+            if total.is_nan() || total <= 0.0 {
                 return 0.0;
             }
             if trail >> depth & 1 == 0 {
@@ -504,7 +523,12 @@ mod tests {
 
     #[test]
     fn octahedral_round_trip_is_close() {
-        for &v in &[Vec3::X, -Vec3::Y, Vec3::new(0.3, -0.5, -0.8).normalize(), -Vec3::Z] {
+        for &v in &[
+            Vec3::X,
+            -Vec3::Y,
+            Vec3::new(0.3, -0.5, -0.8).normalize(),
+            -Vec3::Z,
+        ] {
             let d = oct_decode(oct_encode(v));
             assert!(d.dot(v) > 0.9999, "{v:?} -> {d:?}");
         }

@@ -55,13 +55,21 @@ pub fn eye_hit(scene: &Scene, res: UVec2, pixel: u32, rng: &mut Pcg32) -> Option
     let wo = -ray.d.normalize();
     let front = ray.d.dot(hit.ng) < 0.0;
     let ng = if front { hit.ng } else { -hit.ng };
-    let ns = if hit.ns.dot(wo) < 0.0 { -hit.ns } else { hit.ns };
+    let ns = if hit.ns.dot(wo) < 0.0 {
+        -hit.ns
+    } else {
+        hit.ns
+    };
     let frame = Frame::from_normal(ns);
     Some(EyeHit {
         bsdf: material.bsdf(&hit, front),
         wo_local: frame.to_local(wo),
         frame,
-        sp: ShadingPoint { p: hit.p, n: ng, wo },
+        sp: ShadingPoint {
+            p: hit.p,
+            n: ng,
+            wo,
+        },
         hit,
     })
 }
@@ -79,12 +87,12 @@ pub fn contribution(scene: &Scene, eh: &EyeHit, light: u32, u: Vec2) -> f32 {
     let Some(ls) = l.sample_li(&ctx, u, SamplingMode::SolidAngle) else {
         return 0.0;
     };
-    if !(ls.pdf > 0.0) || ls.wi.dot(eh.sp.n) <= 0.0 {
+    if (ls.pdf.is_nan() || ls.pdf <= 0.0) || ls.wi.dot(eh.sp.n) <= 0.0 {
         return 0.0;
     }
     let wi_local = eh.frame.to_local(ls.wi);
     let v = luminance(eh.bsdf.f(eh.wo_local, wi_local) * ls.li) * wi_local.z.abs() / ls.pdf;
-    if !(v > 0.0) || !v.is_finite() {
+    if (v.is_nan() || v <= 0.0) || !v.is_finite() {
         return 0.0;
     }
     // Shadow ray from just off the surface to just short of the light point.
@@ -94,7 +102,11 @@ pub fn contribution(scene: &Scene, eh: &EyeHit, light: u32, u: Vec2) -> f32 {
         d: ls.p_light - o,
         t_max: 1.0 - 1e-4,
     };
-    if scene.geometry.occluded(&ray) { 0.0 } else { v }
+    if scene.geometry.occluded(&ray) {
+        0.0
+    } else {
+        v
+    }
 }
 
 /// Two uniform numbers.

@@ -31,7 +31,7 @@ impl ExhaustiveSelector {
 impl FiniteSelector for ExhaustiveSelector {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
         let total = self.total(ctx);
-        if !(total > 0.0) || !total.is_finite() {
+        if (total.is_nan() || total <= 0.0) || !total.is_finite() {
             return None;
         }
         let target = u as f64 * total;

@@ -43,7 +43,7 @@ fn safe_sqrt(x: f32) -> f32 {
 /// when unknown. Reflection only: lights entirely below the receiver's tangent plane get 0,
 /// matching the integrator, which only gathers light from above the geometric surface.
 pub fn importance_sphere(center: Vec3, radius: f32, n: Vec3, b: &LightBounds) -> f32 {
-    if !(b.phi > 0.0) {
+    if b.phi.is_nan() || b.phi <= 0.0 {
         return 0.0;
     }
     let pc = (b.min + b.max) * 0.5;
@@ -55,7 +55,10 @@ pub fn importance_sphere(center: Vec3, radius: f32, n: Vec3, b: &LightBounds) ->
     // squared length: deliberately weak, since flooring by its square makes every large node
     // that contains the receiver look equally far away), and a quarter of the region's size.
     let d_eff = (d - radius).max(0.0);
-    let d2 = (d_eff * d_eff).max(rl).max(0.25 * radius * radius).max(1e-12);
+    let d2 = (d_eff * d_eff)
+        .max(rl)
+        .max(0.25 * radius * radius)
+        .max(1e-12);
     // Angle subtended by the light's bounding sphere as seen from anywhere in the region.
     let r_sum = rl + radius;
     let (sin_b, cos_b) = if d <= r_sum || d == 0.0 {
@@ -104,10 +107,10 @@ pub fn importance(p: Vec3, n: Vec3, b: &LightBounds) -> f32 {
 
 /// The union of two light bounds: box union, a cone containing both cones, summed power.
 pub fn union(a: &LightBounds, b: &LightBounds) -> LightBounds {
-    if !(a.phi > 0.0) {
+    if a.phi.is_nan() || a.phi <= 0.0 {
         return *b;
     }
-    if !(b.phi > 0.0) {
+    if b.phi.is_nan() || b.phi <= 0.0 {
         return *a;
     }
     let (w, cos_o) = cone_union(a.w, a.cos_theta_o, b.w, b.cos_theta_o);
@@ -144,5 +147,8 @@ pub fn cone_union(wa: Vec3, cos_a: f32, wb: Vec3, cos_b: f32) -> (Vec3, f32) {
     }
     let w = glam::Quat::from_axis_angle(axis.normalize(), theta_r) * wa;
     // A little slack so f32 rounding of the rotation cannot leave a normal outside the cone.
-    (w.normalize(), (theta_o + 1e-4).min(std::f32::consts::PI).cos())
+    (
+        w.normalize(),
+        (theta_o + 1e-4).min(std::f32::consts::PI).cos(),
+    )
 }

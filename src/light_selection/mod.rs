@@ -241,6 +241,10 @@ pub fn make_selector(
             SELECTORS.join(", ")
         ),
     };
-    let name = SELECTORS.iter().copied().find(|&n| n == name).unwrap_or("?");
+    let name = SELECTORS
+        .iter()
+        .copied()
+        .find(|&n| n == name)
+        .unwrap_or("?");
     Ok(Box::new(Selector::new(name, set, finite)))
 }

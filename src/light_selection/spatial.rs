@@ -65,9 +65,21 @@ impl Grid {
         }
         let edge = (vol / target.max(1) as f64).powf(1.0 / axes.max(1) as f64) as f32;
         let dims = UVec3::new(
-            if flat.x { 1 } else { (ext.x / edge).ceil().clamp(1.0, 256.0) as u32 },
-            if flat.y { 1 } else { (ext.y / edge).ceil().clamp(1.0, 256.0) as u32 },
-            if flat.z { 1 } else { (ext.z / edge).ceil().clamp(1.0, 256.0) as u32 },
+            if flat.x {
+                1
+            } else {
+                (ext.x / edge).ceil().clamp(1.0, 256.0) as u32
+            },
+            if flat.y {
+                1
+            } else {
+                (ext.y / edge).ceil().clamp(1.0, 256.0) as u32
+            },
+            if flat.z {
+                1
+            } else {
+                (ext.z / edge).ceil().clamp(1.0, 256.0) as u32
+            },
         );
         Self {
             lo,
@@ -228,7 +240,11 @@ impl SpatialSelector {
         w.sort_unstable_by_key(|&(l, _)| l);
         let weights: Vec<f32> = w.iter().map(|&(_, x)| x).collect();
         let mut t = CellTable::new(w.into_iter().map(|(l, _)| l).collect(), &weights);
-        t.rest = if total > 0.0 { (1.0 - kept / total) as f32 } else { 0.0 };
+        t.rest = if total > 0.0 {
+            (1.0 - kept / total) as f32
+        } else {
+            0.0
+        };
         t
     }
 

@@ -111,7 +111,11 @@ impl WaldSelector {
         let weights: Vec<f32> = avg.iter().map(|&a| a as f32).collect();
         let seen = weights.iter().filter(|&&w| w > 0.0).count();
         // Nothing seen at all (camera sees no lit surface): power selection alone.
-        let floor = if seen == 0 { 1.0 } else { cfg.floor.clamp(0.0, 1.0) };
+        let floor = if seen == 0 {
+            1.0
+        } else {
+            cfg.floor.clamp(0.0, 1.0)
+        };
         Self {
             estimate: PowerSelector::from_weights(&weights),
             power,

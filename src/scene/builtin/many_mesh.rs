@@ -29,9 +29,26 @@ pub fn many_mesh(opts: &BuiltinOptions) -> anyhow::Result<Scene> {
     let floor = diffuse(&mut b, 0.5);
     let wall = diffuse(&mut b, 0.6);
     let black = diffuse(&mut b, 0.05);
-    b.add_quad(Vec3::new(-6.0, 0.0, -6.0), Vec3::Z * 12.0, Vec3::X * 12.0, floor, None)?;
-    b.add_quad(Vec3::new(-6.0, 0.0, 3.0), Vec3::Y * 5.0, Vec3::X * 12.0, wall, None)?;
-    add_box(&mut b, Vec3::new(1.2, 0.0, -1.0), Vec3::new(2.0, 0.8, -0.2), wall)?;
+    b.add_quad(
+        Vec3::new(-6.0, 0.0, -6.0),
+        Vec3::Z * 12.0,
+        Vec3::X * 12.0,
+        floor,
+        None,
+    )?;
+    b.add_quad(
+        Vec3::new(-6.0, 0.0, 3.0),
+        Vec3::Y * 5.0,
+        Vec3::X * 12.0,
+        wall,
+        None,
+    )?;
+    add_box(
+        &mut b,
+        Vec3::new(1.2, 0.0, -1.0),
+        Vec3::new(2.0, 0.8, -0.2),
+        wall,
+    )?;
     // Torus: ring radius 1, tube radius 0.3, centre (0, 1.3, 0.5), tilted toward the camera.
     let (big, small) = (1.0f32, 0.3f32);
     let rot = Quat::from_rotation_x(1.2);
@@ -49,7 +66,10 @@ pub fn many_mesh(opts: &BuiltinOptions) -> anyhow::Result<Scene> {
         let mut normals = Vec::new();
         for i in 0..=per_band {
             for j in 0..=nv {
-                let (p, n) = point((band * per_band + i) as f32 / nu as f32, j as f32 / nv as f32);
+                let (p, n) = point(
+                    (band * per_band + i) as f32 / nu as f32,
+                    j as f32 / nv as f32,
+                );
                 positions.push(p);
                 normals.push(n);
             }

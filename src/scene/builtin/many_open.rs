@@ -3,8 +3,8 @@
 //! The floor grows with N so the light density stays about one light per square metre.
 
 use super::many_util::{
-    add_box, add_triangle_light, diffuse, emission, log_uniform, radiance_for_power,
-    random_colour, scene_rng, uniform,
+    add_box, add_triangle_light, diffuse, emission, log_uniform, radiance_for_power, random_colour,
+    scene_rng, uniform,
 };
 use super::{BuiltinOptions, Scene};
 use crate::camera::Camera;

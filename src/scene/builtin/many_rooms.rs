@@ -23,7 +23,10 @@ const DOOR: (f32, f32) = (1.0, 2.2);
 /// Build `many-rooms`.
 pub fn many_rooms(opts: &BuiltinOptions) -> anyhow::Result<Scene> {
     let r = opts.rooms.unwrap_or(8);
-    ensure!((1..=64).contains(&r), "--rooms must be between 1 and 64, got {r}");
+    ensure!(
+        (1..=64).contains(&r),
+        "--rooms must be between 1 and 64, got {r}"
+    );
     let per_room = match opts.light_count {
         Some(n) => n.div_ceil(r * r).clamp(1, 256),
         None => 4,
@@ -42,15 +45,26 @@ pub fn many_rooms(opts: &BuiltinOptions) -> anyhow::Result<Scene> {
         for i in 0..=r {
             for j in 0..r {
                 let inner = i > 0 && i < r;
-                let door = inner.then(|| uniform(&mut rng, 0.3 + DOOR.0 * 0.5, ROOM - 0.3 - DOOR.0 * 0.5));
+                let door =
+                    inner.then(|| uniform(&mut rng, 0.3 + DOOR.0 * 0.5, ROOM - 0.3 - DOOR.0 * 0.5));
                 let at = |along: f32, y: f32| {
                     let a = i as f32 * ROOM;
                     let s = j as f32 * ROOM + along;
-                    if axis == 0 { Vec3::new(a, y, s) } else { Vec3::new(s, y, a) }
+                    if axis == 0 {
+                        Vec3::new(a, y, s)
+                    } else {
+                        Vec3::new(s, y, a)
+                    }
                 };
                 let run = if axis == 0 { Vec3::Z } else { Vec3::X };
                 let mut seg = |from: f32, to: f32, y0: f32, y1: f32| {
-                    b.add_quad(at(from, y0), run * (to - from), Vec3::Y * (y1 - y0), wall, None)
+                    b.add_quad(
+                        at(from, y0),
+                        run * (to - from),
+                        Vec3::Y * (y1 - y0),
+                        wall,
+                        None,
+                    )
                 };
                 match door {
                     None => seg(0.0, ROOM, 0.0, HEIGHT)?,
@@ -74,7 +88,11 @@ pub fn many_rooms(opts: &BuiltinOptions) -> anyhow::Result<Scene> {
                     HEIGHT - 0.01,
                     rz as f32 * ROOM + uniform(&mut rng, 0.3, ROOM - 0.3 - s),
                 );
-                let l = radiance_for_power(log_uniform(&mut rng, 5.0, 50.0), s * s, random_colour(&mut rng));
+                let l = radiance_for_power(
+                    log_uniform(&mut rng, 5.0, 50.0),
+                    s * s,
+                    random_colour(&mut rng),
+                );
                 b.add_quad(p, Vec3::X * s, Vec3::Z * s, black, emission(l))?;
             }
         }
