@@ -232,15 +232,27 @@ fn bvh_build_benchmark(count: u32) -> anyhow::Result<()> {
     };
     let scene = load("many-open", &opts)?.scene;
     let set = LightSet::new(&scene.lights);
-    let t0 = Instant::now();
+    let (t0, c0) = (Instant::now(), cpu_seconds());
     let bvh = BvhSelector::new(&set.bounds);
     let t = t0.elapsed().as_secs_f64();
+    let cpu = cpu_seconds().zip(c0).map_or(f64::NAN, |(a, b)| a - b);
     println!();
     println!(
-        "light BVH over {} lights: build {t:.3} s, {} nodes, {:.1} bytes/light",
+        "light BVH over {} lights: build {t:.3} s wall ({cpu:.3} s CPU, all threads), {} nodes, {:.1} bytes/light",
         set.bounds.len(),
         bvh.node_count(),
         bvh.bytes_per_light()
     );
     Ok(())
+}
+
+/// CPU time (user + system) of this process so far, from /proc (Linux); `None` elsewhere. Wall
+/// time alone misleads on a shared machine.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the parenthesised command name; utime and stime are the 12th and 13th.
+    let rest = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
 }

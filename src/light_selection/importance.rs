@@ -127,6 +127,10 @@ pub fn union(a: &LightBounds, b: &LightBounds) -> LightBounds {
 
 /// The smallest cone (axis, cos of half angle) around two cones (pbrt-v4 `Union(DirectionCone)`).
 pub fn cone_union(wa: Vec3, cos_a: f32, wb: Vec3, cos_b: f32) -> (Vec3, f32) {
+    // Same axis (e.g. every light facing down): no trigonometry needed.
+    if wa == wb {
+        return (wa, cos_a.min(cos_b));
+    }
     let theta_a = cos_a.clamp(-1.0, 1.0).acos();
     let theta_b = cos_b.clamp(-1.0, 1.0).acos();
     let theta_d = wa.dot(wb).clamp(-1.0, 1.0).acos();
