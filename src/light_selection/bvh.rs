@@ -26,7 +26,7 @@ const TWO_SIDED: u32 = 1 << 30;
 /// The low 30 bits: second child's node index or the light index.
 const INDEX_MASK: u32 = TWO_SIDED - 1;
 /// Deepest tree the bit trails can describe; deeper subtrees are split by count.
-const MAX_DEPTH: u32 = 60;
+const MAX_DEPTH: u32 = 64;
 /// Buckets per axis of the SAOH split search.
 const BUCKETS: usize = 12;
 /// Subtrees with more lights than this are built in parallel.
@@ -368,7 +368,9 @@ fn split(items: &mut [Item], depth: u32) -> usize {
         items.select_nth_unstable_by(mid, |a, b| a.centroid[dim].total_cmp(&b.centroid[dim]));
         mid
     };
-    if depth >= MAX_DEPTH - 8 || ext.max_element() <= 0.0 {
+    // Halving from here on needs ⌈log2 n⌉ more levels: switch to it while they still fit.
+    let halving_depth = usize::BITS - (n - 1).leading_zeros();
+    if depth + halving_depth + 2 >= MAX_DEPTH || ext.max_element() <= 0.0 {
         return by_count(items);
     }
     let mut best = (f32::INFINITY, 0usize, 0usize);
