@@ -27,7 +27,9 @@ fn no_nan_or_inf_in_any_strategy_and_pattern_on_builtin_scenes() {
                 let (img, stats) = render(&scene, UVec2::new(24, 24), &o).unwrap();
                 assert_eq!(stats.non_finite, 0, "{} {strategy} {pattern}", b.name);
                 assert!(
-                    img.pixels.iter().all(|p| p.is_finite() && p.min_element() >= 0.0),
+                    img.pixels
+                        .iter()
+                        .all(|p| p.is_finite() && p.min_element() >= 0.0),
                     "{} {strategy} {pattern}: non-finite or negative pixel",
                     b.name
                 );
@@ -42,13 +44,18 @@ fn cli_render_writes_the_image_and_reports() {
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("c.exr");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_penumbra"))
-        .args(["render", "cornell", "--spp", "2", "--res", "32x24", "--quiet", "-o"])
+        .args([
+            "render", "cornell", "--spp", "2", "--res", "32x24", "--quiet", "-o",
+        ])
         .arg(&out)
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let line = String::from_utf8_lossy(&o.stdout);
-    assert!(line.contains("32x24") && line.contains("Mrays/s"), "summary: {line}");
+    assert!(
+        line.contains("32x24") && line.contains("Mrays/s"),
+        "summary: {line}"
+    );
     let img = penumbra::image::io::read_image(&out).unwrap();
     assert_eq!((img.width, img.height), (32, 24));
     // Bad input: a clear error and a non-zero exit, never a panic.
@@ -57,7 +64,16 @@ fn cli_render_writes_the_image_and_reports() {
         vec!["render", "cornell", "--res", "0x5"],
         vec!["render", "cornell", "--strategy", "magic"],
         vec!["render", "cornell", "--spp", "0"],
-        vec!["render", "cornell", "-o", "/tmp/x.bmp", "--spp", "1", "--res", "4x4"],
+        vec![
+            "render",
+            "cornell",
+            "-o",
+            "/tmp/x.bmp",
+            "--spp",
+            "1",
+            "--res",
+            "4x4",
+        ],
     ] {
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_penumbra"))
             .args(&args)

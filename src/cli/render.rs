@@ -63,6 +63,9 @@ pub struct Args {
     /// Rooms per side of `many-rooms`.
     #[arg(long)]
     pub rooms: Option<u32>,
+    /// Triangle count of procedural meshes (`dense`).
+    #[arg(long)]
+    pub triangles: Option<u32>,
     /// OBJ: treat the MTL ambient colour Ka as emitted radiance (Embree Cornell-box files).
     #[arg(long)]
     pub obj_ka_emission: bool,
@@ -131,7 +134,7 @@ pub fn load_options(a: &Args) -> LoadOptions {
         builtin: BuiltinOptions {
             light_count: a.light_count,
             rooms: a.rooms,
-            triangles: None,
+            triangles: a.triangles,
         },
         obj_ka_emission: a.obj_ka_emission,
         view: ViewOptions {
