@@ -185,6 +185,7 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
     };
     let lopts = LoadOptions {
         builtin: bopts.clone(),
+        ..LoadOptions::default()
     };
     let names: Vec<String> = if args.scenes.is_empty() {
         MANY.iter().map(|s| s.to_string()).collect()
@@ -281,6 +282,7 @@ fn bvh_build_benchmark(count: u32) -> anyhow::Result<()> {
             light_count: Some(count),
             ..BuiltinOptions::default()
         },
+        ..LoadOptions::default()
     };
     let scene = load("many-open", &opts)?.scene;
     let set = LightSet::new(&scene.lights);
