@@ -57,7 +57,7 @@ fn scene(add: impl FnOnce(&mut SceneBuilder)) -> Scene {
 /// Mean and standard error of the radiance toward a ray hitting the plane at the origin,
 /// over `pixels` independent sample sets of `spp` eye samples × `m` light samples.
 fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> (f64, f64) {
-    let selector = make_selector("uniform", scene).unwrap();
+    let selector = make_selector("uniform", scene, 7).unwrap();
     let pattern = make_pattern(pattern, 7);
     let spp = 16;
     let est = DirectLighting {
