@@ -20,8 +20,10 @@ use crate::image::Image;
 const BACKGROUND: [u8; 3] = [40, 40, 40];
 /// Outline of the domain.
 const OUTLINE: [u8; 3] = [150, 150, 150];
-/// Pixels per side of one scatter panel (one hemisphere disk, or the plane's longer side).
+/// Diameter of one hemisphere disk of the scatter panel.
 const SCATTER_PX: u32 = 360;
+/// Longer side of a planar scatter panel.
+const PLANE_PX: u32 = 512;
 /// Width the grid panels are scaled to (approximately; cells stay whole pixels).
 const GRID_PX: u32 = 512;
 /// Residuals beyond this many standard deviations saturate the difference colours.
@@ -52,11 +54,11 @@ impl ScatterLayout {
             },
             Domain::Plane { rect, .. } => {
                 let (w, h) = (rect[1] - rect[0], rect[3] - rect[2]);
-                let s = SCATTER_PX as f32 / w.max(h).max(f32::MIN_POSITIVE);
+                let s = PLANE_PX as f32 / w.max(h).max(f32::MIN_POSITIVE);
                 Self {
                     domain,
-                    width: ((w * s).round() as u32).clamp(8, SCATTER_PX),
-                    height: ((h * s).round() as u32).clamp(8, SCATTER_PX),
+                    width: ((w * s).round() as u32).clamp(8, PLANE_PX),
+                    height: ((h * s).round() as u32).clamp(8, PLANE_PX),
                 }
             }
         }
@@ -149,23 +151,27 @@ fn to_u8(c: Rgb) -> [u8; 3] {
     [c.x, c.y, c.z].map(|v| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
 }
 
-/// A `res.0 × res.1` grid (row-major, first index = first coordinate) as an image: on the
-/// sphere rows are cos θ from +1 (top) to −1, columns φ from 0 to 2π; on the plane columns are
-/// x and rows y (upwards unless `y_down`).
+/// A `res.0 × res.1` grid (row-major, first index = first coordinate) as an image with the
+/// domain's aspect ratio: on the sphere rows are cos θ from +1 (top) to −1 and columns φ from
+/// 0 to 2π (the equal-area 2 × 2π map, so 2:1); on the plane columns are x and rows y
+/// (upwards unless `y_down`).
 fn grid_image(domain: Domain, res: (usize, usize), color: impl Fn(usize) -> [u8; 3]) -> RgbImage {
     let (na, nb) = (res.0.max(1), res.1.max(1));
-    let (cols, rows) = match domain {
-        Domain::Sphere => (nb, na),
-        Domain::Plane { .. } => (na, nb),
+    let (cols, rows, aspect) = match domain {
+        Domain::Sphere => (nb, na, 0.5),
+        Domain::Plane { rect, .. } => {
+            let a = (rect[3] - rect[2]) / (rect[1] - rect[0]);
+            (na, nb, if a.is_finite() { a.clamp(0.1, 10.0) } else { 1.0 })
+        }
     };
-    let cell = (GRID_PX / cols as u32).max(1);
-    let cell_h = match domain {
-        // Keep the (cos θ, φ) map at aspect 2:1 (its true equal-area shape: 2 × 2π).
-        Domain::Sphere => ((GRID_PX / 2) / rows as u32).max(1),
-        Domain::Plane { .. } => cell,
+    let (w, h) = if aspect <= 1.0 {
+        (GRID_PX, (GRID_PX as f32 * aspect).round().max(1.0) as u32)
+    } else {
+        ((GRID_PX as f32 / aspect).round().max(1.0) as u32, GRID_PX)
     };
-    RgbImage::from_fn(cols as u32 * cell, rows as u32 * cell_h, |x, y| {
-        let (c, r) = ((x / cell) as usize, (y / cell_h) as usize);
+    RgbImage::from_fn(w, h, |x, y| {
+        let c = (x as usize * cols / w as usize).min(cols - 1);
+        let r = (y as usize * rows / h as usize).min(rows - 1);
         let k = match domain {
             Domain::Sphere => (na - 1 - r) * nb + c,
             Domain::Plane { y_down, .. } => c * nb + if y_down { r } else { nb - 1 - r },
