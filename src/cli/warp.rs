@@ -126,7 +126,7 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
     println!("statistic   {}", c.statistic);
     println!("dof         {}", c.dof);
     println!("p-value     {:e}", c.p_value);
-    println!("alpha       {}", c.alpha);
+    println!("alpha       {:.3e}", c.alpha);
     let note = if r.independent {
         String::new()
     } else {

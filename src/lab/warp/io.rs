@@ -77,8 +77,12 @@ fn is_npy(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
 }
 
-/// Write `table` to `path` (text or `.npy`); a one-column table becomes a 1-D array.
+/// Write `table` to `path` (text or `.npy`), creating missing parent directories; a
+/// one-column table becomes a 1-D array.
 pub fn write_table<T: Scalar>(path: &Path, table: &Table<T>) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
     let bytes = if is_npy(path) {
         npy_bytes(table)
     } else {
