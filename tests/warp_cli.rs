@@ -104,7 +104,10 @@ fn dump_pdf_round_trips_through_the_binary() {
             "{routine}"
         );
         // The samples were drawn by the routine, so its pdf is positive at every one of them.
-        assert!(lib.iter().all(|&v| v > 0.0), "{routine}: zero pdf at a sample");
+        assert!(
+            lib.iter().all(|&v| v > 0.0),
+            "{routine}: zero pdf at a sample"
+        );
     }
 }
 
@@ -217,14 +220,26 @@ fn chi2_points_and_patterns_equal_the_harness() {
     let direct = chi2_points(
         &chi2_config(&warp, &cfg),
         [-1.0, 2.0, 0.0, 1.2],
-        |u| Some(penumbra::sampling::uniform_triangle_point(Vec2::new(u[1], u[2]), a, b, c).truncate()),
+        |u| {
+            Some(
+                penumbra::sampling::uniform_triangle_point(Vec2::new(u[1], u[2]), a, b, c)
+                    .truncate(),
+            )
+        },
         |p| warp.pdf(p.extend(0.0)),
     );
     assert_eq!(lib.chi2.statistic.to_bits(), direct.statistic.to_bits());
     assert!(lib.chi2.passed, "{}", lib.chi2.summary());
 
     // Pattern input: the CLI's statistic is chi2_directions_from on the pattern's samples.
-    let o = penumbra(&["cosine-power", "-n", "4096", "--pattern", "sobol", "--no-plots"]);
+    let o = penumbra(&[
+        "cosine-power",
+        "-n",
+        "4096",
+        "--pattern",
+        "sobol",
+        "--no-plots",
+    ]);
     assert!(o.status.success(), "{:?}", text(&o));
     let (stdout, _) = text(&o);
     let stat: f64 = printed(&stdout, "statistic").parse().unwrap();
@@ -247,7 +262,14 @@ fn chi2_points_and_patterns_equal_the_harness() {
 #[test]
 fn chi2_rejection_exits_non_zero() {
     // At α = 0.999 a correct sampler is rejected unless p ≥ 0.999: the exit status must say so.
-    let o = penumbra(&["sphere", "-n", "5000", "--no-plots", "--significance", "0.999"]);
+    let o = penumbra(&[
+        "sphere",
+        "-n",
+        "5000",
+        "--no-plots",
+        "--significance",
+        "0.999",
+    ]);
     let (stdout, stderr) = text(&o);
     let pval: f64 = printed(&stdout, "p-value").parse().unwrap();
     assert!(pval < 0.999, "choose another seed: p = {pval}");
@@ -277,10 +299,19 @@ fn bad_params_fail_cleanly() {
         (vec!["cosine-power", "-p", "m=2"], "no parameter \"m\""),
         (vec!["sphere", "-p", "n=2"], "takes no parameters"),
         (vec!["no-such-warp"], "unknown routine"),
-        (vec!["triangle", "-p", "a=0,0", "-p", "b=1,1", "-p", "c=2,2"], "degenerate"),
+        (
+            vec!["triangle", "-p", "a=0,0", "-p", "b=1,1", "-p", "c=2,2"],
+            "degenerate",
+        ),
         (vec!["triangle", "-p", "a=0,0,0"], "expected 2"),
-        (vec!["spherical-triangle", "-p", "a=1,0,0", "-p", "b=2,0,0"], "degenerate"),
-        (vec!["spherical-rectangle", "-p", "ex=1,0,0", "-p", "ey=1,1,0"], "degenerate"),
+        (
+            vec!["spherical-triangle", "-p", "a=1,0,0", "-p", "b=2,0,0"],
+            "degenerate",
+        ),
+        (
+            vec!["spherical-rectangle", "-p", "ex=1,0,0", "-p", "ey=1,1,0"],
+            "degenerate",
+        ),
         (vec!["cone", "-p", "angle=0"], "angle"),
         (vec!["cone", "-p", "angle=200"], "angle"),
         (vec!["phong", "-p", "kd=0.7", "-p", "ks=0.6"], "exceeds 1"),
@@ -290,14 +321,23 @@ fn bad_params_fail_cleanly() {
         (vec!["ggx", "-p", "alpha=-0.1"], "alpha"),
         (vec!["ggx", "-p", "sampling=best"], "sampling"),
         (vec!["coated-diffuse", "-p", "eta=0.5"], "eta"),
-        (vec!["piecewise-2d", "-p", "image=/no/such/file.png"], "image"),
+        (
+            vec!["piecewise-2d", "-p", "image=/no/such/file.png"],
+            "image",
+        ),
         (vec!["cosine-hemisphere", "-n", "0"], "count"),
-        (vec!["cosine-hemisphere", "--significance", "2"], "significance"),
+        (
+            vec!["cosine-hemisphere", "--significance", "2"],
+            "significance",
+        ),
         (vec!["cosine-hemisphere", "--pattern", "halton"], "halton"),
         (vec!["cosine-hemisphere", "--pdf-at", w], "coordinates"),
         (vec!["cosine-hemisphere", "--pdf-at", r], "line 2"),
         (vec!["cosine-hemisphere", "--pdf-at", g], "npy"),
-        (vec!["cosine-hemisphere", "--pdf-at", "/no/such/points.txt"], "points.txt"),
+        (
+            vec!["cosine-hemisphere", "--pdf-at", "/no/such/points.txt"],
+            "points.txt",
+        ),
     ];
     for (args, needle) in cases {
         let mut a = args.clone();
@@ -305,16 +345,16 @@ fn bad_params_fail_cleanly() {
         let o = penumbra(&a);
         let (stdout, stderr) = text(&o);
         assert!(!o.status.success(), "{args:?} succeeded:\n{stdout}");
-        assert!(
-            !stderr.contains("panicked"),
-            "{args:?} panicked:\n{stderr}"
-        );
+        assert!(!stderr.contains("panicked"), "{args:?} panicked:\n{stderr}");
         assert!(
             matches!(o.status.code(), Some(1) | Some(2)),
             "{args:?}: exit {:?}\n{stderr}",
             o.status.code()
         );
-        assert!(stderr.contains(needle), "{args:?}: {needle:?} not in:\n{stderr}");
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: {needle:?} not in:\n{stderr}"
+        );
     }
 }
 
@@ -339,7 +379,12 @@ fn chi2_every_listed_routine_passes_with_defaults() {
         };
         let res = run(&warp, &cfg);
         eprintln!("{}: {}", r.name, res.chi2.summary());
-        assert!(res.chi2.p_value >= alpha, "{}: {}", r.name, res.chi2.summary());
+        assert!(
+            res.chi2.p_value >= alpha,
+            "{}: {}",
+            r.name,
+            res.chi2.summary()
+        );
         assert!(res.chi2.dof > 10, "{}: too coarse a test", r.name);
     }
 }

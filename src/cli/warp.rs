@@ -59,7 +59,12 @@ fn parse_res(s: &str) -> Result<(usize, usize), String> {
     let (a, b) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected AxB, got {s:?}"))?;
-    let p = |t: &str| t.trim().parse::<usize>().ok().filter(|&v| (1..=4096).contains(&v));
+    let p = |t: &str| {
+        t.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&v| (1..=4096).contains(&v))
+    };
     match (p(a), p(b)) {
         (Some(a), Some(b)) => Ok((a, b)),
         _ => Err(format!("expected AxB with 1 <= A, B <= 4096, got {s:?}")),
@@ -82,11 +87,18 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         let points: Table<f32> = read_table(input)?;
         let pdf = pdf_at(&warp, points.cols, &points.values)
             .with_context(|| format!("--pdf-at {}", input.display()))?;
-        let table = Table { cols: 1, values: pdf };
+        let table = Table {
+            cols: 1,
+            values: pdf,
+        };
         match &args.dump_pdf {
             Some(out) => {
                 write_table(out, &table)?;
-                println!("wrote {} pdf values to {}", table.values.len(), out.display());
+                println!(
+                    "wrote {} pdf values to {}",
+                    table.values.len(),
+                    out.display()
+                );
             }
             None => table.values.iter().for_each(|v| println!("{v}")),
         }
@@ -97,7 +109,10 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         bail!("--count must be in 1..={}", u32::MAX);
     }
     if !(args.significance > 0.0 && args.significance < 1.0) {
-        bail!("--significance must be in (0, 1), got {}", args.significance);
+        bail!(
+            "--significance must be in (0, 1), got {}",
+            args.significance
+        );
     }
     let cfg = RunConfig {
         count: args.count,
@@ -138,7 +153,11 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
     println!(
         "verdict     {}{}",
         if c.passed { "PASSED" } else { "REJECTED" },
-        if note.is_empty() { String::new() } else { format!(" ({note})") }
+        if note.is_empty() {
+            String::new()
+        } else {
+            format!(" ({note})")
+        }
     );
 
     if let Some(path) = &args.dump {
@@ -152,7 +171,11 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         println!("wrote {} samples to {}", r.samples.len(), path.display());
     }
     if !args.no_plots {
-        let short = if r.independent { "" } else { "non-independent pattern" };
+        let short = if r.independent {
+            ""
+        } else {
+            "non-independent pattern"
+        };
         for p in plot::write_plots(&args.out, &warp, &r, short)? {
             println!("wrote {}", p.display());
         }

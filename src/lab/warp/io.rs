@@ -155,7 +155,11 @@ pub fn parse_text<T: Scalar>(text: &str) -> anyhow::Result<Table<T>> {
         if cols == 0 {
             cols = row.len();
         } else if row.len() != cols {
-            bail!("line {}: {} values, but earlier rows have {cols}", n + 1, row.len());
+            bail!(
+                "line {}: {} values, but earlier rows have {cols}",
+                n + 1,
+                row.len()
+            );
         }
         values.extend(row);
     }
@@ -195,7 +199,10 @@ pub fn parse_npy<T: Scalar>(bytes: &[u8]) -> anyhow::Result<Table<T>> {
     } else if descr.starts_with("'<f8'") {
         8
     } else {
-        bail!("dtype {:?} is not <f4 or <f8", descr.split(',').next().unwrap_or(""));
+        bail!(
+            "dtype {:?} is not <f4 or <f8",
+            descr.split(',').next().unwrap_or("")
+        );
     };
     if !field("fortran_order")?.starts_with("False") {
         bail!("Fortran-ordered arrays are not supported");
@@ -219,7 +226,10 @@ pub fn parse_npy<T: Scalar>(bytes: &[u8]) -> anyhow::Result<Table<T>> {
     let count = rows.checked_mul(cols).context("shape overflows")?;
     let data = &bytes[start + header_len..];
     if data.len() != count * size {
-        bail!("{} data bytes for shape ({rows}, {cols}) of {size}-byte values", data.len());
+        bail!(
+            "{} data bytes for shape ({rows}, {cols}) of {size}-byte values",
+            data.len()
+        );
     }
     let values = if size == 4 {
         data.chunks_exact(4)

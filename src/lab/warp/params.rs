@@ -26,9 +26,15 @@ pub struct Params {
 impl Params {
     /// Defaults of `specs` overridden by `overrides` (each `KEY=VALUE`); an unknown key or a
     /// pair without `=` is an error that lists the valid keys.
-    pub fn new(routine: &'static str, specs: &[ParamSpec], overrides: &[String]) -> anyhow::Result<Self> {
-        let mut values: BTreeMap<&'static str, String> =
-            specs.iter().map(|s| (s.key, s.default.to_string())).collect();
+    pub fn new(
+        routine: &'static str,
+        specs: &[ParamSpec],
+        overrides: &[String],
+    ) -> anyhow::Result<Self> {
+        let mut values: BTreeMap<&'static str, String> = specs
+            .iter()
+            .map(|s| (s.key, s.default.to_string()))
+            .collect();
         let keys = || {
             if specs.is_empty() {
                 "it takes no parameters".to_string()
@@ -39,11 +45,17 @@ impl Params {
         };
         for pair in overrides {
             let Some((key, value)) = pair.split_once('=') else {
-                bail!("--param {pair:?}: expected KEY=VALUE ({routine}: {})", keys());
+                bail!(
+                    "--param {pair:?}: expected KEY=VALUE ({routine}: {})",
+                    keys()
+                );
             };
             let key = key.trim();
             let Some(spec) = specs.iter().find(|s| s.key == key) else {
-                bail!("--param {pair:?}: {routine} has no parameter {key:?} ({})", keys());
+                bail!(
+                    "--param {pair:?}: {routine} has no parameter {key:?} ({})",
+                    keys()
+                );
             };
             values.insert(spec.key, value.trim().to_string());
         }
@@ -106,6 +118,10 @@ impl Params {
 
     /// Error for a value that parses but is out of range: names routine, key and value.
     pub fn invalid(&self, key: &str, why: impl std::fmt::Display) -> anyhow::Error {
-        anyhow::anyhow!("{}: parameter {key}={:?} {why}", self.routine, self.raw(key))
+        anyhow::anyhow!(
+            "{}: parameter {key}={:?} {why}",
+            self.routine,
+            self.raw(key)
+        )
     }
 }

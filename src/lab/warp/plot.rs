@@ -11,10 +11,10 @@ use std::path::{Path, PathBuf};
 use super::registry::{Domain, Warp};
 use super::run::RunResult;
 use crate::Rgb;
+use crate::image::Image;
 use crate::image::colormap::viridis;
 use crate::image::io::{save_png_atomic, srgb_to_linear};
 use crate::image::montage::montage;
-use crate::image::Image;
 
 /// Background outside the domain.
 const BACKGROUND: [u8; 3] = [40, 40, 40];
@@ -161,7 +161,15 @@ fn grid_image(domain: Domain, res: (usize, usize), color: impl Fn(usize) -> [u8;
         Domain::Sphere => (nb, na, 0.5),
         Domain::Plane { rect, .. } => {
             let a = (rect[3] - rect[2]) / (rect[1] - rect[0]);
-            (na, nb, if a.is_finite() { a.clamp(0.1, 10.0) } else { 1.0 })
+            (
+                na,
+                nb,
+                if a.is_finite() {
+                    a.clamp(0.1, 10.0)
+                } else {
+                    1.0
+                },
+            )
         }
     };
     let (w, h) = if aspect <= 1.0 {
@@ -200,7 +208,11 @@ pub fn histogram_and_pdf(domain: Domain, r: &RunResult) -> (RgbImage, RgbImage) 
 
 /// Diverging colour for a standardised residual t ∈ [−1, 1]: blue below, red above, dark at 0.
 fn diverging(t: f64) -> [u8; 3] {
-    let t = if t.is_nan() { 0.0 } else { t.clamp(-1.0, 1.0) as f32 };
+    let t = if t.is_nan() {
+        0.0
+    } else {
+        t.clamp(-1.0, 1.0) as f32
+    };
     let mid = Rgb::splat(0.12);
     let end = if t >= 0.0 {
         Rgb::new(1.0, 0.25, 0.2)
@@ -215,7 +227,10 @@ fn diverging(t: f64) -> [u8; 3] {
 pub fn difference(domain: Domain, r: &RunResult) -> RgbImage {
     let (o, e) = (&r.chi2.observed, &r.chi2.expected);
     grid_image(domain, r.chi2.res, |k| {
-        let (o, e) = (o.get(k).copied().unwrap_or(0.0), e.get(k).copied().unwrap_or(0.0));
+        let (o, e) = (
+            o.get(k).copied().unwrap_or(0.0),
+            e.get(k).copied().unwrap_or(0.0),
+        );
         diverging((o - e) / e.max(1.0).sqrt() / RESIDUAL_RANGE)
     })
 }
@@ -234,7 +249,12 @@ fn linear(img: &RgbImage) -> Image {
 
 /// Write `NAME_samples.png`, `NAME_histogram.png`, `NAME_pdf.png`, `NAME_difference.png` and
 /// the labelled overview `NAME.png` into `dir`; returns the paths written.
-pub fn write_plots(dir: &Path, warp: &Warp, r: &RunResult, note: &str) -> anyhow::Result<Vec<PathBuf>> {
+pub fn write_plots(
+    dir: &Path,
+    warp: &Warp,
+    r: &RunResult,
+    note: &str,
+) -> anyhow::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)
         .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
     let samples = scatter(warp.domain, &r.samples);
@@ -250,10 +270,18 @@ pub fn write_plots(dir: &Path, warp: &Warp, r: &RunResult, note: &str) -> anyhow
         _ => "samples".to_string(),
     };
     let panels = [
-        (&samples, "samples", format!("{scatter_label}\n{} of {}", r.samples.len(), r.attempts)),
+        (
+            &samples,
+            "samples",
+            format!("{scatter_label}\n{} of {}", r.samples.len(), r.attempts),
+        ),
         (&hist, "histogram", format!("histogram\n{grid_axes}")),
         (&pdf, "pdf", "integrated pdf (same scale)".to_string()),
-        (&diff, "difference", format!("(O − E)/√E, ±{RESIDUAL_RANGE}σ\nblue: too few, red: too many")),
+        (
+            &diff,
+            "difference",
+            format!("(O − E)/√E, ±{RESIDUAL_RANGE}σ\nblue: too few, red: too many"),
+        ),
     ];
     let mut written = Vec::new();
     for (img, suffix, _) in &panels {
@@ -261,8 +289,10 @@ pub fn write_plots(dir: &Path, warp: &Warp, r: &RunResult, note: &str) -> anyhow
         save_png_atomic(img, &path)?;
         written.push(path);
     }
-    let linear_panels: Vec<(Image, String)> =
-        panels.iter().map(|(img, _, l)| (linear(img), l.clone())).collect();
+    let linear_panels: Vec<(Image, String)> = panels
+        .iter()
+        .map(|(img, _, l)| (linear(img), l.clone()))
+        .collect();
     let mut title = format!("{} — {}", warp.label, r.chi2.summary());
     if !note.is_empty() {
         title.push_str(&format!(" ({note})"));

@@ -13,9 +13,9 @@ use crate::bsdf::{Bsdf, Bxdf, CoatedDiffuse, Conductor, Lambert, LobeSampling, P
 use crate::image::read_image;
 use crate::sampling::{
     Distribution2D, SphericalRectangle, SphericalTriangle, concentric_disk, concentric_disk_pdf,
-    cosine_hemisphere, cosine_hemisphere_pdf, cosine_power_hemisphere,
-    cosine_power_hemisphere_pdf, uniform_cone, uniform_cone_pdf, uniform_hemisphere,
-    uniform_hemisphere_pdf, uniform_sphere, uniform_sphere_pdf, uniform_triangle_point,
+    cosine_hemisphere, cosine_hemisphere_pdf, cosine_power_hemisphere, cosine_power_hemisphere_pdf,
+    uniform_cone, uniform_cone_pdf, uniform_hemisphere, uniform_hemisphere_pdf, uniform_sphere,
+    uniform_sphere_pdf, uniform_triangle_point,
 };
 
 /// Where a routine's samples live.
@@ -114,10 +114,16 @@ impl Routine {
 
 /// Look up a routine by name; the error lists every name.
 pub fn find(name: &str) -> anyhow::Result<&'static Routine> {
-    ROUTINES.iter().find(|r| r.name == name.trim()).ok_or_else(|| {
-        let names: Vec<&str> = ROUTINES.iter().map(|r| r.name).collect();
-        anyhow::anyhow!("unknown routine {name:?}; expected one of: {}", names.join(", "))
-    })
+    ROUTINES
+        .iter()
+        .find(|r| r.name == name.trim())
+        .ok_or_else(|| {
+            let names: Vec<&str> = ROUTINES.iter().map(|r| r.name).collect();
+            anyhow::anyhow!(
+                "unknown routine {name:?}; expected one of: {}",
+                names.join(", ")
+            )
+        })
 }
 
 /// Build routine `name` with `overrides` (`KEY=VALUE` each).
@@ -131,7 +137,11 @@ pub fn list_text() -> String {
     for r in ROUTINES {
         s.push_str(&format!("{:<20} {}\n", r.name, r.summary));
         for p in r.params {
-            let d = if p.default.is_empty() { "(unset)" } else { p.default };
+            let d = if p.default.is_empty() {
+                "(unset)"
+            } else {
+                p.default
+            };
             s.push_str(&format!("    {:<12} = {:<22} {}\n", p.key, d, p.help));
         }
     }
@@ -334,7 +344,12 @@ pub static ROUTINES: &[Routine] = &[
             },
         ],
         build: |p| {
-            let (corner, ex, ey, o) = (p.vec3("corner")?, p.vec3("ex")?, p.vec3("ey")?, p.vec3("p")?);
+            let (corner, ex, ey, o) = (
+                p.vec3("corner")?,
+                p.vec3("ex")?,
+                p.vec3("ey")?,
+                p.vec3("p")?,
+            );
             let rect = SphericalRectangle::new(o, corner, ex, ey).ok_or_else(|| {
                 anyhow::anyhow!(
                     "spherical-rectangle: corner={corner}, ex={ex}, ey={ey} seen from p={o} is \
@@ -498,7 +513,11 @@ fn plane(
     sample: impl Fn(f32, Vec2) -> Option<Vec3> + Send + Sync + 'static,
     pdf: impl Fn(Vec3) -> f64 + Send + Sync + 'static,
 ) -> (Domain, SampleFn, PdfFn) {
-    (Domain::Plane { rect, y_down }, Box::new(sample), Box::new(pdf))
+    (
+        Domain::Plane { rect, y_down },
+        Box::new(sample),
+        Box::new(pdf),
+    )
 }
 
 /// A BSDF's sampler at outgoing direction `wo`: delta samples carry no density, so they
@@ -613,8 +632,13 @@ pub fn procedural_image() -> (Vec<f32>, usize, usize) {
 fn build_piecewise(p: &Params) -> anyhow::Result<(Domain, SampleFn, PdfFn)> {
     let (f, nu, nv) = if p.is_set("image") {
         let path = Path::new(p.raw("image"));
-        let img = read_image(path).with_context(|| format!("piecewise-2d: image={}", path.display()))?;
-        let f = img.pixels.iter().map(|&c| crate::luminance(c).max(0.0)).collect();
+        let img =
+            read_image(path).with_context(|| format!("piecewise-2d: image={}", path.display()))?;
+        let f = img
+            .pixels
+            .iter()
+            .map(|&c| crate::luminance(c).max(0.0))
+            .collect();
         (f, img.width as usize, img.height as usize)
     } else {
         procedural_image()

@@ -148,9 +148,7 @@ pub fn pdf_at(warp: &Warp, cols: usize, points: &[f32]) -> anyhow::Result<Vec<f6
         .map(|r| {
             let x = match warp.domain {
                 Domain::Sphere => Vec3::new(r[0], r[1], r[2]).try_normalize(),
-                Domain::Plane { .. } => {
-                    Some(Vec3::new(r[0], r[1], 0.0)).filter(|p| p.is_finite())
-                }
+                Domain::Plane { .. } => Some(Vec3::new(r[0], r[1], 0.0)).filter(|p| p.is_finite()),
             };
             x.map_or(0.0, |x| warp.pdf(x))
         })
