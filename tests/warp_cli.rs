@@ -260,6 +260,22 @@ fn chi2_points_and_patterns_equal_the_harness() {
 }
 
 #[test]
+fn chi2_negative_control_wrong_exponent_is_rejected() {
+    // Samples of n = 10 judged by the n = 12 routine's pdf through the CLI's own test path:
+    // the harness must have the power to tell them apart at the CLI's default count.
+    let (drawn, judge) = (
+        build("cosine-power", &["n=10".into()]).unwrap(),
+        build("cosine-power", &["n=12".into()]).unwrap(),
+    );
+    let cfg = RunConfig::default();
+    let good = run(&drawn, &cfg);
+    assert!(good.chi2.passed, "{}", good.chi2.summary());
+    let bad = test_samples(&judge, &chi2_config(&judge, &cfg), &good.samples, cfg.count);
+    eprintln!("n = 10 vs 12: {}", bad.summary());
+    assert!(!bad.passed, "harness has no power: {}", bad.summary());
+}
+
+#[test]
 fn chi2_rejection_exits_non_zero() {
     // At α = 0.999 a correct sampler is rejected unless p ≥ 0.999: the exit status must say so.
     let o = penumbra(&[

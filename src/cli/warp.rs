@@ -105,8 +105,10 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         return Ok(());
     }
 
-    if args.count == 0 || args.count > u32::MAX as usize {
-        bail!("--count must be in 1..={}", u32::MAX);
+    // Every accepted sample is kept for the plots and --dump: cap the memory at ~1.2 GB.
+    const MAX_COUNT: usize = 100_000_000;
+    if args.count == 0 || args.count > MAX_COUNT {
+        bail!("--count must be in 1..={MAX_COUNT}, got {}", args.count);
     }
     if !(args.significance > 0.0 && args.significance < 1.0) {
         bail!(
