@@ -22,11 +22,14 @@ pub enum Command {
     Bench(bench::Args),
     /// Compare an image with a reference: MSE, relMSE, MAE.
     Compare(compare::Args),
+    /// Plot and chi-square-test a sampling routine; dump samples, evaluate its pdf.
+    Warp(warp::Args),
 }
 
 pub mod bench;
 pub mod compare;
 pub mod render;
+pub mod warp;
 
 /// Dispatch a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -40,6 +43,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Some(Command::Bench(a)) => bench::run(a),
+        Some(Command::Warp(a)) => warp::run_cmd(a),
         None => match Cli::try_parse_from(["penumbra", "render"])?.command {
             Some(Command::Render(a)) => render::run(a),
             _ => unreachable!("`render` parses to the render command"),
