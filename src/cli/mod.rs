@@ -22,10 +22,13 @@ pub enum Command {
     Bench(bench::Args),
     /// Compare an image with a reference: MSE, relMSE, MAE.
     Compare(compare::Args),
+    /// Render the lecture's comparison figures with timings, relMSE and an HTML report.
+    Lab(lab::Args),
 }
 
 pub mod bench;
 pub mod compare;
+pub mod lab;
 pub mod render;
 
 /// Dispatch a parsed command line.
@@ -33,6 +36,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Render(a)) => render::run(a),
         Some(Command::Compare(a)) => compare::run(a),
+        Some(Command::Lab(a)) => lab::run(a),
         Some(Command::Scenes) => {
             for b in penumbra::scene::builtin::BUILTINS {
                 println!("{:<16} {}", b.name, b.description);
