@@ -6,6 +6,7 @@
 //! convergence plot and `index.html`.
 
 pub mod figures;
+pub mod mask;
 pub mod report;
 pub mod runner;
 

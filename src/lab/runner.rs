@@ -2,6 +2,7 @@
 //! of every figure, measures wall time and relMSE, writes images and montages, and sweeps the
 //! convergence of the four estimators. The report files are written by [`super::report`].
 
+use super::mask::{edge_mask, smooth_rel_mse};
 use super::figures::{Figure, FigureScene, LobeChoice, Panel, lecture_figures};
 use super::report::{
     ConvergencePoint, ConvergenceSeries, FigureResult, LabResults, PanelResult, ReferenceInfo,
@@ -77,6 +78,8 @@ impl Default for LabOptions {
 struct Prepared {
     scene: Scene,
     reference: Image,
+    /// Edge pixels of the reference (excluded from the smooth relMSE).
+    mask: Vec<bool>,
 }
 
 /// The built-in or main scene name a figure renders, or why it cannot run.
@@ -285,6 +288,7 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
                 path: path.display().to_string(),
                 spp: None,
                 time_s: 0.0,
+                smooth_fraction: 0.0,
             };
             (img, info)
         } else {
@@ -292,8 +296,18 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
             let (img, info) = cached_reference(&scene, name, res, opts, &progress)?;
             (img, info)
         };
+        let mask = edge_mask(&reference);
+        let mut info = info;
+        info.smooth_fraction = smooth_rel_mse(&reference, &reference, &mask).1;
         references.push(info);
-        prepared.insert(name.clone(), Prepared { scene, reference });
+        prepared.insert(
+            name.clone(),
+            Prepared {
+                scene,
+                reference,
+                mask,
+            },
+        );
     }
 
     // Figures.
@@ -340,6 +354,7 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
                 time_s: stats.time.as_secs_f64(),
                 rays: stats.rays,
                 rel_mse: err.rel_mse,
+                smooth_rel_mse: smooth_rel_mse(&img, &prep.reference, &prep.mask).0,
                 mse: err.mse,
                 exr: files.exr,
                 png: files.png,
@@ -388,6 +403,7 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
                     spp,
                     time_s: stats.time.as_secs_f64(),
                     rel_mse: err.rel_mse,
+                    smooth_rel_mse: smooth_rel_mse(&img, &prep.reference, &prep.mask).0,
                 });
             }
             convergence.push(ConvergenceSeries {
@@ -450,6 +466,7 @@ fn cached_reference(
         path: file,
         spp: Some(opts.reference_spp),
         time_s: 0.0,
+        smooth_fraction: 0.0,
     };
     if path.exists() {
         // A damaged or mis-sized cache is re-rendered rather than trusted.
