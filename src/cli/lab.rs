@@ -67,8 +67,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for f in &r.figures {
         for p in &f.panels {
             println!(
-                "{:<5} {:<20} {:<17} {:>4} × {:<4} {:>8.3} s  relMSE {:.4e}",
-                f.id, p.label, p.strategy, p.spp, p.shadow_rays, p.time_s, p.rel_mse
+                "{:<5} {:<14} {:<17} {:>3} × {:<4} {:>8.3} s  relMSE {:.3e}  smooth {:.3e}",
+                f.id,
+                p.label,
+                p.strategy,
+                p.spp,
+                p.shadow_rays,
+                p.time_s,
+                p.rel_mse,
+                p.smooth_rel_mse
             );
         }
         for s in f.skipped.iter().filter(|s| !s.is_empty()) {
@@ -79,8 +86,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let last = s.points.last();
         if let Some(p) = last {
             println!(
-                "convergence {:<17} {:>4} spp {:>8.3} s  relMSE {:.4e}",
-                s.strategy, p.spp, p.time_s, p.rel_mse
+                "convergence {:<17} {:>4} spp {:>8.3} s  relMSE {:.3e}  smooth {:.3e}",
+                s.strategy, p.spp, p.time_s, p.rel_mse, p.smooth_rel_mse
             );
         }
     }
