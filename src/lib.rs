@@ -5,6 +5,9 @@
 //! `light_selection` and the sample patterns of `sampling`; `image` accumulates and writes it.
 //! `sampling` knows nothing of rendering: all sampling math lives there.
 
+// `!(x > 0.0)` is how this crate rejects NaN together with non-positive values, on purpose.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod bsdf;
 pub mod camera;
 pub mod geometry;

@@ -49,7 +49,10 @@ fn check(strategy: Strategy, max_rel_mse: f64, mean_tol: f64) {
         100.0 * (m / mr - 1.0),
         stats.time.as_secs_f64()
     );
-    assert!(e <= max_rel_mse, "{strategy}: relMSE {e:.3e} > {max_rel_mse:.1e}");
+    assert!(
+        e <= max_rel_mse,
+        "{strategy}: relMSE {e:.3e} > {max_rel_mse:.1e}"
+    );
     assert!(
         (m / mr - 1.0).abs() <= mean_tol,
         "{strategy}: mean {m} differs from the reference's {mr} by more than {}%",

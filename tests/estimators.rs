@@ -9,9 +9,9 @@ use glam::{UVec2, Vec3};
 use penumbra::Rgb;
 use penumbra::camera::Camera;
 use penumbra::geometry::{Ray, Transform};
+use penumbra::integrator::MisHeuristic;
 use penumbra::integrator::Strategy;
 use penumbra::integrator::direct::DirectLighting;
-use penumbra::integrator::MisHeuristic;
 use penumbra::light_selection::make_selector;
 use penumbra::lights::{Light, UniformInfiniteLight};
 use penumbra::material::{Material, Texture};
@@ -68,6 +68,7 @@ fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> 
         mis: MisHeuristic::Power,
         eye_rays: spp,
         shadow_rays: m,
+        bsdf_sampling: penumbra::bsdf::LobeSampling::Importance,
     };
     // A ray that reaches the origin from the side, clear of lights above it.
     let o = Vec3::new(0.0, -3.0, 1.0);
@@ -144,7 +145,9 @@ fn sphere_light_irradiance_is_pi_l_sin2_alpha_for_every_strategy_and_pattern() {
 fn furnace_diffuse_plane_under_uniform_sky_reflects_rho_le() {
     let le = 2.0f32;
     let s = scene(|b| {
-        b.add_light(Light::UniformInfinite(UniformInfiniteLight::new(Rgb::splat(le))));
+        b.add_light(Light::UniformInfinite(UniformInfiniteLight::new(
+            Rgb::splat(le),
+        )));
     });
     for strategy in Strategy::ALL {
         let e = estimate(&s, strategy, PatternKind::Stratified, 1);

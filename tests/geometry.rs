@@ -41,7 +41,9 @@ fn triangle_hit_miss_edges_and_grazing() {
     let down = -Vec3::Z;
     let hit = intersect_triangle(Vec3::new(0.25, 0.25, 1.0), down, f32::INFINITY, p).unwrap();
     assert!((hit.0 - 1.0).abs() < 1e-6);
-    assert!((hit.1 - 0.5).abs() < 1e-6 && (hit.2 - 0.25).abs() < 1e-6 && (hit.3 - 0.25).abs() < 1e-6);
+    assert!(
+        (hit.1 - 0.5).abs() < 1e-6 && (hit.2 - 0.25).abs() < 1e-6 && (hit.3 - 0.25).abs() < 1e-6
+    );
     // Outside, behind the origin, beyond t_max.
     assert!(intersect_triangle(Vec3::new(0.8, 0.8, 1.0), down, f32::INFINITY, p).is_none());
     assert!(intersect_triangle(Vec3::new(0.25, 0.25, -1.0), down, f32::INFINITY, p).is_none());
@@ -54,9 +56,11 @@ fn triangle_hit_miss_edges_and_grazing() {
     let mut rng = pcg_from_keys(&[42]);
     for _ in 0..20_000 {
         let s = next_f32(&mut rng);
-        let o = Vec3::new(s, s, 1.0) + Vec3::new(next_f32(&mut rng), next_f32(&mut rng), 0.0) * 1e-3
+        let o = Vec3::new(s, s, 1.0)
+            + Vec3::new(next_f32(&mut rng), next_f32(&mut rng), 0.0) * 1e-3
             - Vec3::splat(5e-4).with_z(0.0);
-        let d = Vec3::new(next_f32(&mut rng) - 0.5, next_f32(&mut rng) - 0.5, -1.0).normalize() * 1e-3
+        let d = Vec3::new(next_f32(&mut rng) - 0.5, next_f32(&mut rng) - 0.5, -1.0).normalize()
+            * 1e-3
             + down;
         let target = o + d * (1.0 / -d.z);
         if !(0.001..0.999).contains(&target.x) || !(0.001..0.999).contains(&target.y) {
@@ -111,7 +115,10 @@ fn spheres_and_disks_under_transforms() {
         .intersect(&Ray::new(p + Vec3::new(0.0, 0.0, -5.0), Vec3::Z))
         .map(|h| h.ng);
     assert!(h.is_none() || h.unwrap().is_finite());
-    let h = s.geometry.intersect(&Ray::new(p * 3.0, -p.normalize())).unwrap();
+    let h = s
+        .geometry
+        .intersect(&Ray::new(p * 3.0, -p.normalize()))
+        .unwrap();
     let expect = Vec3::new(p.x / 4.0, p.y, 0.0).normalize();
     assert!((h.ng - expect).length() < 1e-3, "{} vs {expect}", h.ng);
     // Disk: radius 1 at height 2 of a rotated frame.
@@ -154,7 +161,11 @@ fn transforms_points_vectors_normals_inverse() {
     assert!(tan.dot(n).abs() < 1e-6);
     assert!(t.vector(tan).dot(t.normal(n)).abs() < 1e-4);
     assert!(!t.swaps_handedness());
-    assert!(Transform::new(Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))).unwrap().swaps_handedness());
+    assert!(
+        Transform::new(Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)))
+            .unwrap()
+            .swaps_handedness()
+    );
     assert!(Transform::new(Mat4::from_scale(Vec3::new(0.0, 1.0, 1.0))).is_none());
     let c = t.then_apply_to(&t.inverse());
     assert!((c.point(p) - p).length() < 1e-5);
@@ -176,12 +187,17 @@ fn spawned_rays_do_not_reintersect_their_surface() {
         let w = uniform_sphere(glam::Vec2::new(next_f32(&mut rng), next_f32(&mut rng)));
         let w = if w.dot(h.ng) < 0.0 { -w } else { w };
         assert!(
-            s.geometry.intersect(&Ray::new(h.spawn_origin(w), w)).is_none(),
+            s.geometry
+                .intersect(&Ray::new(h.spawn_origin(w), w))
+                .is_none(),
             "self-intersection leaving {}",
             h.p
         );
         let r = s.geometry.intersect(&Ray::new(h.spawn_origin(-w), -w));
-        assert!(r.is_some_and(|r| r.t > 1e-3), "inward ray lost or hit its origin");
+        assert!(
+            r.is_some_and(|r| r.t > 1e-3),
+            "inward ray lost or hit its origin"
+        );
     }
 }
 
@@ -206,7 +222,9 @@ fn shadow_rays_no_acne_and_no_leaks_at_contacts() {
             if z { hi.z } else { lo.z },
         )
     };
-    let positions: Vec<Vec3> = (0..8).map(|i| c(i & 1 != 0, i & 2 != 0, i & 4 != 0)).collect();
+    let positions: Vec<Vec3> = (0..8)
+        .map(|i| c(i & 1 != 0, i & 2 != 0, i & 4 != 0))
+        .collect();
     let indices = vec![
         0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1, 2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4,
         1, 5, 7, 1, 7, 3,
@@ -230,12 +248,19 @@ fn shadow_rays_no_acne_and_no_leaks_at_contacts() {
         let z = next_f32(&mut rng) * 1.8 - 0.9;
         let x = -1.0 - next_f32(&mut rng) * 1e-3 - 1e-6;
         let o = Vec3::new(x, 3.0, z);
-        let h = s.geometry.intersect(&Ray::new(o, Vec3::NEG_Y)).expect("floor");
+        let h = s
+            .geometry
+            .intersect(&Ray::new(o, Vec3::NEG_Y))
+            .expect("floor");
         assert!(h.p.y.abs() < 1e-5);
         // A light point on the far side of the box, low: the box must block it (no leak under
         // the contact) ...
         let target = Vec3::new(3.0, 0.05 + next_f32(&mut rng) * 0.5, z);
-        assert!(s.geometry.occluded(&shadow_ray(&h, target)), "leak at {}", h.p);
+        assert!(
+            s.geometry.occluded(&shadow_ray(&h, target)),
+            "leak at {}",
+            h.p
+        );
         // ... and a point straight above is visible (no acne on the floor).
         let up = h.p + Vec3::new(-0.5, 5.0, 0.0);
         assert!(!s.geometry.occluded(&shadow_ray(&h, up)), "acne at {}", h.p);
@@ -256,10 +281,27 @@ fn camera_framing_follows_pbrt() {
     let sy = 0.98 / 6.83 / t;
     let expect = Vec2::new((sx + 1.0) / 2.0 * 512.0, (1.0 - sy) / 2.0 * 512.0);
     assert!((p - expect).length() < 1e-3, "{p} vs {expect}");
-    assert!((p.x - 254.91).abs() < 0.05 && (p.y - 42.22).abs() < 0.05, "{p}");
+    assert!(
+        (p.x - 254.91).abs() < 0.05 && (p.y - 42.22).abs() < 0.05,
+        "{p}"
+    );
     // The red wall (x = −1) is on the left, the green one (x = +1) on the right.
-    assert!(scene.camera.project(Vec3::new(-1.0, 1.0, 0.0), res).unwrap().x < 100.0);
-    assert!(scene.camera.project(Vec3::new(1.0, 1.0, 0.0), res).unwrap().x > 412.0);
+    assert!(
+        scene
+            .camera
+            .project(Vec3::new(-1.0, 1.0, 0.0), res)
+            .unwrap()
+            .x
+            < 100.0
+    );
+    assert!(
+        scene
+            .camera
+            .project(Vec3::new(1.0, 1.0, 0.0), res)
+            .unwrap()
+            .x
+            > 412.0
+    );
     // generate_ray through the projected position passes through the point.
     let r = scene.camera.generate_ray(p, res);
     let to = (light_center - r.o).normalize();
@@ -273,8 +315,9 @@ fn camera_framing_follows_pbrt() {
 
 #[test]
 fn renders_are_bit_identical_across_thread_counts() {
-    let scene = (penumbra::scene::builtin::find("cornell").unwrap().build)(&BuiltinOptions::default())
-        .unwrap();
+    let scene =
+        (penumbra::scene::builtin::find("cornell").unwrap().build)(&BuiltinOptions::default())
+            .unwrap();
     let res = UVec2::new(48, 40);
     for strategy in [Strategy::Mis, Strategy::Bsdf] {
         let opts = RenderOptions {
@@ -293,7 +336,14 @@ fn renders_are_bit_identical_across_thread_counts() {
         let a = run(1);
         assert_eq!(a, run(2));
         assert_eq!(a, run(3));
-        let other = RenderOptions { seed: 4, ..opts.clone() };
-        assert_ne!(a, render(&scene, res, &other).unwrap().0, "the seed must matter");
+        let other = RenderOptions {
+            seed: 4,
+            ..opts.clone()
+        };
+        assert_ne!(
+            a,
+            render(&scene, res, &other).unwrap().0,
+            "the seed must matter"
+        );
     }
 }

@@ -1,8 +1,7 @@
 //! Ideal diffuse reflection, sampled cosine-weighted.
 
-use super::{BsdfSample, Bxdf};
+use super::{BsdfSample, Bxdf, LobeSampling};
 use crate::Rgb;
-use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
@@ -11,6 +10,18 @@ use std::f32::consts::FRAC_1_PI;
 pub struct Lambert {
     /// Albedo (reflectance), each channel in [0, 1].
     pub r: Rgb,
+    /// Sampling mode (Importance and Cosine coincide here).
+    pub sampling: LobeSampling,
+}
+
+impl Lambert {
+    /// Lambertian reflector with importance (cosine) sampling.
+    pub fn new(r: Rgb) -> Self {
+        Self {
+            r,
+            sampling: LobeSampling::Importance,
+        }
+    }
 }
 
 impl Bxdf for Lambert {
@@ -24,20 +35,7 @@ impl Bxdf for Lambert {
 
     #[inline]
     fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let wi = cosine_hemisphere(u);
-        let pdf = cosine_hemisphere_pdf(wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.r * FRAC_1_PI,
-            pdf,
-            delta: false,
-        })
+        super::sample_by_hemisphere(self, self.sampling, wo, u)
     }
 
     #[inline]
@@ -45,6 +43,6 @@ impl Bxdf for Lambert {
         if wo.z <= 0.0 {
             return 0.0;
         }
-        cosine_hemisphere_pdf(wi)
+        self.sampling.hemisphere_pdf(wi)
     }
 }

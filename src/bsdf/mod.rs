@@ -1,16 +1,35 @@
 //! BSDFs in the local shading frame (z = shading normal).
 //!
 //! Contract: `f` excludes the cosine factor; `pdf(wo, wi)` is exactly the solid-angle density
-//! `sample` draws from (the chi² tests check this); delta lobes report `delta = true` with
-//! `pdf = 1` by convention and are never evaluated by `f`/`pdf` (they return 0).
+//! `sample` draws from (the chi² tests check this); samples that a lobe would put below the
+//! surface are returned as `None` (their weight is zero), so `pdf` integrates to ≤ 1.
+//! Delta lobes report `delta = true` with `pdf = 1` by convention and `f` chosen so that
+//! `f·|cos θi| / pdf` is the sample's throughput weight (e.g. `R / |cos θi|`); `f()`/`pdf()`
+//! never see them (they return 0 for delta directions).
 //! The integrator builds the frame with the shading normal flipped toward `wo`, so `wo.z ≥ 0`
 //! for every call; transmissive BSDFs are told which side they are entered from at construction.
 
+pub mod coated;
+pub mod conductor;
+pub mod dielectric;
+pub mod fresnel;
+pub mod ggx;
 pub mod lambert;
+pub mod mirror;
+pub mod phong;
 
+pub use coated::CoatedDiffuse;
+pub use conductor::{Conductor, named_metal};
+pub use dielectric::Dielectric;
+pub use ggx::{TrowbridgeReitz, roughness_to_alpha};
 pub use lambert::Lambert;
+pub use mirror::Mirror;
+pub use phong::Phong;
 
 use crate::Rgb;
+use crate::sampling::{
+    cosine_hemisphere, cosine_hemisphere_pdf, uniform_hemisphere, uniform_hemisphere_pdf,
+};
 use glam::{Vec2, Vec3};
 
 /// One sampled direction.
@@ -40,36 +59,151 @@ pub trait Bxdf {
     }
 }
 
+/// How the non-delta lobes of a BSDF are sampled (the lecture's I₁/I₂ variants, for the lab).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum LobeSampling {
+    /// Importance sampling matched to the BSDF (cosine for diffuse, cosⁿ / GGX VNDF for glossy).
+    #[default]
+    Importance,
+    /// Cosine-weighted hemisphere for every lobe.
+    Cosine,
+    /// Uniform hemisphere for every lobe.
+    Uniform,
+}
+
+impl std::str::FromStr for LobeSampling {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim() {
+            "importance" | "cosine-power" => Ok(Self::Importance),
+            "cosine" => Ok(Self::Cosine),
+            "uniform" => Ok(Self::Uniform),
+            _ => Err(format!(
+                "unknown BSDF sampling '{s}' (expected importance, cosine or uniform)"
+            )),
+        }
+    }
+}
+
+impl LobeSampling {
+    /// Draw from the BSDF-independent hemisphere density of this mode (Importance → cosine).
+    #[inline]
+    pub fn sample_hemisphere(self, u: Vec2) -> Vec3 {
+        match self {
+            LobeSampling::Uniform => uniform_hemisphere(u),
+            _ => cosine_hemisphere(u),
+        }
+    }
+
+    /// Density of [`LobeSampling::sample_hemisphere`] (0 below the surface).
+    #[inline]
+    pub fn hemisphere_pdf(self, wi: Vec3) -> f32 {
+        if wi.z <= 0.0 {
+            return 0.0;
+        }
+        match self {
+            LobeSampling::Uniform => uniform_hemisphere_pdf(wi),
+            _ => cosine_hemisphere_pdf(wi),
+        }
+    }
+}
+
+/// Mirror direction of `w` about the shading normal (+z).
+#[inline]
+pub fn reflect_z(w: Vec3) -> Vec3 {
+    Vec3::new(-w.x, -w.y, w.z)
+}
+
+/// Mirror direction of `w` about the unit vector `n` (both pointing away from the surface).
+#[inline]
+pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
+    2.0 * w.dot(n) * n - w
+}
+
+/// Draw `wi` from a mode-dependent hemisphere density and evaluate `bsdf` there: the shared
+/// sampling path of every non-importance [`LobeSampling`] mode.
+#[inline]
+fn sample_by_hemisphere(
+    bsdf: &impl Bxdf,
+    mode: LobeSampling,
+    wo: Vec3,
+    u: Vec2,
+) -> Option<BsdfSample> {
+    if wo.z <= 0.0 {
+        return None;
+    }
+    let wi = mode.sample_hemisphere(u);
+    let pdf = mode.hemisphere_pdf(wi);
+    if pdf <= 0.0 {
+        return None;
+    }
+    Some(BsdfSample {
+        wi,
+        f: bsdf.f(wo, wi),
+        pdf,
+        delta: false,
+    })
+}
+
 /// Closed set of BSDFs (enum dispatch keeps the per-sample path free of virtual calls).
 #[derive(Clone, Debug)]
 pub enum Bsdf {
     /// Ideal diffuse.
     Lambert(Lambert),
+    /// Modified (energy-conserving) Phong.
+    Phong(Phong),
+    /// GGX rough (or smooth) conductor.
+    Conductor(Conductor),
+    /// Smooth glass.
+    Dielectric(Dielectric),
+    /// GGX dielectric coat over a diffuse base.
+    CoatedDiffuse(CoatedDiffuse),
+    /// Ideal mirror.
+    Mirror(Mirror),
+}
+
+macro_rules! dispatch {
+    ($self:ident, $b:ident => $e:expr) => {
+        match $self {
+            Bsdf::Lambert($b) => $e,
+            Bsdf::Phong($b) => $e,
+            Bsdf::Conductor($b) => $e,
+            Bsdf::Dielectric($b) => $e,
+            Bsdf::CoatedDiffuse($b) => $e,
+            Bsdf::Mirror($b) => $e,
+        }
+    };
+}
+
+impl Bsdf {
+    /// Choose how every non-delta lobe is sampled (the lab's I₁/I₂ comparison); delta BSDFs
+    /// ignore it because a delta lobe can only be sampled one way.
+    pub fn set_sampling(&mut self, s: LobeSampling) {
+        match self {
+            Bsdf::Lambert(b) => b.sampling = s,
+            Bsdf::Phong(b) => b.sampling = s,
+            Bsdf::Conductor(b) => b.sampling = s,
+            Bsdf::CoatedDiffuse(b) => b.sampling = s,
+            Bsdf::Dielectric(_) | Bsdf::Mirror(_) => {}
+        }
+    }
 }
 
 impl Bxdf for Bsdf {
     #[inline]
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        match self {
-            Bsdf::Lambert(b) => b.f(wo, wi),
-        }
+        dispatch!(self, b => b.f(wo, wi))
     }
     #[inline]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        match self {
-            Bsdf::Lambert(b) => b.sample(wo, uc, u),
-        }
+        dispatch!(self, b => b.sample(wo, uc, u))
     }
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match self {
-            Bsdf::Lambert(b) => b.pdf(wo, wi),
-        }
+        dispatch!(self, b => b.pdf(wo, wi))
     }
     #[inline]
     fn is_delta(&self) -> bool {
-        match self {
-            Bsdf::Lambert(b) => b.is_delta(),
-        }
+        dispatch!(self, b => b.is_delta())
     }
 }

@@ -47,6 +47,9 @@ pub struct Args {
     /// Light selection strategy.
     #[arg(long, default_value = "uniform")]
     pub light_selection: String,
+    /// How BSDF lobes are sampled: importance (cosine-power / GGX), cosine or uniform.
+    #[arg(long, default_value = "importance")]
+    pub bsdf_sampling: penumbra::bsdf::LobeSampling,
     /// PNG exposure in stops.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
@@ -63,10 +66,18 @@ pub fn parse_res(s: &str) -> Result<UVec2, String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WxH (e.g. 512x512), got '{s}'"))?;
-    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
-    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad height in '{s}'"))?;
     if w == 0 || h == 0 || w > 65536 || h > 65536 {
-        return Err(format!("resolution must be between 1 and 65536 per axis, got '{s}'"));
+        return Err(format!(
+            "resolution must be between 1 and 65536 per axis, got '{s}'"
+        ));
     }
     Ok(UVec2::new(w, h))
 }
@@ -100,6 +111,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         mis: args.mis,
         pattern: args.pattern,
         light_selection: args.light_selection.clone(),
+        bsdf_sampling: args.bsdf_sampling,
         progress: !args.quiet,
     };
     anyhow::ensure!(opts.spp >= 1, "--spp must be at least 1");

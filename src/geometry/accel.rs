@@ -137,18 +137,26 @@ impl Geometry {
         let p = &self.prims[id];
         match p.kind {
             PrimKind::Triangle { mesh, v } => {
-                let (b0, b1, b2) = match RayShear::new(ray.o, ray.d).intersect(p.p[0], p.p[1], p.p[2], f32::INFINITY) {
+                let (b0, b1, b2) = match RayShear::new(ray.o, ray.d).intersect(
+                    p.p[0],
+                    p.p[1],
+                    p.p[2],
+                    f32::INFINITY,
+                ) {
                     Some((_, b0, b1, b2)) => (b0, b1, b2),
                     None => (1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0),
                 };
                 let verts = p.p;
                 let pos = verts[0] * b0 + verts[1] * b1 + verts[2] * b2;
                 let m = &self.meshes[mesh as usize];
-                let mut ng = (verts[1] - verts[0]).cross(verts[2] - verts[0]).normalize_or_zero();
+                let mut ng = (verts[1] - verts[0])
+                    .cross(verts[2] - verts[0])
+                    .normalize_or_zero();
                 let ns = match &m.normals {
                     Some(n) => {
-                        let ns = (n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2)
-                            .normalize_or_zero();
+                        let ns =
+                            (n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2)
+                                .normalize_or_zero();
                         if ns == Vec3::ZERO {
                             ng
                         } else {
@@ -166,7 +174,9 @@ impl Geometry {
                     }
                 };
                 let uv = match &m.uvs {
-                    Some(uv) => uv[v[0] as usize] * b0 + uv[v[1] as usize] * b1 + uv[v[2] as usize] * b2,
+                    Some(uv) => {
+                        uv[v[0] as usize] * b0 + uv[v[1] as usize] * b1 + uv[v[2] as usize] * b2
+                    }
                     // pbrt-v4's default parameterisation (0,0), (1,0), (1,1).
                     None => Vec2::new(b1 + b2, b2),
                 };

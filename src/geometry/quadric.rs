@@ -141,7 +141,9 @@ impl Quadric {
             + self.to_world.m.y_axis.abs().max_element()
             + self.to_world.m.z_axis.abs().max_element();
         let obj_err = gamma(5) * p.as_vec3().abs().max_element() * scale;
-        let err = obj_err + gamma(3) * (pw.abs().max_element() + self.to_world.m.w_axis.truncate().abs().max_element());
+        let err = obj_err
+            + gamma(3)
+                * (pw.abs().max_element() + self.to_world.m.w_axis.truncate().abs().max_element());
         QuadricHit {
             p: pw,
             n,
@@ -167,7 +169,14 @@ fn sphere_t(o: DVec3, d: DVec3, r: f64, t_max: f64) -> Option<f64> {
     }
     let s = (a * disc).sqrt();
     let q = if b < 0.0 { -b + s } else { -b - s };
-    let (mut t0, mut t1) = (q / a, if q != 0.0 { (o.length_squared() - r * r) / q } else { 0.0 });
+    let (mut t0, mut t1) = (
+        q / a,
+        if q != 0.0 {
+            (o.length_squared() - r * r) / q
+        } else {
+            0.0
+        },
+    );
     if t0 > t1 {
         std::mem::swap(&mut t0, &mut t1);
     }

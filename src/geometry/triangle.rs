@@ -41,7 +41,13 @@ impl RayShear {
 
     /// Intersect triangle (p0, p1, p2); returns (t, b0, b1, b2) with t in (0, t_max).
     #[inline(always)]
-    pub fn intersect(&self, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<(f32, f32, f32, f32)> {
+    pub fn intersect(
+        &self,
+        p0: Vec3,
+        p1: Vec3,
+        p2: Vec3,
+        t_max: f32,
+    ) -> Option<(f32, f32, f32, f32)> {
         let [kx, ky, kz] = self.k;
         let a = p0 - self.o;
         let b = p1 - self.o;
@@ -89,7 +95,12 @@ impl RayShear {
 
 /// Intersect the ray (o, d) with triangle (p0, p1, p2); returns (t, b0, b1, b2).
 #[inline]
-pub fn intersect_triangle(o: Vec3, d: Vec3, t_max: f32, p: [Vec3; 3]) -> Option<(f32, f32, f32, f32)> {
+pub fn intersect_triangle(
+    o: Vec3,
+    d: Vec3,
+    t_max: f32,
+    p: [Vec3; 3],
+) -> Option<(f32, f32, f32, f32)> {
     RayShear::new(o, d).intersect(p[0], p[1], p[2], t_max)
 }
 

@@ -8,7 +8,7 @@
 
 use super::{MisHeuristic, Strategy};
 use crate::Rgb;
-use crate::bsdf::{Bsdf, Bxdf};
+use crate::bsdf::{Bsdf, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::{Ray, RayQuery, SurfaceHit};
 use crate::light_selection::{LightSelector, ShadingPoint};
@@ -47,6 +47,8 @@ pub struct DirectLighting<'a> {
     pub eye_rays: u32,
     /// Light / BSDF samples per eye ray (M).
     pub shadow_rays: u32,
+    /// How BSDF lobes are sampled.
+    pub bsdf_sampling: LobeSampling,
 }
 
 /// Where the samples of one eye ray come from.
@@ -100,18 +102,30 @@ impl<'a> DirectLighting<'a> {
         }
         let front = ray.d.dot(hit.ng) < 0.0;
         let ng = if front { hit.ng } else { -hit.ng };
-        let ns = if hit.ns.dot(wo) < 0.0 { -hit.ns } else { hit.ns };
+        let ns = if hit.ns.dot(wo) < 0.0 {
+            -hit.ns
+        } else {
+            hit.ns
+        };
         let frame = Frame::from_normal(ns);
         let Some(material) = scene.materials.get(hit.material as usize) else {
             return (l, rays);
         };
+        let mut bsdf = material.bsdf(&hit, front);
+        if self.bsdf_sampling != LobeSampling::Importance {
+            bsdf.set_sampling(self.bsdf_sampling);
+        }
         let sh = Shading {
-            bsdf: material.bsdf(&hit, front),
+            bsdf,
             wo_local: frame.to_local(wo),
             frame,
             ng,
             ctx: LightSampleContext { p: hit.p, n: ng },
-            sp: ShadingPoint { p: hit.p, n: ng, wo },
+            sp: ShadingPoint {
+                p: hit.p,
+                n: ng,
+                wo,
+            },
             hit,
         };
         let m = self.shadow_rays.max(1);
@@ -144,9 +158,7 @@ impl<'a> DirectLighting<'a> {
         self.scene
             .infinite_lights
             .iter()
-            .map(|&i| {
-                self.scene.lights[i as usize].radiance(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, w)
-            })
+            .map(|&i| self.scene.lights[i as usize].radiance(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, w))
             .sum()
     }
 
@@ -174,7 +186,11 @@ impl<'a> DirectLighting<'a> {
             return Rgb::ZERO;
         }
         *rays += 1;
-        if self.scene.geometry.occluded(&shadow_ray(&sh.hit, ls.p_light)) {
+        if self
+            .scene
+            .geometry
+            .occluded(&shadow_ray(&sh.hit, ls.p_light))
+        {
             return Rgb::ZERO;
         }
         let pdf = sel.pmf * ls.pdf;
@@ -188,8 +204,12 @@ impl<'a> DirectLighting<'a> {
 
     /// One BSDF-sampling estimate f·cos·Le / pdf, MIS-weighted when `mis`.
     fn bsdf_sample(&self, sh: &Shading, si: SampleIndex, mis: bool, rays: &mut u64) -> Rgb {
-        let uc = self.pattern.sample_1d(si.pixel, DIM_LOBE, si.index, si.count);
-        let u = self.pattern.sample_2d(si.pixel, DIM_BSDF, si.index, si.count);
+        let uc = self
+            .pattern
+            .sample_1d(si.pixel, DIM_LOBE, si.index, si.count);
+        let u = self
+            .pattern
+            .sample_2d(si.pixel, DIM_BSDF, si.index, si.count);
         let Some(bs) = sh.bsdf.sample(sh.wo_local, uc, u) else {
             return Rgb::ZERO;
         };
@@ -197,7 +217,9 @@ impl<'a> DirectLighting<'a> {
             return Rgb::ZERO;
         }
         let wi = sh.frame.to_world(bs.wi).normalize();
-        if wi.dot(sh.ng) <= 0.0 {
+        // Only specular transmission (smooth glass) may leave below the geometric surface;
+        // every other sample there is rejected exactly as light sampling rejects it.
+        if wi.dot(sh.ng) <= 0.0 && !bs.delta {
             return Rgb::ZERO;
         }
         let weight = bs.f * (bs.wi.z.abs() / bs.pdf);

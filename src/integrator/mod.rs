@@ -10,6 +10,7 @@ pub mod render;
 
 pub use render::{RenderStats, render};
 
+use crate::bsdf::LobeSampling;
 use crate::sampling::PatternKind;
 use std::fmt;
 use std::str::FromStr;
@@ -80,7 +81,9 @@ impl FromStr for MisHeuristic {
         match s.trim() {
             "power" => Ok(Self::Power),
             "balance" => Ok(Self::Balance),
-            _ => Err(format!("unknown MIS heuristic '{s}' (expected power or balance)")),
+            _ => Err(format!(
+                "unknown MIS heuristic '{s}' (expected power or balance)"
+            )),
         }
     }
 }
@@ -102,6 +105,8 @@ pub struct RenderOptions {
     pub pattern: PatternKind,
     /// Light selection strategy name (see `light_selection`).
     pub light_selection: String,
+    /// How BSDF lobes are sampled (the lecture's I₂ variants; importance by default).
+    pub bsdf_sampling: LobeSampling,
     /// Show a progress bar.
     pub progress: bool,
 }
@@ -116,6 +121,7 @@ impl Default for RenderOptions {
             mis: MisHeuristic::Power,
             pattern: PatternKind::Stratified,
             light_selection: "uniform".into(),
+            bsdf_sampling: LobeSampling::Importance,
             progress: false,
         }
     }

@@ -38,8 +38,17 @@ impl RenderStats {
 }
 
 /// Render `scene` at `res` with `opts`.
-pub fn render(scene: &Scene, res: UVec2, opts: &RenderOptions) -> anyhow::Result<(Image, RenderStats)> {
-    anyhow::ensure!(res.x > 0 && res.y > 0, "resolution must be positive, got {}x{}", res.x, res.y);
+pub fn render(
+    scene: &Scene,
+    res: UVec2,
+    opts: &RenderOptions,
+) -> anyhow::Result<(Image, RenderStats)> {
+    anyhow::ensure!(
+        res.x > 0 && res.y > 0,
+        "resolution must be positive, got {}x{}",
+        res.x,
+        res.y
+    );
     anyhow::ensure!(opts.spp > 0, "--spp must be at least 1");
     let selector = make_selector(&opts.light_selection, scene)?;
     let pattern = make_pattern(opts.pattern, opts.seed);
@@ -51,13 +60,16 @@ pub fn render(scene: &Scene, res: UVec2, opts: &RenderOptions) -> anyhow::Result
         mis: opts.mis,
         eye_rays: opts.spp,
         shadow_rays: opts.shadow_rays.max(1),
+        bsdf_sampling: opts.bsdf_sampling,
     };
     let tiles_x = res.x.div_ceil(TILE);
     let tiles_y = res.y.div_ceil(TILE);
     let n_tiles = (tiles_x * tiles_y) as u64;
     let bar = if opts.progress && std::io::stderr().is_terminal() {
         let b = ProgressBar::with_draw_target(Some(n_tiles), ProgressDrawTarget::stderr());
-        if let Ok(style) = ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed} ETA {eta}") {
+        if let Ok(style) =
+            ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed} ETA {eta}")
+        {
             b.set_style(style);
         }
         b

@@ -1,12 +1,16 @@
 //! Materials: what a surface is made of, turned into a [`Bsdf`] at each hit (textures resolved).
-//! TODO(issue 4/5): phong, conductor, coated diffuse, dielectric, mix, textures.
+//! The pbrt/OBJ/glTF loaders map onto exactly these variants.
 
 pub mod texture;
 
 pub use texture::Texture;
 
-use crate::bsdf::{Bsdf, Lambert};
+use crate::Rgb;
+use crate::bsdf::fresnel::k_from_reflectance;
+use crate::bsdf::ggx::is_smooth;
+use crate::bsdf::{Bsdf, CoatedDiffuse, Conductor, Dielectric, Lambert, Mirror, Phong};
 use crate::geometry::SurfaceHit;
+use glam::Vec2;
 
 /// A surface material description.
 #[derive(Clone, Debug)]
@@ -16,19 +20,92 @@ pub enum Material {
         /// Albedo.
         reflectance: Texture,
     },
+    /// Modified Phong (kd + ks ≤ 1 enforced by scaling at BSDF construction).
+    Phong {
+        /// Diffuse reflectance.
+        kd: Texture,
+        /// Specular reflectance.
+        ks: Rgb,
+        /// Phong exponent.
+        n: f32,
+    },
+    /// GGX conductor.
+    Conductor {
+        /// Real part of the complex index (per channel).
+        eta: Rgb,
+        /// Extinction coefficient (per channel).
+        k: Rgb,
+        /// GGX widths (already remapped from roughness by the loader).
+        alpha: Vec2,
+        /// pbrt's "reflectance" mode: normal-incidence reflectance overriding eta/k.
+        reflectance: Option<Texture>,
+    },
+    /// Dielectric coat over a diffuse base (pbrt coateddiffuse / Mitsuba roughplastic).
+    CoatedDiffuse {
+        /// Base albedo.
+        reflectance: Texture,
+        /// Coat GGX widths.
+        alpha: Vec2,
+        /// Coat index of refraction.
+        eta: f32,
+    },
+    /// Glass-like dielectric (smooth or GGX rough).
+    Dielectric {
+        /// Index of refraction (inside / outside).
+        eta: f32,
+        /// GGX widths (already remapped from roughness by the loader).
+        alpha: Vec2,
+    },
+    /// Perfect mirror (reflectance 1).
+    Mirror,
 }
 
 impl Material {
     /// The BSDF at a hit. `front` is true when the ray arrives on the side of `hit.ng`
     /// (transmissive materials need it to orient their index of refraction).
     pub fn bsdf(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
-        let _ = front;
+        let unit = |c: Rgb| c.clamp(Rgb::ZERO, Rgb::ONE);
         match self {
-            Material::Diffuse { reflectance } => Bsdf::Lambert(Lambert {
-                r: reflectance
-                    .eval(hit.uv)
-                    .clamp(crate::Rgb::ZERO, crate::Rgb::ONE),
+            Material::Diffuse { reflectance } => {
+                Bsdf::Lambert(Lambert::new(unit(reflectance.eval(hit.uv))))
+            }
+            Material::Phong { kd, ks, n } => Bsdf::Phong(Phong::clamped(kd.eval(hit.uv), *ks, *n)),
+            Material::Conductor {
+                eta,
+                k,
+                alpha,
+                reflectance,
+            } => {
+                let (eta, k) = match reflectance {
+                    Some(r) => (Rgb::ONE, k_from_reflectance(r.eval(hit.uv))),
+                    None => (*eta, *k),
+                };
+                Bsdf::Conductor(Conductor::new(eta, k, *alpha))
+            }
+            Material::CoatedDiffuse {
+                reflectance,
+                alpha,
+                eta,
+            } => Bsdf::CoatedDiffuse(CoatedDiffuse::new(reflectance.eval(hit.uv), *alpha, *eta)),
+            Material::Dielectric { eta, alpha } => Bsdf::Dielectric(Dielectric {
+                eta: *eta,
+                alpha: *alpha,
+                entering: front,
             }),
+            Material::Mirror => Bsdf::Mirror(Mirror { r: Rgb::ONE }),
+        }
+    }
+
+    /// True if every BSDF of this material is a delta lobe (light sampling cannot help).
+    pub fn is_delta_only(&self) -> bool {
+        match self {
+            Material::Mirror => true,
+            Material::Conductor { alpha, .. } | Material::Dielectric { alpha, .. } => {
+                is_smooth(*alpha)
+            }
+            Material::Diffuse { .. } | Material::Phong { .. } | Material::CoatedDiffuse { .. } => {
+                false
+            }
         }
     }
 }

@@ -76,21 +76,36 @@ impl SceneBuilder {
         );
         let nv = positions.len();
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            bail!("mesh vertex {i} has a non-finite position {:?}", positions[i]);
+            bail!(
+                "mesh vertex {i} has a non-finite position {:?}",
+                positions[i]
+            );
         }
         let normals = match normals {
             Some(n) => {
-                ensure!(n.len() == nv, "mesh has {} normals for {nv} vertices", n.len());
+                ensure!(
+                    n.len() == nv,
+                    "mesh has {} normals for {nv} vertices",
+                    n.len()
+                );
                 if let Some(i) = n.iter().position(|v| !v.is_finite()) {
                     bail!("mesh normal {i} is not finite");
                 }
                 // Normalised here, once, so every loader and built-in scene agrees bit for bit.
-                Some(n.into_iter().map(|v| v.normalize_or_zero()).collect::<Vec<_>>())
+                Some(
+                    n.into_iter()
+                        .map(|v| v.normalize_or_zero())
+                        .collect::<Vec<_>>(),
+                )
             }
             None => None,
         };
         if let Some(uv) = &uvs {
-            ensure!(uv.len() == nv, "mesh has {} uvs for {nv} vertices", uv.len());
+            ensure!(
+                uv.len() == nv,
+                "mesh has {} uvs for {nv} vertices",
+                uv.len()
+            );
         }
         if let Some(&bad) = indices.iter().find(|&&i| i as usize >= nv) {
             bail!("mesh index {bad} out of range ({nv} vertices)");

@@ -23,7 +23,8 @@ pub struct Loaded {
 /// Load `spec`: a built-in scene name or a path to a scene file.
 pub fn load(spec: &str, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     if let Some(b) = builtin::find(spec) {
-        let scene = (b.build)(&opts.builtin).with_context(|| format!("building built-in scene '{spec}'"))?;
+        let scene = (b.build)(&opts.builtin)
+            .with_context(|| format!("building built-in scene '{spec}'"))?;
         return Ok(Loaded {
             scene,
             warnings: Vec::new(),
@@ -43,9 +44,10 @@ pub fn load(spec: &str, opts: &LoadOptions) -> anyhow::Result<Loaded> {
         .unwrap_or("")
         .to_ascii_lowercase();
     match ext.as_str() {
-        other => bail!(
-            "{}: unsupported scene format '.{other}'",
-            path.display()
-        ),
+        "pbrt" => {
+            let (scene, warnings) = super::pbrt::load_pbrt(path)?;
+            Ok(Loaded { scene, warnings })
+        }
+        other => bail!("{}: unsupported scene format '.{other}'", path.display()),
     }
 }

@@ -6,6 +6,7 @@
 pub mod builder;
 pub mod builtin;
 pub mod load;
+pub mod pbrt;
 
 pub use builder::SceneBuilder;
 

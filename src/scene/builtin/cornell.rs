@@ -2,11 +2,11 @@
 
 use super::cornell_data::{LIGHT, LIGHT_L, MATERIALS, MESHES, MeshData};
 use super::{BuiltinOptions, Scene};
+use crate::Rgb;
 use crate::camera::Camera;
 use crate::geometry::Transform;
 use crate::material::{Material, Texture};
 use crate::scene::{AreaEmission, FilmSpec, Filter, SceneBuilder, TriangleMesh};
-use crate::Rgb;
 use glam::{Mat4, UVec2, Vec2, Vec3};
 
 /// The pbrt file's `Transform` (column-major, camera-from-world).
@@ -29,27 +29,37 @@ pub fn cornell_camera() -> Camera {
 pub fn cornell_film() -> FilmSpec {
     FilmSpec {
         resolution: UVec2::new(512, 512),
-        filter: Filter::Triangle {
-            radius: Vec2::ONE,
-        },
+        filter: Filter::Triangle { radius: Vec2::ONE },
         filename: None,
         spp: Some(64),
     }
 }
 
 fn mesh(d: &MeshData) -> TriangleMesh {
-    let v3 = |a: &[f32]| a.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
+    let v3 = |a: &[f32]| {
+        a.chunks_exact(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect()
+    };
     TriangleMesh {
         positions: v3(d.p),
         normals: Some(v3(d.n)),
-        uvs: Some(d.uv.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])).collect()),
+        uvs: Some(
+            d.uv.chunks_exact(2)
+                .map(|c| Vec2::new(c[0], c[1]))
+                .collect(),
+        ),
         indices: d.indices.to_vec(),
         flip_normals: false,
     }
 }
 
-/// Add the box (walls, blocks, light) to a builder; returns the material indices by name.
-pub fn add_cornell_box(b: &mut SceneBuilder) -> anyhow::Result<Vec<(&'static str, u32)>> {
+/// Add the box (walls, blocks unless `blocks` is false, light) to a builder; returns the
+/// material indices by name.
+pub fn add_cornell_box(
+    b: &mut SceneBuilder,
+    blocks: bool,
+) -> anyhow::Result<Vec<(&'static str, u32)>> {
     let ids: Vec<(&'static str, u32)> = MATERIALS
         .iter()
         .map(|(name, r)| {
@@ -61,19 +71,60 @@ pub fn add_cornell_box(b: &mut SceneBuilder) -> anyhow::Result<Vec<(&'static str
         .collect();
     let id = |name: &str| ids.iter().find(|(n, _)| *n == name).map(|(_, i)| *i);
     for d in MESHES {
+        if !blocks && d.material.ends_with("Box") {
+            continue;
+        }
         b.add_mesh(mesh(d), id(d.material).unwrap_or(0), None)?;
     }
     let emission = AreaEmission {
         l: Rgb::from_array(LIGHT_L),
         two_sided: false,
     };
-    b.add_mesh(mesh(&LIGHT), id(LIGHT.material).unwrap_or(0), Some(emission))?;
+    b.add_mesh(
+        mesh(&LIGHT),
+        id(LIGHT.material).unwrap_or(0),
+        Some(emission),
+    )?;
     Ok(ids)
 }
 
 /// Build the default Cornell box.
 pub fn cornell(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
     let mut b = SceneBuilder::new();
-    add_cornell_box(&mut b)?;
+    add_cornell_box(&mut b, true)?;
+    b.build(cornell_camera(), cornell_film())
+}
+
+/// The Cornell box with glossy spheres instead of blocks: modified Phong (front row, exponents
+/// 10, 100, 1000) and GGX conductors (back row: gold α = 0.05, copper α = 0.2, aluminium
+/// α = 0.5), to show how the estimators handle glossy lobes.
+pub fn cornell_phong(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
+    let mut b = SceneBuilder::new();
+    add_cornell_box(&mut b, false)?;
+    let r = 0.28;
+    for (i, n) in [10.0f32, 100.0, 1000.0].into_iter().enumerate() {
+        let m = b.add_material(Material::Phong {
+            kd: Texture::Constant(Rgb::new(0.25, 0.25, 0.35)),
+            ks: Rgb::splat(0.6),
+            n,
+        });
+        let c = Vec3::new(-0.62 + 0.62 * i as f32, r, 0.35);
+        b.add_sphere(Transform::translate(c), r, m, None, false)?;
+    }
+    for (i, (metal, alpha)) in [("Au", 0.05f32), ("Cu", 0.2), ("Al", 0.5)]
+        .into_iter()
+        .enumerate()
+    {
+        let (eta, k) = crate::bsdf::named_metal(metal)
+            .ok_or_else(|| anyhow::anyhow!("missing metal table for {metal}"))?;
+        let m = b.add_material(Material::Conductor {
+            eta,
+            k,
+            alpha: Vec2::splat(alpha),
+            reflectance: None,
+        });
+        let c = Vec3::new(-0.62 + 0.62 * i as f32, r, -0.4);
+        b.add_sphere(Transform::translate(c), r, m, None, false)?;
+    }
     b.build(cornell_camera(), cornell_film())
 }

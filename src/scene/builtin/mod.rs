@@ -1,6 +1,6 @@
 //! Built-in scenes, selectable by name wherever a scene path is accepted.
 
-mod cornell;
+pub mod cornell;
 mod cornell_data;
 
 use super::Scene;
@@ -27,11 +27,18 @@ pub struct Builtin {
 }
 
 /// Every built-in scene, default first.
-pub const BUILTINS: &[Builtin] = &[Builtin {
-    name: "cornell",
-    description: "Cornell box of ../shared/scenes/cornell-box-bitterli/scene-v4.pbrt (default), 512x512",
-    build: cornell::cornell,
-}];
+pub const BUILTINS: &[Builtin] = &[
+    Builtin {
+        name: "cornell",
+        description: "Cornell box of ../shared/scenes/cornell-box-bitterli/scene-v4.pbrt (default), 512x512",
+        build: cornell::cornell,
+    },
+    Builtin {
+        name: "cornell-phong",
+        description: "Cornell box with Phong (n = 10, 100, 1000) and GGX conductor spheres",
+        build: cornell::cornell_phong,
+    },
+];
 
 /// The built-in scene called `name`, if there is one.
 pub fn find(name: &str) -> Option<&'static Builtin> {

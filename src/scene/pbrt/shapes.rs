@@ -1,0 +1,450 @@
+//! `Shape` directive: `trianglemesh`, `plymesh`, `bilinearmesh` (as triangles), `sphere`, `disk`.
+//! Meshes are validated and taken to world space here: positions by the CTM, normals by its
+//! inverse transpose (renormalised); `flip_normals` = ReverseOrientation xor handedness swap.
+
+use super::params::ParamSet;
+use super::ply::read_ply;
+use super::textures::{Warn, resolve};
+use super::tokenizer::{Loc, err_at};
+use crate::geometry::Transform;
+use crate::scene::TriangleMesh;
+use glam::{Mat4, Vec2, Vec3};
+use std::f32::consts::PI;
+use std::path::Path;
+
+/// The geometry of one shape, in world space.
+#[derive(Clone, Debug)]
+pub enum ShapeGeom {
+    /// A triangle mesh (world space, validated).
+    Mesh(TriangleMesh),
+    /// A full sphere.
+    Sphere {
+        /// Object-to-world.
+        to_world: Transform,
+        /// Radius in object space.
+        radius: f32,
+    },
+    /// A full disk at z = height, normal +z.
+    Disk {
+        /// Object-to-world.
+        to_world: Transform,
+        /// Height in object space.
+        height: f32,
+        /// Radius in object space.
+        radius: f32,
+    },
+}
+
+fn area_scale(t: &Transform) -> f32 {
+    // Uniform-scale estimate: |det|^(2/3) (exact for similarity transforms).
+    t.m.determinant().abs().powf(2.0 / 3.0)
+}
+
+impl ShapeGeom {
+    /// World-space surface area (for area-light `power`).
+    pub fn area(&self) -> f32 {
+        match self {
+            ShapeGeom::Mesh(m) => m
+                .indices
+                .chunks_exact(3)
+                .map(|t| {
+                    let p = |i: u32| m.positions[i as usize];
+                    0.5 * (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).length()
+                })
+                .sum(),
+            ShapeGeom::Sphere { to_world, radius } => {
+                4.0 * PI * radius * radius * area_scale(to_world)
+            }
+            ShapeGeom::Disk {
+                to_world, radius, ..
+            } => PI * radius * radius * area_scale(to_world),
+        }
+    }
+
+    /// The same geometry moved by `t` (object instancing).
+    pub fn transformed(&self, t: &Transform) -> ShapeGeom {
+        match self {
+            ShapeGeom::Mesh(m) => {
+                let nt = t.m_inv.transpose();
+                ShapeGeom::Mesh(TriangleMesh {
+                    positions: m.positions.iter().map(|&p| t.point(p)).collect(),
+                    normals: m.normals.as_ref().map(|ns| {
+                        ns.iter()
+                            .map(|&n| nt.transform_vector3(n).normalize_or_zero())
+                            .collect()
+                    }),
+                    uvs: m.uvs.clone(),
+                    indices: m.indices.clone(),
+                    flip_normals: m.flip_normals ^ t.swaps_handedness(),
+                })
+            }
+            ShapeGeom::Sphere { to_world, radius } => ShapeGeom::Sphere {
+                to_world: t.then_apply_to(to_world),
+                radius: *radius,
+            },
+            ShapeGeom::Disk {
+                to_world,
+                height,
+                radius,
+            } => ShapeGeom::Disk {
+                to_world: t.then_apply_to(to_world),
+                height: *height,
+                radius: *radius,
+            },
+        }
+    }
+}
+
+/// Where a shape is made: CTM, orientation, directory for relative file names, location.
+pub struct ShapeCtx<'a> {
+    /// Current transformation matrix (object → world).
+    pub ctm: &'a Transform,
+    /// ReverseOrientation in effect.
+    pub reverse: bool,
+    /// Directory of the file containing the directive.
+    pub dir: &'a Path,
+    /// Location of the `Shape` directive.
+    pub loc: &'a Loc,
+}
+
+/// An object-space mesh before validation.
+pub struct RawMesh {
+    /// Positions.
+    pub positions: Vec<Vec3>,
+    /// Optional normals.
+    pub normals: Option<Vec<Vec3>>,
+    /// Optional uvs.
+    pub uvs: Option<Vec<Vec2>>,
+    /// Triangle indices (unchecked).
+    pub indices: Vec<u32>,
+}
+
+/// Validate an object-space mesh and take it to world space. Errors: empty mesh, non-finite
+/// data, index out of range, attribute count mismatch, all triangles degenerate. Zero-area
+/// triangles are dropped with a warning.
+pub fn finish_mesh(raw: RawMesh, ctx: &ShapeCtx, warn: &mut Warn) -> anyhow::Result<TriangleMesh> {
+    let loc = ctx.loc;
+    let n = raw.positions.len();
+    if n == 0 || raw.indices.is_empty() {
+        return Err(err_at(
+            loc,
+            "empty mesh: expected vertices and triangles, found none",
+        ));
+    }
+    if !raw.indices.len().is_multiple_of(3) {
+        return Err(err_at(
+            loc,
+            format!(
+                "expected a multiple of 3 indices, found {}",
+                raw.indices.len()
+            ),
+        ));
+    }
+    if let Some(i) = raw.positions.iter().position(|p| !p.is_finite()) {
+        return Err(err_at(loc, format!("non-finite position at vertex {i}")));
+    }
+    if let Some((k, &i)) = raw
+        .indices
+        .iter()
+        .enumerate()
+        .find(|&(_, &i)| i as usize >= n)
+    {
+        return Err(err_at(
+            loc,
+            format!("index {i} (entry {k}) out of range: mesh has {n} vertices"),
+        ));
+    }
+    if let Some(ns) = &raw.normals {
+        if ns.len() != n {
+            return Err(err_at(
+                loc,
+                format!("expected {n} normals, found {}", ns.len()),
+            ));
+        }
+        if let Some(i) = ns.iter().position(|p| !p.is_finite()) {
+            return Err(err_at(loc, format!("non-finite normal at vertex {i}")));
+        }
+    }
+    if let Some(uv) = &raw.uvs {
+        if uv.len() != n {
+            return Err(err_at(loc, format!("expected {n} uvs, found {}", uv.len())));
+        }
+        if let Some(i) = uv.iter().position(|p| !p.is_finite()) {
+            return Err(err_at(loc, format!("non-finite uv at vertex {i}")));
+        }
+    }
+    // The identity (the common case after WorldBegin) is skipped entirely: no rounding, so a
+    // scene loaded from file matches the same data given to the builder bit for bit (the
+    // builder normalises normals itself).
+    let identity = ctx.ctm.m == Mat4::IDENTITY;
+    let m: Mat4 = ctx.ctm.m;
+    let positions: Vec<Vec3> = if identity {
+        raw.positions
+    } else {
+        raw.positions
+            .iter()
+            .map(|&p| m.transform_point3(p))
+            .collect()
+    };
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(err_at(
+            loc,
+            format!("position of vertex {i} is not finite in world space"),
+        ));
+    }
+    let nt = ctx.ctm.m_inv.transpose();
+    let normals = raw.normals.map(|ns| {
+        if identity {
+            return ns;
+        }
+        ns.into_iter()
+            .map(|v| nt.transform_vector3(v).normalize_or_zero())
+            .collect()
+    });
+    let before = raw.indices.len() / 3;
+    let mut indices = raw.indices;
+    let mut w = 0;
+    for t in 0..before {
+        let (a, b, c) = (indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]);
+        let (pa, pb, pc) = (
+            positions[a as usize],
+            positions[b as usize],
+            positions[c as usize],
+        );
+        if (pb - pa).cross(pc - pa).length_squared() > 0.0 {
+            indices.copy_within(3 * t..3 * t + 3, 3 * w);
+            w += 1;
+        }
+    }
+    indices.truncate(3 * w);
+    if w == 0 {
+        return Err(err_at(
+            loc,
+            format!("all {before} triangles have zero area"),
+        ));
+    }
+    if w < before {
+        warn(
+            &format!("zero-area@{}", loc.file_line()),
+            loc,
+            format!("{} zero-area triangle(s) skipped", before - w),
+        );
+    }
+    Ok(TriangleMesh {
+        positions,
+        normals,
+        uvs: raw.uvs,
+        indices,
+        flip_normals: ctx.reverse ^ ctx.ctm.swaps_handedness(),
+    })
+}
+
+fn indices_param(
+    params: &ParamSet,
+    name: &str,
+    nverts: usize,
+    per: usize,
+    loc: &Loc,
+) -> anyhow::Result<Vec<u32>> {
+    match params.ints(name)? {
+        Some((v, ploc)) => {
+            let mut out = Vec::with_capacity(v.len());
+            for (k, &i) in v.iter().enumerate() {
+                if i < 0 || i >= nverts as i64 {
+                    return Err(err_at(
+                        &ploc,
+                        format!("index {i} (entry {k}) out of range: mesh has {nverts} vertices"),
+                    ));
+                }
+                out.push(i as u32);
+            }
+            Ok(out)
+        }
+        None if nverts == per => Ok((0..per as u32).collect()),
+        None => Err(err_at(
+            loc,
+            format!(
+                "expected \"integer {name}\" (required unless there are exactly {per} vertices)"
+            ),
+        )),
+    }
+}
+
+/// Positions, optional normals, optional uvs of a mesh directive.
+type MeshAttrs = (Vec<Vec3>, Option<Vec<Vec3>>, Option<Vec<Vec2>>);
+
+fn mesh_attrs(params: &ParamSet, loc: &Loc) -> anyhow::Result<MeshAttrs> {
+    let p = params
+        .point3s("P")?
+        .ok_or_else(|| err_at(loc, "expected \"point3 P\", found none"))?;
+    let n = params.normals("N")?;
+    let uv = match params.point2s("uv")? {
+        Some(uv) => Some(uv),
+        None => params.point2s("st")?,
+    };
+    for ignored in ["S", "faceIndices", "emission"] {
+        let _ = params.find(ignored);
+    }
+    Ok((p, n, uv))
+}
+
+/// Build the shape of pbrt type `kind`; `Ok(None)` for unsupported kinds (warned).
+pub fn make_shape(
+    kind: &str,
+    params: &ParamSet,
+    ctx: &ShapeCtx,
+    warn: &mut Warn,
+) -> anyhow::Result<Option<ShapeGeom>> {
+    let loc = ctx.loc;
+    for p in ["alpha", "displacement"] {
+        if params.has(p) {
+            let _ = params.find(p);
+            warn(
+                &format!("shape-{p}"),
+                loc,
+                format!("shape parameter '{p}' is ignored"),
+            );
+        }
+    }
+    Ok(Some(match kind {
+        "trianglemesh" => {
+            let (p, n, uv) = mesh_attrs(params, loc)?;
+            let indices = indices_param(params, "indices", p.len(), 3, loc)?;
+            ShapeGeom::Mesh(finish_mesh(
+                RawMesh {
+                    positions: p,
+                    normals: n,
+                    uvs: uv,
+                    indices,
+                },
+                ctx,
+                warn,
+            )?)
+        }
+        "bilinearmesh" => {
+            let (p, n, uv) = mesh_attrs(params, loc)?;
+            let quads = indices_param(params, "indices", p.len(), 4, loc)?;
+            if !quads.len().is_multiple_of(4) {
+                return Err(err_at(
+                    loc,
+                    format!(
+                        "bilinearmesh: expected a multiple of 4 indices, found {}",
+                        quads.len()
+                    ),
+                ));
+            }
+            // Patch vertices are p00 p10 p01 p11: split along p00–p11 keeping the
+            // orientation of (p10 − p00) × (p01 − p00).
+            let mut indices = Vec::with_capacity(quads.len() / 4 * 6);
+            for q in quads.chunks_exact(4) {
+                indices.extend_from_slice(&[q[0], q[1], q[3], q[0], q[3], q[2]]);
+            }
+            warn(
+                "bilinearmesh",
+                loc,
+                "bilinear patches approximated by two triangles each".into(),
+            );
+            ShapeGeom::Mesh(finish_mesh(
+                RawMesh {
+                    positions: p,
+                    normals: n,
+                    uvs: uv,
+                    indices,
+                },
+                ctx,
+                warn,
+            )?)
+        }
+        "plymesh" => {
+            let file = params
+                .string("filename")?
+                .ok_or_else(|| err_at(loc, "plymesh: expected \"string filename\", found none"))?;
+            let path = resolve(ctx.dir, &file);
+            for ignored in ["edgelength", "displacement"] {
+                let _ = params.find(ignored);
+            }
+            if !path.is_file() {
+                return Err(err_at(
+                    params.loc_of("filename").as_ref().unwrap_or(loc),
+                    format!("plymesh: file not found: {}", path.display()),
+                ));
+            }
+            let ply = read_ply(&path).map_err(|e| err_at(loc, format!("plymesh: {e}")))?;
+            if ply.big_polygons > 0 {
+                warn(
+                    "ply-polygons",
+                    loc,
+                    format!(
+                        "{} PLY polygons with more than 4 vertices fan-triangulated",
+                        ply.big_polygons
+                    ),
+                );
+            }
+            ShapeGeom::Mesh(finish_mesh(
+                RawMesh {
+                    positions: ply.positions,
+                    normals: ply.normals,
+                    uvs: ply.uvs,
+                    indices: ply.indices,
+                },
+                ctx,
+                warn,
+            )?)
+        }
+        "sphere" => {
+            let radius = params.float("radius", 1.0)?;
+            if !(radius.is_finite() && radius > 0.0) {
+                return Err(err_at(
+                    loc,
+                    format!("sphere: radius must be positive, found {radius}"),
+                ));
+            }
+            let partial = params.float("zmin", -radius)? > -radius
+                || params.float("zmax", radius)? < radius
+                || params.float("phimax", 360.0)? < 360.0;
+            if partial {
+                warn(
+                    "partial-sphere",
+                    loc,
+                    "partial sphere (zmin/zmax/phimax) approximated by a full sphere".into(),
+                );
+            }
+            ShapeGeom::Sphere {
+                to_world: *ctx.ctm,
+                radius,
+            }
+        }
+        "disk" => {
+            let radius = params.float("radius", 1.0)?;
+            if !(radius.is_finite() && radius > 0.0) {
+                return Err(err_at(
+                    loc,
+                    format!("disk: radius must be positive, found {radius}"),
+                ));
+            }
+            if params.float("innerradius", 0.0)? > 0.0 || params.float("phimax", 360.0)? < 360.0 {
+                warn(
+                    "partial-disk",
+                    loc,
+                    "annulus/partial disk approximated by a full disk".into(),
+                );
+            }
+            ShapeGeom::Disk {
+                to_world: *ctx.ctm,
+                height: params.float("height", 0.0)?,
+                radius,
+            }
+        }
+        other => {
+            warn(
+                &format!("shape-{other}"),
+                loc,
+                format!("shape \"{other}\" is not supported; skipped"),
+            );
+            for p in &params.params {
+                let _ = params.find(&p.name);
+            }
+            return Ok(None);
+        }
+    }))
+}
