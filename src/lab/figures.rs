@@ -4,6 +4,7 @@
 //! Keeping the figures declarative lets the runner, the report and the tests share one list, so
 //! a figure's sample counts are written down exactly once.
 
+use crate::bsdf::LobeSampling;
 use crate::integrator::Strategy;
 use crate::sampling::PatternKind;
 
@@ -36,6 +37,15 @@ impl LobeChoice {
             LobeChoice::Uniform => "uniform",
             LobeChoice::Cosine => "cosine",
             LobeChoice::Importance => "cosine-power",
+        }
+    }
+
+    /// The renderer's setting for this choice.
+    pub fn sampling(self) -> LobeSampling {
+        match self {
+            LobeChoice::Uniform => LobeSampling::Uniform,
+            LobeChoice::Cosine => LobeSampling::Cosine,
+            LobeChoice::Importance => LobeSampling::Importance,
         }
     }
 }

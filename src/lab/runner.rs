@@ -101,23 +101,10 @@ fn figure_scene_name(fig: &Figure, main: &str) -> Result<String, String> {
 
 /// Why a panel cannot be rendered with this build, if it cannot.
 fn panel_unsupported(panel: &Panel, scene: &Scene) -> Option<String> {
-    if let Some(lobe) = panel.lobe
-        && !lobe_supported(lobe)
-    {
-        return Some(format!(
-            "lobe sampling '{}' needs RenderOptions::bsdf_sampling (bsdf branch not merged)",
-            lobe.name()
-        ));
-    }
     if let Err(e) = make_selector(&panel.light_selection, scene) {
         return Some(format!("light selection '{}': {e}", panel.light_selection));
     }
     None
-}
-
-/// Whether the renderer can switch the BSDFs' lobe sampling.
-fn lobe_supported(_lobe: LobeChoice) -> bool {
-    false
 }
 
 /// Render options of a panel.
@@ -130,6 +117,7 @@ fn panel_options(panel: &Panel, seed: u64) -> RenderOptions {
         mis: MisHeuristic::Power,
         pattern: panel.pattern,
         light_selection: panel.light_selection.clone(),
+        bsdf_sampling: panel.lobe.map(LobeChoice::sampling).unwrap_or_default(),
         progress: false,
     }
 }
@@ -394,7 +382,7 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
                     mis: MisHeuristic::Power,
                     pattern: PatternKind::Stratified,
                     light_selection: "uniform".into(),
-                    progress: false,
+                    ..RenderOptions::default()
                 };
                 let (img, stats) = render(&prep.scene, res, &o)?;
                 progress.done(cost(res, spp, 1, strategy));
@@ -486,7 +474,7 @@ fn cached_reference(
         mis: MisHeuristic::Power,
         pattern: PatternKind::Stratified,
         light_selection: "uniform".into(),
-        progress: false,
+        ..RenderOptions::default()
     };
     let (img, stats) = render(scene, res, &o)?;
     progress.done(cost(res, opts.reference_spp, 1, Strategy::Mis));
