@@ -131,3 +131,61 @@ fn lab_claim_more_eye_rays_beat_more_shadow_rays_at_equal_cost() {
     let shadow = measure(Strategy::LightArea, PatternKind::Stratified, 4, 16, Metric::Full);
     assert_beats("64 × 1 vs 4 × 16", eye, shadow);
 }
+
+/// splitmix64 → uniform f32 in [0, 1): a tiny independent stream for the BSDF-only claim.
+fn next_f32(state: &mut u64) -> f32 {
+    *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^= z >> 31;
+    (z >> 40) as f32 / (1u64 << 24) as f32
+}
+
+/// Mean, sample variance, and the standard errors of both, of the albedo estimator
+/// f·cosθ/pdf of `bsdf` at normal incidence over `n` samples.
+fn albedo_estimator(bsdf: &penumbra::bsdf::Phong, n: usize, seed: u64) -> [f64; 4] {
+    use penumbra::bsdf::Bxdf;
+    let wo = glam::Vec3::Z;
+    let mut s = seed;
+    let v: Vec<f64> = (0..n)
+        .map(|_| {
+            let uc = next_f32(&mut s);
+            let u = glam::Vec2::new(next_f32(&mut s), next_f32(&mut s));
+            match bsdf.sample(wo, uc, u) {
+                Some(b) if b.pdf > 0.0 => (b.f.x * b.wi.z.max(0.0) / b.pdf) as f64,
+                _ => 0.0,
+            }
+        })
+        .collect();
+    let nf = n as f64;
+    let mean = v.iter().sum::<f64>() / nf;
+    let m2 = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (nf - 1.0);
+    let m4 = v.iter().map(|x| (x - mean).powi(4)).sum::<f64>() / nf;
+    // Standard error of the sample variance: sqrt((μ4 − σ⁴) / n).
+    [mean, m2, (m2 / nf).sqrt(), ((m4 - m2 * m2).max(0.0) / nf).sqrt()]
+}
+
+#[test]
+fn lab_claim_cosine_power_beats_cosine_beats_uniform_for_phong_n100() {
+    use penumbra::bsdf::{LobeSampling, Phong};
+    // Pure glossy lobe (kd = 0, ks = 1, n = 100): its albedo at normal incidence is exactly 1.
+    let mut v = Vec::new();
+    for (mode, seed) in [
+        (LobeSampling::Importance, 1),
+        (LobeSampling::Cosine, 2),
+        (LobeSampling::Uniform, 3),
+    ] {
+        let mut p = Phong::new(glam::Vec3::ZERO, glam::Vec3::ONE, 100.0).unwrap();
+        p.sampling = mode;
+        let [mean, var, se_mean, se_var] = albedo_estimator(&p, 200_000, seed);
+        eprintln!("{mode:?}: albedo {mean:.4} ± {se_mean:.1e}, variance {var:.4e} ± {se_var:.1e}");
+        assert!((mean - 1.0).abs() < SIGMAS * se_mean, "{mode:?} is biased: {mean} ± {se_mean}");
+        v.push((var, se_var));
+    }
+    for (better, worse, what) in [(0, 1, "cosine-power vs cosine"), (1, 2, "cosine vs uniform")] {
+        let (a, b) = (v[better], v[worse]);
+        let se = (a.1 * a.1 + b.1 * b.1).sqrt();
+        assert!(b.0 - a.0 > SIGMAS * se, "{what}: variance {a:?} does not beat {b:?}");
+    }
+}

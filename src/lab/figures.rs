@@ -128,7 +128,7 @@ pub fn lecture_figures() -> Vec<Figure> {
     use Strategy::{Bsdf, LightArea, LightSolidAngle};
     let mut phong = Vec::new();
     for lobe in [LobeChoice::Uniform, LobeChoice::Cosine, LobeChoice::Importance] {
-        let mut p = Panel::new(lobe.name(), Bsdf, 4, 16, Stratified);
+        let mut p = Panel::new(lobe.name(), Bsdf, 4, 32, Stratified);
         p.lobe = Some(lobe);
         phong.push(p);
     }
