@@ -54,7 +54,13 @@ enum Metric {
 }
 
 /// (mean, standard error of the mean) of the metric over [`SEEDS`] renders.
-fn measure(strategy: Strategy, pattern: PatternKind, spp: u32, m: u32, metric: Metric) -> (f64, f64) {
+fn measure(
+    strategy: Strategy,
+    pattern: PatternKind,
+    spp: u32,
+    m: u32,
+    metric: Metric,
+) -> (f64, f64) {
     let f = fixture();
     let v: Vec<f64> = (0..SEEDS)
         .map(|seed| {
@@ -112,23 +118,59 @@ fn lab_claim_light_area_beats_bsdf_sampling_for_small_light() {
 fn lab_claim_stratified_beats_random_at_equal_samples() {
     // Smooth pixels: the full relMSE at 4 eye rays is dominated by (heavy-tailed) emitter-edge
     // aliasing, which would need many more seeds to resolve the same difference.
-    let strat = measure(Strategy::LightArea, PatternKind::Stratified, 4, 16, Metric::Smooth);
-    let random = measure(Strategy::LightArea, PatternKind::Random, 4, 16, Metric::Smooth);
+    let strat = measure(
+        Strategy::LightArea,
+        PatternKind::Stratified,
+        4,
+        16,
+        Metric::Smooth,
+    );
+    let random = measure(
+        Strategy::LightArea,
+        PatternKind::Random,
+        4,
+        16,
+        Metric::Smooth,
+    );
     assert_beats("stratified vs random, 4 × 16, smooth", strat, random);
 }
 
 #[test]
 fn lab_claim_random_beats_fixed_light_sample_in_penumbrae() {
     // A fixed point on the light renders hard shadows: a bias no sample count removes.
-    let random = measure(Strategy::LightArea, PatternKind::Random, 4, 4, Metric::Smooth);
-    let fixed = measure(Strategy::LightArea, PatternKind::Fixed, 4, 4, Metric::Smooth);
+    let random = measure(
+        Strategy::LightArea,
+        PatternKind::Random,
+        4,
+        4,
+        Metric::Smooth,
+    );
+    let fixed = measure(
+        Strategy::LightArea,
+        PatternKind::Fixed,
+        4,
+        4,
+        Metric::Smooth,
+    );
     assert_beats("random vs fixed, 4 × 4, smooth", random, fixed);
 }
 
 #[test]
 fn lab_claim_more_eye_rays_beat_more_shadow_rays_at_equal_cost() {
-    let eye = measure(Strategy::LightArea, PatternKind::Stratified, 64, 1, Metric::Full);
-    let shadow = measure(Strategy::LightArea, PatternKind::Stratified, 4, 16, Metric::Full);
+    let eye = measure(
+        Strategy::LightArea,
+        PatternKind::Stratified,
+        64,
+        1,
+        Metric::Full,
+    );
+    let shadow = measure(
+        Strategy::LightArea,
+        PatternKind::Stratified,
+        4,
+        16,
+        Metric::Full,
+    );
     assert_beats("64 × 1 vs 4 × 16", eye, shadow);
 }
 
@@ -163,7 +205,12 @@ fn albedo_estimator(bsdf: &penumbra::bsdf::Phong, n: usize, seed: u64) -> [f64; 
     let m2 = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (nf - 1.0);
     let m4 = v.iter().map(|x| (x - mean).powi(4)).sum::<f64>() / nf;
     // Standard error of the sample variance: sqrt((μ4 − σ⁴) / n).
-    [mean, m2, (m2 / nf).sqrt(), ((m4 - m2 * m2).max(0.0) / nf).sqrt()]
+    [
+        mean,
+        m2,
+        (m2 / nf).sqrt(),
+        ((m4 - m2 * m2).max(0.0) / nf).sqrt(),
+    ]
 }
 
 #[test]
@@ -180,12 +227,21 @@ fn lab_claim_cosine_power_beats_cosine_beats_uniform_for_phong_n100() {
         p.sampling = mode;
         let [mean, var, se_mean, se_var] = albedo_estimator(&p, 200_000, seed);
         eprintln!("{mode:?}: albedo {mean:.4} ± {se_mean:.1e}, variance {var:.4e} ± {se_var:.1e}");
-        assert!((mean - 1.0).abs() < SIGMAS * se_mean, "{mode:?} is biased: {mean} ± {se_mean}");
+        assert!(
+            (mean - 1.0).abs() < SIGMAS * se_mean,
+            "{mode:?} is biased: {mean} ± {se_mean}"
+        );
         v.push((var, se_var));
     }
-    for (better, worse, what) in [(0, 1, "cosine-power vs cosine"), (1, 2, "cosine vs uniform")] {
+    for (better, worse, what) in [
+        (0, 1, "cosine-power vs cosine"),
+        (1, 2, "cosine vs uniform"),
+    ] {
         let (a, b) = (v[better], v[worse]);
         let se = (a.1 * a.1 + b.1 * b.1).sqrt();
-        assert!(b.0 - a.0 > SIGMAS * se, "{what}: variance {a:?} does not beat {b:?}");
+        assert!(
+            b.0 - a.0 > SIGMAS * se,
+            "{what}: variance {a:?} does not beat {b:?}"
+        );
     }
 }

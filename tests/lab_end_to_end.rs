@@ -42,8 +42,17 @@ fn lab_writes_every_promised_file() {
 
     // Figures 1–4 run on the main scene and always render every panel.
     for f in r.figures.iter().take(4) {
-        let def = lecture_figures().into_iter().find(|d| d.id == f.id).unwrap();
-        assert_eq!(f.panels.len(), def.panels.len(), "{}: {:?}", f.id, f.skipped);
+        let def = lecture_figures()
+            .into_iter()
+            .find(|d| d.id == f.id)
+            .unwrap();
+        assert_eq!(
+            f.panels.len(),
+            def.panels.len(),
+            "{}: {:?}",
+            f.id,
+            f.skipped
+        );
         let montage = f.montage.as_ref().expect("montage written");
         assert_file(&out, montage);
         for p in &f.panels {
@@ -52,8 +61,17 @@ fn lab_writes_every_promised_file() {
             }
             let img = read_image(&out.join(&p.exr)).unwrap();
             assert_eq!((img.width, img.height), (32, 32));
-            assert!(p.time_s > 0.0 && p.rays > 0, "{}: no work measured", p.label);
-            assert!(p.rel_mse.is_finite() && p.rel_mse > 0.0, "{}: relMSE {}", p.label, p.rel_mse);
+            assert!(
+                p.time_s > 0.0 && p.rays > 0,
+                "{}: no work measured",
+                p.label
+            );
+            assert!(
+                p.rel_mse.is_finite() && p.rel_mse > 0.0,
+                "{}: relMSE {}",
+                p.label,
+                p.rel_mse
+            );
             assert!(p.smooth_rel_mse.is_finite() && p.smooth_rel_mse <= p.rel_mse * 10.0);
         }
     }
@@ -74,7 +92,11 @@ fn lab_writes_every_promised_file() {
     }
     assert_file(&out, "convergence.svg");
     assert_file(&out, "convergence.png");
-    assert!(std::fs::read_to_string(out.join("convergence.svg")).unwrap().contains("<svg"));
+    assert!(
+        std::fs::read_to_string(out.join("convergence.svg"))
+            .unwrap()
+            .contains("<svg")
+    );
 
     // Reports: JSON round-trips the panels; HTML links every image relatively.
     assert_file(&out, "results.json");
@@ -86,10 +108,17 @@ fn lab_writes_every_promised_file() {
     assert!(html.starts_with("<!DOCTYPE html>") && html.trim_end().ends_with("</html>"));
     for f in &r.figures {
         if let Some(m) = &f.montage {
-            assert!(html.contains(&format!("src=\"{m}\"")), "html lacks montage {m}");
+            assert!(
+                html.contains(&format!("src=\"{m}\"")),
+                "html lacks montage {m}"
+            );
         }
         for p in &f.panels {
-            assert!(html.contains(&format!("href=\"{}\"", p.exr)), "html lacks {}", p.exr);
+            assert!(
+                html.contains(&format!("href=\"{}\"", p.exr)),
+                "html lacks {}",
+                p.exr
+            );
         }
     }
     assert!(!html.contains("src=\"/"), "links must be relative");
@@ -161,12 +190,24 @@ fn lab_uses_given_reference_and_rejects_bad_input() {
 fn lab_cli_runs_one_figure() {
     let out = out_dir("cli");
     let status = std::process::Command::new(env!("CARGO_BIN_EXE_penumbra"))
-        .args(["lab", "cornell", "--res", "16x16", "--quiet", "--figures", "fig2"])
+        .args([
+            "lab",
+            "cornell",
+            "--res",
+            "16x16",
+            "--quiet",
+            "--figures",
+            "fig2",
+        ])
         .args(["--reference-spp", "8", "--convergence-spp", "1", "--out"])
         .arg(&out)
         .output()
         .expect("penumbra runs");
-    assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
     assert!(String::from_utf8_lossy(&status.stdout).contains("relMSE"));
     for f in ["fig2.png", "index.html", "results.json", "convergence.png"] {
         assert_file(&out, f);

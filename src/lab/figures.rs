@@ -71,7 +71,13 @@ pub struct Panel {
 
 impl Panel {
     /// A light-selection-uniform, default-lobe panel.
-    fn new(label: &str, strategy: Strategy, spp: u32, shadow_rays: u32, pattern: PatternKind) -> Self {
+    fn new(
+        label: &str,
+        strategy: Strategy,
+        spp: u32,
+        shadow_rays: u32,
+        pattern: PatternKind,
+    ) -> Self {
         Self {
             label: label.to_string(),
             strategy,
@@ -93,7 +99,13 @@ impl Panel {
         let label: String = self
             .label
             .chars()
-            .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' })
+            .map(|c| {
+                if c.is_ascii_alphanumeric() {
+                    c.to_ascii_lowercase()
+                } else {
+                    '-'
+                }
+            })
             .collect();
         format!("{label}-{}x{}", self.spp, self.shadow_rays)
     }
@@ -127,7 +139,11 @@ pub fn lecture_figures() -> Vec<Figure> {
     use PatternKind::{Fixed, Grid, Random, Stratified};
     use Strategy::{Bsdf, LightArea, LightSolidAngle};
     let mut phong = Vec::new();
-    for lobe in [LobeChoice::Uniform, LobeChoice::Cosine, LobeChoice::Importance] {
+    for lobe in [
+        LobeChoice::Uniform,
+        LobeChoice::Cosine,
+        LobeChoice::Importance,
+    ] {
         let mut p = Panel::new(lobe.name(), Bsdf, 4, 32, Stratified);
         p.lobe = Some(lobe);
         phong.push(p);

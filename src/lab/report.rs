@@ -315,7 +315,12 @@ pub fn render_html(r: &LabResults) -> String {
             }
         );
         if let Some(m) = &f.montage {
-            let _ = writeln!(h, "<p><img src=\"{0}\" alt=\"{1}\"></p>", esc(m), esc(&f.title));
+            let _ = writeln!(
+                h,
+                "<p><img src=\"{0}\" alt=\"{1}\"></p>",
+                esc(m),
+                esc(&f.title)
+            );
         }
         if !f.panels.is_empty() {
             h.push_str("<p>relMSE maps (viridis, log10 −4..1): ");
@@ -352,8 +357,11 @@ pub fn render_html(r: &LabResults) -> String {
         for s in &r.convergence {
             let _ = write!(h, "<tr><td>{}</td>", esc(&s.strategy));
             for p in &s.points {
-                let _ = write!(h, "<td>{:.3e}<br>smooth {:.3e}<br>{:.3} s</td>",
-                    p.rel_mse, p.smooth_rel_mse, p.time_s);
+                let _ = write!(
+                    h,
+                    "<td>{:.3e}<br>smooth {:.3e}<br>{:.3} s</td>",
+                    p.rel_mse, p.smooth_rel_mse, p.time_s
+                );
             }
             h.push_str("</tr>\n");
         }

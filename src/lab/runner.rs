@@ -2,8 +2,8 @@
 //! of every figure, measures wall time and relMSE, writes images and montages, and sweeps the
 //! convergence of the four estimators. The report files are written by [`super::report`].
 
-use super::mask::{edge_mask, smooth_rel_mse};
 use super::figures::{Figure, FigureScene, LobeChoice, Panel, lecture_figures};
+use super::mask::{edge_mask, smooth_rel_mse};
 use super::report::{
     ConvergencePoint, ConvergenceSeries, FigureResult, LabResults, PanelResult, ReferenceInfo,
 };
@@ -30,7 +30,7 @@ pub const DEFAULT_REFERENCE_SPP: u32 = 1024;
 pub const DEFAULT_CONVERGENCE_SPP: u32 = 64;
 
 /// Seed offset of the reference, so its samples are independent of every panel's.
-const REFERENCE_SEED_OFFSET: u64 = 0x5eed_0f_2ef;
+const REFERENCE_SEED_OFFSET: u64 = 0x5eed_f2ef;
 
 /// What to run and where to write it.
 #[derive(Clone, Debug)]
@@ -135,7 +135,13 @@ fn scene_slug(spec: &str) -> String {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| spec.to_string());
     stem.chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect()
 }
 
@@ -179,7 +185,10 @@ impl Progress {
 /// Run the lab; writes every image, montage, plot and report into `opts.out`.
 pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
     let started = Instant::now();
-    anyhow::ensure!(opts.reference_spp >= 1, "--reference-spp must be at least 1");
+    anyhow::ensure!(
+        opts.reference_spp >= 1,
+        "--reference-spp must be at least 1"
+    );
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("creating output directory {}", opts.out.display()))?;
     let user_reference = match &opts.reference {
@@ -190,7 +199,11 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
     };
     let res = opts
         .res
-        .or_else(|| user_reference.as_ref().map(|r| UVec2::new(r.width, r.height)))
+        .or_else(|| {
+            user_reference
+                .as_ref()
+                .map(|r| UVec2::new(r.width, r.height))
+        })
         .unwrap_or(DEFAULT_RES);
     if let Some(r) = &user_reference {
         anyhow::ensure!(
@@ -506,6 +519,10 @@ fn write_outputs(
     };
     write_image(img, &out.join(&files.exr), 0.0)?;
     write_image(img, &out.join(&files.png), 0.0)?;
-    write_image(&error_image(img, reference)?, &out.join(&files.error_png), 0.0)?;
+    write_image(
+        &error_image(img, reference)?,
+        &out.join(&files.error_png),
+        0.0,
+    )?;
     Ok(files)
 }
