@@ -25,7 +25,7 @@ use std::time::Instant;
 /// Default lab resolution: the whole default lab stays under two minutes on two cores.
 pub const DEFAULT_RES: UVec2 = UVec2::new(256, 256);
 /// Default eye rays per pixel of the automatic reference (MIS, one sample of each technique).
-pub const DEFAULT_REFERENCE_SPP: u32 = 1024;
+pub const DEFAULT_REFERENCE_SPP: u32 = 512;
 /// Default largest spp of the convergence sweep (doubling from 1).
 pub const DEFAULT_CONVERGENCE_SPP: u32 = 64;
 
