@@ -31,6 +31,8 @@ pub struct ReferenceInfo {
     pub time_s: f64,
     /// Fraction of its pixels away from edges (used by the smooth relMSE).
     pub smooth_fraction: f64,
+    /// Light selection of a rendered reference (empty for a given file).
+    pub light_selection: String,
 }
 
 /// One rendered panel and its measurements.

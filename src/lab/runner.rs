@@ -9,7 +9,6 @@ use super::report::{
 };
 use crate::image::{Image, compare, error_image, read_image, save_png_atomic, write_image};
 use crate::integrator::{MisHeuristic, RenderOptions, Strategy, render};
-use crate::light_selection::make_selector;
 use crate::sampling::PatternKind;
 use crate::scene::Scene;
 use crate::scene::builtin::BUILTINS;
@@ -99,13 +98,11 @@ fn figure_scene_name(fig: &Figure, main: &str) -> Result<String, String> {
     }
 }
 
-/// Why a panel cannot be rendered with this build, if it cannot.
-fn panel_unsupported(panel: &Panel, scene: &Scene) -> Option<String> {
-    if let Err(e) = make_selector(&panel.light_selection, scene) {
-        return Some(format!("light selection '{}': {e}", panel.light_selection));
-    }
-    None
-}
+/// Light selections tried, in order, for the reference of a scene with many lights: the first
+/// this build knows is used (uniform selection would leave a many-light reference noisy).
+const REFERENCE_SELECTIONS: [&str; 3] = ["bvh", "power", "uniform"];
+/// Scenes with more lights than this get a reference with [`REFERENCE_SELECTIONS`].
+const MANY_LIGHTS: usize = 4;
 
 /// Render options of a panel.
 fn panel_options(panel: &Panel, seed: u64) -> RenderOptions {
@@ -290,6 +287,7 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
                 spp: None,
                 time_s: 0.0,
                 smooth_fraction: 0.0,
+                light_selection: String::new(),
             };
             (img, info)
         } else {
@@ -331,15 +329,20 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
         let mut montage_panels = Vec::new();
         for panel in &fig.panels {
             let units = cost(res, panel.spp, panel.shadow_rays, panel.strategy);
-            if let Some(why) = panel_unsupported(panel, &prep.scene) {
-                notes.push(format!("{} {}: skipped: {why}", fig.id, panel.label));
-                result.skipped.push(format!("{}: {why}", panel.label));
-                progress.done(units);
-                continue;
-            }
             progress.start(&format!("{} {} {}", fig.id, panel.label, panel.counts()));
-            let (img, stats) = render(&prep.scene, res, &panel_options(panel, opts.seed))?;
+            let rendered = render(&prep.scene, res, &panel_options(panel, opts.seed));
             progress.done(units);
+            let (img, stats) = match rendered {
+                Ok(r) => r,
+                // Selectors arrive with the many-light work; until then say so and go on.
+                Err(e) if panel.light_selection != "uniform" => {
+                    let why = format!("light selection '{}': {e:#}", panel.light_selection);
+                    notes.push(format!("{} {}: skipped: {why}", fig.id, panel.label));
+                    result.skipped.push(format!("{}: {why}", panel.label));
+                    continue;
+                }
+                Err(e) => return Err(e),
+            };
             let err = compare(&img, &prep.reference)?;
             let stem = format!("{}-{}", fig.id, panel.slug());
             let files = write_outputs(&opts.out, &stem, &img, &prep.reference)?;
@@ -468,6 +471,7 @@ fn cached_reference(
         spp: Some(opts.reference_spp),
         time_s: 0.0,
         smooth_fraction: 0.0,
+        light_selection: "uniform".into(),
     };
     if path.exists() {
         // A damaged or mis-sized cache is re-rendered rather than trusted.
@@ -479,17 +483,37 @@ fn cached_reference(
             return Ok((img, info));
         }
     }
-    let o = RenderOptions {
-        spp: opts.reference_spp,
-        shadow_rays: 1,
-        seed: opts.seed.wrapping_add(REFERENCE_SEED_OFFSET),
-        strategy: Strategy::Mis,
-        mis: MisHeuristic::Power,
-        pattern: PatternKind::Stratified,
-        light_selection: "uniform".into(),
-        ..RenderOptions::default()
+    let selections: &[&str] = if scene.lights.len() > MANY_LIGHTS {
+        &REFERENCE_SELECTIONS
+    } else {
+        &["uniform"]
     };
-    let (img, stats) = render(scene, res, &o)?;
+    let mut rendered = None;
+    for (i, &sel) in selections.iter().enumerate() {
+        let o = RenderOptions {
+            spp: opts.reference_spp,
+            shadow_rays: 1,
+            seed: opts.seed.wrapping_add(REFERENCE_SEED_OFFSET),
+            strategy: Strategy::Mis,
+            mis: MisHeuristic::Power,
+            pattern: PatternKind::Stratified,
+            light_selection: sel.into(),
+            ..RenderOptions::default()
+        };
+        match render(scene, res, &o) {
+            Ok(r) => {
+                info.light_selection = sel.to_string();
+                rendered = Some(r);
+                break;
+            }
+            // An unknown selector fails before rendering; fall back to the next one.
+            Err(_) if i + 1 < selections.len() => continue,
+            Err(e) => return Err(e),
+        }
+    }
+    let Some((img, stats)) = rendered else {
+        anyhow::bail!("no light selection could render the reference of {name}");
+    };
     progress.done(cost(res, opts.reference_spp, 1, Strategy::Mis));
     write_image(&img, &path, 0.0)?;
     write_image(&img, &path.with_extension("png"), 0.0)?;
