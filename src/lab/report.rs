@@ -75,10 +75,12 @@ pub struct PanelResult {
 impl PanelResult {
     /// The montage label: strategy, N × M, time, relMSE (one per line).
     pub fn montage_label(&self) -> String {
-        let what = match &self.lobe {
-            Some(l) => format!("{} ({l})", self.strategy),
-            None if self.label == self.strategy => self.label.clone(),
-            None => format!("{} ({})", self.label, self.strategy),
+        // The strategy gets its own line when the label names something else (pattern,
+        // lobe, selector), so cells stay narrow.
+        let what = if self.label == self.strategy {
+            self.label.clone()
+        } else {
+            format!("{}\n{}", self.label, self.strategy)
         };
         format!(
             "{what}\n{} × {}\n{}\nrelMSE {:.2e}\nsmooth {:.2e}",

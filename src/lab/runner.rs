@@ -230,7 +230,12 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
     let mut notes = Vec::new();
     let mut scenes: HashMap<String, Scene> = HashMap::new();
     let mut fig_scene: Vec<Result<String, String>> = Vec::new();
-    let mut needed = vec![opts.scene.clone()];
+    let spps = convergence_spps(opts.convergence_spp);
+    // The main scene is needed for the convergence sweep or a figure on it.
+    let mut needed = Vec::new();
+    if !spps.is_empty() || figures.iter().any(|f| f.scene == FigureScene::Main) {
+        needed.push(opts.scene.clone());
+    }
     for fig in &figures {
         let name = figure_scene_name(fig, &opts.scene);
         if let Ok(n) = &name
@@ -264,7 +269,6 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
             .map(|p| cost(res, p.spp, p.shadow_rays, p.strategy))
             .sum::<u64>();
     }
-    let spps = convergence_spps(opts.convergence_spp);
     for s in Strategy::ALL {
         total += spps.iter().map(|&n| cost(res, n, 1, s)).sum::<u64>();
     }
