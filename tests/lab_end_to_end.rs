@@ -220,3 +220,37 @@ fn lab_cli_runs_one_figure() {
     assert!(!bad.status.success());
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn lab_figures_use_the_lectures_sample_counts() {
+    let figs = lecture_figures();
+    let counts = |id: &str| -> Vec<(String, u32, u32)> {
+        figs.iter()
+            .find(|f| f.id == id)
+            .unwrap()
+            .panels
+            .iter()
+            .map(|p| (p.label.clone(), p.spp, p.shadow_rays))
+            .collect()
+    };
+    let c = |l: &str, n, m| (l.to_string(), n, m);
+    assert_eq!(counts("fig1"), [c("bsdf", 4, 100), c("light-area", 4, 100)]);
+    assert_eq!(counts("fig2"), [c("fixed", 4, 1), c("random", 4, 1)]);
+    assert_eq!(counts("fig3"), [c("grid", 4, 64), c("stratified", 4, 64)]);
+    assert_eq!(
+        counts("fig4"),
+        [c("stratified", 4, 16), c("stratified", 64, 1)]
+    );
+    // Every panel's files are distinct within its figure.
+    for f in &figs {
+        let mut slugs: Vec<String> = f.panels.iter().map(|p| p.slug()).collect();
+        slugs.sort();
+        slugs.dedup();
+        assert_eq!(
+            slugs.len(),
+            f.panels.len(),
+            "{}: duplicate panel file names",
+            f.id
+        );
+    }
+}

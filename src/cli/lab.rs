@@ -27,7 +27,7 @@ pub struct Args {
     /// Reference image of the main scene (default: rendered with MIS and cached in --out).
     #[arg(long)]
     pub reference: Option<PathBuf>,
-    /// Eye rays per pixel of the rendered references.
+    /// Eye rays per pixel of the rendered references (many-light scenes use a quarter).
     #[arg(long, default_value_t = DEFAULT_REFERENCE_SPP)]
     pub reference_spp: u32,
     /// Largest spp of the convergence sweep (doubling from 1); 0 skips it.

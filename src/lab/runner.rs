@@ -103,6 +103,19 @@ fn figure_scene_name(fig: &Figure, main: &str) -> Result<String, String> {
 const REFERENCE_SELECTIONS: [&str; 3] = ["bvh", "power", "uniform"];
 /// Scenes with more lights than this get a reference with [`REFERENCE_SELECTIONS`].
 const MANY_LIGHTS: usize = 4;
+/// Many-light references use this fraction of `--reference-spp`: their per-sample cost is
+/// several times Cornell's, and a good selector converges fast enough that the reference
+/// noise stays well below the panels' error.
+const MANY_LIGHTS_REFERENCE_DIVISOR: u32 = 4;
+
+/// Eye rays per pixel of the reference rendered for `scene`.
+fn reference_spp(scene: &Scene, opts: &LabOptions) -> u32 {
+    if scene.lights.len() > MANY_LIGHTS {
+        (opts.reference_spp / MANY_LIGHTS_REFERENCE_DIVISOR).max(1)
+    } else {
+        opts.reference_spp
+    }
+}
 
 /// Render options of a panel.
 fn panel_options(panel: &Panel, seed: u64) -> RenderOptions {
@@ -254,12 +267,12 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
     }
 
     // Plan the run so the progress bar covers all of it.
-    let cached = |name: &str| reference_path(&opts.out, name, res, opts.reference_spp);
     let mut total = 0u64;
-    for name in &needed {
+    for (name, scene) in &scenes {
         let given = user_reference.is_some() && name == &opts.scene;
-        if !given && !cached(name).exists() {
-            total += cost(res, opts.reference_spp, 1, Strategy::Mis);
+        let spp = reference_spp(scene, opts);
+        if !given && !reference_path(&opts.out, name, res, spp).exists() {
+            total += cost(res, spp, 1, Strategy::Mis);
         }
     }
     for fig in &figures {
@@ -455,7 +468,7 @@ pub fn reference_path(out: &Path, scene: &str, res: UVec2, spp: u32) -> PathBuf 
 }
 
 /// The reference of `scene`: read from the cache in `opts.out` when present and of the right
-/// size, else rendered with MIS at `opts.reference_spp` and cached (EXR + PNG).
+/// size, else rendered with MIS at [`reference_spp`] and cached (EXR + PNG).
 fn cached_reference(
     scene: &Scene,
     name: &str,
@@ -463,7 +476,8 @@ fn cached_reference(
     opts: &LabOptions,
     progress: &Progress,
 ) -> anyhow::Result<(Image, ReferenceInfo)> {
-    let path = reference_path(&opts.out, name, res, opts.reference_spp);
+    let spp = reference_spp(scene, opts);
+    let path = reference_path(&opts.out, name, res, spp);
     let file = path
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
@@ -472,7 +486,7 @@ fn cached_reference(
         scene: name.to_string(),
         source: "cache".into(),
         path: file,
-        spp: Some(opts.reference_spp),
+        spp: Some(spp),
         time_s: 0.0,
         smooth_fraction: 0.0,
         light_selection: "uniform".into(),
@@ -495,7 +509,7 @@ fn cached_reference(
     let mut rendered = None;
     for (i, &sel) in selections.iter().enumerate() {
         let o = RenderOptions {
-            spp: opts.reference_spp,
+            spp,
             shadow_rays: 1,
             seed: opts.seed.wrapping_add(REFERENCE_SEED_OFFSET),
             strategy: Strategy::Mis,
@@ -518,7 +532,7 @@ fn cached_reference(
     let Some((img, stats)) = rendered else {
         anyhow::bail!("no light selection could render the reference of {name}");
     };
-    progress.done(cost(res, opts.reference_spp, 1, Strategy::Mis));
+    progress.done(cost(res, spp, 1, Strategy::Mis));
     write_image(&img, &path, 0.0)?;
     write_image(&img, &path.with_extension("png"), 0.0)?;
     info.source = "rendered".into();
