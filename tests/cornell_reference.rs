@@ -74,3 +74,8 @@ fn cornell_light_area_matches_mitsuba_reference() {
 fn cornell_bsdf_matches_mitsuba_reference() {
     check(Strategy::Bsdf, 0.23, 0.02);
 }
+
+#[test]
+fn cornell_light_solid_angle_matches_mitsuba_reference() {
+    check(Strategy::LightSolidAngle, 2.7e-4, 0.005);
+}

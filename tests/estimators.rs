@@ -57,7 +57,7 @@ fn scene(add: impl FnOnce(&mut SceneBuilder)) -> Scene {
 /// Mean and standard error of the radiance toward a ray hitting the plane at the origin,
 /// over `pixels` independent sample sets of `spp` eye samples × `m` light samples.
 fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> (f64, f64) {
-    let selector = make_selector("uniform", scene).unwrap();
+    let selector = make_selector("uniform", scene, 7).unwrap();
     let pattern = make_pattern(pattern, 7);
     let spp = 16;
     let est = DirectLighting {
@@ -69,6 +69,7 @@ fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> 
         eye_rays: spp,
         shadow_rays: m,
         bsdf_sampling: penumbra::bsdf::LobeSampling::Importance,
+        mis_light: penumbra::lights::SamplingMode::SolidAngle,
     };
     // A ray that reaches the origin from the side, clear of lights above it.
     let o = Vec3::new(0.0, -3.0, 1.0);
@@ -80,8 +81,9 @@ fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> 
         // Average the eye samples of a pixel first: the per-pixel means are i.i.d. even when
         // the pattern stratifies within a pixel.
         let mut pm = 0.0f64;
+        let px = pattern.pixel(pixel);
         for i in 0..spp {
-            let (l, _) = est.li(pixel, i, &ray);
+            let (l, _) = est.li(&px, i, &ray);
             pm += l.x as f64;
         }
         pm /= spp as f64;

@@ -24,12 +24,15 @@ pub enum Command {
     Compare(compare::Args),
     /// Render the lecture's comparison figures with timings, relMSE and an HTML report.
     Lab(lab::Args),
+    /// Plot and chi-square-test a sampling routine; dump samples, evaluate its pdf.
+    Warp(warp::Args),
 }
 
 pub mod bench;
 pub mod compare;
 pub mod lab;
 pub mod render;
+pub mod warp;
 
 /// Dispatch a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -44,6 +47,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Some(Command::Bench(a)) => bench::run(a),
+        Some(Command::Warp(a)) => warp::run_cmd(a),
         None => match Cli::try_parse_from(["penumbra", "render"])?.command {
             Some(Command::Render(a)) => render::run(a),
             _ => unreachable!("`render` parses to the render command"),

@@ -6,6 +6,7 @@ use penumbra::integrator::{MisHeuristic, RenderOptions, Strategy, render};
 use penumbra::sampling::PatternKind;
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
+use penumbra::scene::view::ViewOptions;
 use std::path::PathBuf;
 
 /// Arguments of `penumbra render`.
@@ -47,6 +48,9 @@ pub struct Args {
     /// Light selection strategy.
     #[arg(long, default_value = "uniform")]
     pub light_selection: String,
+    /// Light sampling technique inside `mis`: solid-angle (default) or area.
+    #[arg(long, default_value = "solid-angle", value_parser = parse_mode)]
+    pub mis_light: penumbra::lights::SamplingMode,
     /// How BSDF lobes are sampled: importance (cosine-power / GGX), cosine or uniform.
     #[arg(long, default_value = "importance")]
     pub bsdf_sampling: penumbra::bsdf::LobeSampling,
@@ -59,6 +63,48 @@ pub struct Args {
     /// Rooms per side of `many-rooms`.
     #[arg(long)]
     pub rooms: Option<u32>,
+    /// Triangle count of procedural meshes (`dense`).
+    #[arg(long)]
+    pub triangles: Option<u32>,
+    /// OBJ: treat the MTL ambient colour Ka as emitted radiance (Embree Cornell-box files).
+    #[arg(long)]
+    pub obj_ka_emission: bool,
+    /// OBJ/glTF camera eye X,Y,Z (overrides the file's camera / automatic framing).
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
+    pub look_from: Option<glam::Vec3>,
+    /// OBJ/glTF camera target X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
+    pub look_at: Option<glam::Vec3>,
+    /// OBJ/glTF camera up vector X,Y,Z (default 0,1,0).
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
+    pub up: Option<glam::Vec3>,
+    /// OBJ/glTF field of view in degrees along the shorter image axis (default 40).
+    #[arg(long)]
+    pub fov: Option<f32>,
+}
+
+/// Parse `X,Y,Z` (finite numbers).
+pub fn parse_vec3(s: &str) -> Result<glam::Vec3, String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|c| c.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected X,Y,Z (e.g. 0,1,5), got '{s}'"))?;
+    match v[..] {
+        [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => {
+            Ok(glam::Vec3::new(x, y, z))
+        }
+        _ => Err(format!("expected three finite numbers X,Y,Z, got '{s}'")),
+    }
+}
+
+/// Parse a light sampling mode name.
+pub fn parse_mode(s: &str) -> Result<penumbra::lights::SamplingMode, String> {
+    match s {
+        "area" => Ok(penumbra::lights::SamplingMode::Area),
+        "solid-angle" => Ok(penumbra::lights::SamplingMode::SolidAngle),
+        _ => Err(format!("expected area or solid-angle, got '{s}'")),
+    }
 }
 
 /// Parse `WxH`.
@@ -88,7 +134,14 @@ pub fn load_options(a: &Args) -> LoadOptions {
         builtin: BuiltinOptions {
             light_count: a.light_count,
             rooms: a.rooms,
-            triangles: None,
+            triangles: a.triangles,
+        },
+        obj_ka_emission: a.obj_ka_emission,
+        view: ViewOptions {
+            look_from: a.look_from,
+            look_at: a.look_at,
+            up: a.up,
+            fov: a.fov,
         },
     }
 }
@@ -112,6 +165,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         pattern: args.pattern,
         light_selection: args.light_selection.clone(),
         bsdf_sampling: args.bsdf_sampling,
+        mis_light: args.mis_light,
         progress: !args.quiet,
     };
     anyhow::ensure!(opts.spp >= 1, "--spp must be at least 1");

@@ -1,5 +1,7 @@
-//! [`Geometry`]: every primitive of a scene behind one obvhs compressed-wide BVH (CWBVH).
+//! [`Geometry`]: every primitive of a scene behind one BVH — penumbra's own binned-SAH BVH2
+//! ([`super::bvh`]) or obvhs's compressed-wide BVH (CWBVH), see [`Backend`].
 
+use super::bvh::Bvh;
 use super::quadric::Quadric;
 use super::triangle::{RayShear, barycentric_error};
 use super::{Ray, RayQuery, SurfaceHit};
@@ -48,6 +50,23 @@ pub struct Primitive {
     pub light: u32,
 }
 
+/// Which acceleration structure [`Geometry`] builds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Backend {
+    /// penumbra's binned-SAH BVH2.
+    Own,
+    /// obvhs's CWBVH (the default: fewer instructions per ray on cornell, see `penumbra bench`).
+    #[default]
+    Obvhs,
+}
+
+/// The built acceleration structure.
+enum Accel {
+    None,
+    Own(Bvh),
+    Obvhs(CwBvh),
+}
+
 /// All scene geometry and its BVH.
 pub struct Geometry {
     prims: Vec<Primitive>,
@@ -55,52 +74,88 @@ pub struct Geometry {
     pub meshes: Vec<MeshShading>,
     /// Spheres and disks.
     pub quadrics: Vec<Quadric>,
-    bvh: Option<CwBvh>,
+    accel: Accel,
     bounds: (Vec3, Vec3),
     /// Wall time of the BVH build.
     pub build_time: Duration,
 }
 
 impl Geometry {
-    /// Build the BVH over `prims` (reordered internally so the BVH's leaf order is the storage
-    /// order: one indirection less per intersection test).
+    /// Build the default BVH over `prims` (reordered internally so the BVH's leaf order is the
+    /// storage order: one indirection less per intersection test).
     pub fn new(prims: Vec<Primitive>, meshes: Vec<MeshShading>, quadrics: Vec<Quadric>) -> Self {
+        Self::with_backend(prims, meshes, quadrics, Backend::default())
+    }
+
+    /// Build the BVH of `backend` over `prims` (see [`Geometry::new`]).
+    pub fn with_backend(
+        prims: Vec<Primitive>,
+        meshes: Vec<MeshShading>,
+        quadrics: Vec<Quadric>,
+        backend: Backend,
+    ) -> Self {
         let start = Instant::now();
-        let aabbs: Vec<Aabb> = prims
-            .iter()
-            .map(|p| {
-                let (lo, hi) = prim_bounds(p, &quadrics);
-                Aabb::new(lo.into(), hi.into())
-            })
-            .collect();
+        let boxes: Vec<(Vec3, Vec3)> = prims.iter().map(|p| prim_bounds(p, &quadrics)).collect();
         let mut bounds = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for a in &aabbs {
-            bounds.0 = bounds.0.min(a.min.into());
-            bounds.1 = bounds.1.max(a.max.into());
+        for (lo, hi) in &boxes {
+            bounds.0 = bounds.0.min(*lo);
+            bounds.1 = bounds.1.max(*hi);
         }
-        let (prims, bvh) = if prims.is_empty() {
-            (prims, None)
+        let (order, accel): (Vec<u32>, Accel) = if prims.is_empty() {
+            (Vec::new(), Accel::None)
         } else {
-            let mut t = Duration::ZERO;
-            let bvh = obvhs::cwbvh::builder::build_cwbvh(
-                &aabbs,
-                obvhs::BvhBuildParams::medium_build(),
-                &mut t,
-            );
-            let ordered: Vec<Primitive> = bvh
-                .primitive_indices
-                .iter()
-                .map(|&i| prims[i as usize])
-                .collect();
-            (ordered, Some(bvh))
+            match backend {
+                Backend::Own => {
+                    let mut bvh = Bvh::build(&boxes);
+                    (std::mem::take(&mut bvh.indices), Accel::Own(bvh))
+                }
+                Backend::Obvhs => {
+                    let aabbs: Vec<Aabb> = boxes
+                        .iter()
+                        .map(|(lo, hi)| Aabb::new((*lo).into(), (*hi).into()))
+                        .collect();
+                    let mut t = Duration::ZERO;
+                    let bvh = obvhs::cwbvh::builder::build_cwbvh(
+                        &aabbs,
+                        obvhs::BvhBuildParams::medium_build(),
+                        &mut t,
+                    );
+                    (bvh.primitive_indices.clone(), Accel::Obvhs(bvh))
+                }
+            }
         };
+        let prims = order.iter().map(|&i| prims[i as usize]).collect();
         Self {
             prims,
             meshes,
             quadrics,
-            bvh,
+            accel,
             bounds,
             build_time: start.elapsed(),
+        }
+    }
+
+    /// The same geometry behind a freshly built BVH of `backend` (benchmarks, backend tests).
+    pub fn rebuild(&self, backend: Backend) -> Self {
+        Self::with_backend(
+            self.prims.clone(),
+            self.meshes.clone(),
+            self.quadrics.clone(),
+            backend,
+        )
+    }
+
+    /// Primitive `id` (the `prim` of a [`SurfaceHit`]); ids depend on the backend's leaf order.
+    pub fn primitive(&self, id: u32) -> Option<&Primitive> {
+        self.prims.get(id as usize)
+    }
+
+    /// Which backend was built (`None` for an empty scene).
+    pub fn backend(&self) -> Option<Backend> {
+        match self.accel {
+            Accel::None => None,
+            Accel::Own(_) => Some(Backend::Own),
+            Accel::Obvhs(_) => Some(Backend::Obvhs),
         }
     }
 
@@ -235,25 +290,36 @@ fn to_obvhs(ray: &Ray) -> obvhs::ray::Ray {
 
 impl RayQuery for Geometry {
     fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
-        let bvh = self.bvh.as_ref()?;
-        let mut hit = RayHit::none();
         let shear = RayShear::new(ray.o, ray.d);
-        let found = bvh.ray_traverse(to_obvhs(ray), &mut hit, |r, id| {
-            self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
-        });
-        if !found {
-            return None;
-        }
-        Some(self.surface_hit(hit.primitive_id as usize, ray, hit.t))
+        let (id, t) = match &self.accel {
+            Accel::None => return None,
+            Accel::Own(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
+                self.prim_t(id, &shear, ray.o, ray.d, t_max)
+            })?,
+            Accel::Obvhs(bvh) => {
+                let mut hit = RayHit::none();
+                let found = bvh.ray_traverse(to_obvhs(ray), &mut hit, |r, id| {
+                    self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
+                });
+                if !found {
+                    return None;
+                }
+                (hit.primitive_id as usize, hit.t)
+            }
+        };
+        Some(self.surface_hit(id, ray, t))
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
-        let Some(bvh) = self.bvh.as_ref() else {
-            return false;
-        };
         let shear = RayShear::new(ray.o, ray.d);
-        !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
-            self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
-        })
+        match &self.accel {
+            Accel::None => false,
+            Accel::Own(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                self.prim_t(id, &shear, ray.o, ray.d, ray.t_max) < ray.t_max
+            }),
+            Accel::Obvhs(bvh) => !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
+                self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
+            }),
+        }
     }
 }

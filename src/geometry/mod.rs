@@ -1,6 +1,7 @@
-//! Shapes, transforms, rays and the ray-query acceleration structure (obvhs CWBVH).
+//! Shapes, transforms, rays and the ray-query acceleration structures (own BVH2, obvhs CWBVH).
 
 pub mod accel;
+pub mod bvh;
 pub mod float;
 pub mod interaction;
 pub mod quadric;
@@ -8,7 +9,7 @@ pub mod ray;
 pub mod transform;
 pub mod triangle;
 
-pub use accel::{Geometry, MeshShading, PrimKind, Primitive};
+pub use accel::{Backend, Geometry, MeshShading, PrimKind, Primitive};
 pub use interaction::SurfaceHit;
 pub use quadric::{Quadric, QuadricKind};
 pub use ray::Ray;

@@ -13,9 +13,9 @@ use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::{Ray, RayQuery, SurfaceHit};
 use crate::light_selection::{LightSelector, ShadingPoint};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode};
-use crate::sampling::{Frame, SamplePattern, balance_heuristic, power_heuristic};
+use crate::sampling::{Frame, PixelSamples, SamplePattern, balance_heuristic, power_heuristic};
 use crate::scene::Scene;
-use glam::{UVec2, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 
 /// Pattern dimension of the pixel-filter sample.
 pub const DIM_FILTER: u32 = 0;
@@ -49,12 +49,14 @@ pub struct DirectLighting<'a> {
     pub shadow_rays: u32,
     /// How BSDF lobes are sampled.
     pub bsdf_sampling: LobeSampling,
+    /// Light sampling technique of `mis`.
+    pub mis_light: SamplingMode,
 }
 
 /// Where the samples of one eye ray come from.
 #[derive(Clone, Copy)]
-struct SampleIndex {
-    pixel: UVec2,
+struct SampleIndex<'p> {
+    px: &'p PixelSamples,
     index: u32,
     count: u32,
 }
@@ -75,6 +77,7 @@ impl<'a> DirectLighting<'a> {
     fn mode(&self) -> SamplingMode {
         match self.strategy {
             Strategy::LightArea => SamplingMode::Area,
+            Strategy::Mis => self.mis_light,
             _ => SamplingMode::SolidAngle,
         }
     }
@@ -87,9 +90,9 @@ impl<'a> DirectLighting<'a> {
         }
     }
 
-    /// Radiance along camera ray `ray` for eye sample `eye` of `pixel`; also returns the number
-    /// of rays traced.
-    pub fn li(&self, pixel: UVec2, eye: u32, ray: &Ray) -> (Rgb, u64) {
+    /// Radiance along camera ray `ray` for eye sample `eye` of the pixel whose samples are `px`
+    /// (from [`SamplePattern::pixel`]); also returns the number of rays traced.
+    pub fn li(&self, px: &PixelSamples, eye: u32, ray: &Ray) -> (Rgb, u64) {
         let scene = self.scene;
         let Some(hit) = scene.geometry.intersect(ray) else {
             return (self.escaped(ray.d), 1);
@@ -133,7 +136,7 @@ impl<'a> DirectLighting<'a> {
         let mut sum = Rgb::ZERO;
         for j in 0..m {
             let si = SampleIndex {
-                pixel,
+                px,
                 index: eye * m + j,
                 count,
             };
@@ -163,17 +166,13 @@ impl<'a> DirectLighting<'a> {
     }
 
     /// One light-sampling estimate f·Li·cos / (pmf·pdf), MIS-weighted when `mis`.
-    fn light_sample(&self, sh: &Shading, si: SampleIndex, mis: bool, rays: &mut u64) -> Rgb {
-        let uc = self
-            .pattern
-            .sample_1d(si.pixel, DIM_LIGHT_SELECT, si.index, si.count);
+    fn light_sample(&self, sh: &Shading, si: SampleIndex<'_>, mis: bool, rays: &mut u64) -> Rgb {
+        let uc = si.px.sample_1d(DIM_LIGHT_SELECT, si.index, si.count);
         let Some(sel) = self.selector.sample(&sh.sp, uc) else {
             return Rgb::ZERO;
         };
         let light = &self.scene.lights[sel.index as usize];
-        let u = self
-            .pattern
-            .sample_2d(si.pixel, DIM_LIGHT, si.index, si.count);
+        let u = si.px.sample_2d(DIM_LIGHT, si.index, si.count);
         let Some(ls) = light.sample_li(&sh.ctx, u, self.mode()) else {
             return Rgb::ZERO;
         };
@@ -203,13 +202,9 @@ impl<'a> DirectLighting<'a> {
     }
 
     /// One BSDF-sampling estimate f·cos·Le / pdf, MIS-weighted when `mis`.
-    fn bsdf_sample(&self, sh: &Shading, si: SampleIndex, mis: bool, rays: &mut u64) -> Rgb {
-        let uc = self
-            .pattern
-            .sample_1d(si.pixel, DIM_LOBE, si.index, si.count);
-        let u = self
-            .pattern
-            .sample_2d(si.pixel, DIM_BSDF, si.index, si.count);
+    fn bsdf_sample(&self, sh: &Shading, si: SampleIndex<'_>, mis: bool, rays: &mut u64) -> Rgb {
+        let uc = si.px.sample_1d(DIM_LOBE, si.index, si.count);
+        let u = si.px.sample_2d(DIM_BSDF, si.index, si.count);
         let Some(bs) = sh.bsdf.sample(sh.wo_local, uc, u) else {
             return Rgb::ZERO;
         };

@@ -105,6 +105,8 @@ pub struct RenderOptions {
     pub pattern: PatternKind,
     /// Light selection strategy name (see `light_selection`).
     pub light_selection: String,
+    /// How `mis` samples lights: by solid angle where supported (default) or by area.
+    pub mis_light: crate::lights::SamplingMode,
     /// How BSDF lobes are sampled (the lecture's I₂ variants; importance by default).
     pub bsdf_sampling: LobeSampling,
     /// Show a progress bar.
@@ -122,6 +124,7 @@ impl Default for RenderOptions {
             pattern: PatternKind::Stratified,
             light_selection: "uniform".into(),
             bsdf_sampling: LobeSampling::Importance,
+            mis_light: crate::lights::SamplingMode::SolidAngle,
             progress: false,
         }
     }

@@ -50,7 +50,7 @@ pub fn render(
         res.y
     );
     anyhow::ensure!(opts.spp > 0, "--spp must be at least 1");
-    let selector = make_selector(&opts.light_selection, scene)?;
+    let selector = make_selector(&opts.light_selection, scene, opts.seed)?;
     let pattern = make_pattern(opts.pattern, opts.seed);
     let est = DirectLighting {
         scene,
@@ -61,6 +61,7 @@ pub fn render(
         eye_rays: opts.spp,
         shadow_rays: opts.shadow_rays.max(1),
         bsdf_sampling: opts.bsdf_sampling,
+        mis_light: opts.mis_light,
     };
     let tiles_x = res.x.div_ceil(TILE);
     let tiles_y = res.y.div_ceil(TILE);
@@ -92,12 +93,13 @@ pub fn render(
             for y in y0..y1 {
                 for x in x0..x1 {
                     let pixel = UVec2::new(x, y);
+                    let px = pattern.pixel(pixel);
                     let mut sum = Rgb::ZERO;
                     for i in 0..opts.spp {
-                        let u = pattern.sample_2d(pixel, DIM_FILTER, i, opts.spp);
+                        let u = px.sample_2d(DIM_FILTER, i, opts.spp);
                         let p = filter_sample(&scene.film.filter, pixel, u);
                         let ray = scene.camera.generate_ray(p, res);
-                        let (l, r) = est.li(pixel, i, &ray);
+                        let (l, r) = est.li(&px, i, &ray);
                         tile_rays += r;
                         if l.is_finite() {
                             sum += l;

@@ -128,7 +128,7 @@ fn panel_options(panel: &Panel, seed: u64) -> RenderOptions {
         pattern: panel.pattern,
         light_selection: panel.light_selection.clone(),
         bsdf_sampling: panel.lobe.map(LobeChoice::sampling).unwrap_or_default(),
-        progress: false,
+        ..RenderOptions::default()
     }
 }
 

@@ -1,12 +1,37 @@
 //! Which light a shadow ray goes to. Every selector returns `(light, pmf)` and can answer the
 //! pmf of any light for the same shading context, so MIS can weight BSDF samples that hit an
 //! emitter. Rule for all: any light that could contribute keeps a non-zero probability.
-//! TODO(issue 6): power, spatial, adaptive, wald, bvh, exhaustive.
+//!
+//! Strategies, one per file: [`uniform`], [`power`] (alias table over Φ), [`exhaustive`]
+//! (importance of every light per shading point, O(N): the yardstick), [`bvh`] (light BVH à la
+//! Conty Estevez & Kulla 2018 / pbrt-v4), [`wald`] (Wald et al. 2003: one global distribution
+//! estimated from low-resolution eye rays), [`spatial`] (a grid of per-cell tables built from
+//! conservative bounds) and [`adaptive`] (the spatial grid, trained per cell by eye rays).
+//!
+//! Every strategy except `uniform` works on the *finite* lights (those with [`LightBounds`]);
+//! [`Selector`] wraps it and gives lights without bounds (environment, sky, distant) a fixed
+//! share [`INFINITE_SHARE`] of the probability, split uniformly among them.
 
+pub mod adaptive;
+pub mod bvh;
+pub mod estimate;
+pub mod exhaustive;
+pub mod importance;
+pub mod power;
+pub mod spatial;
 pub mod uniform;
+pub mod wald;
 
+pub use adaptive::AdaptiveSelector;
+pub use bvh::BvhSelector;
+pub use exhaustive::ExhaustiveSelector;
+pub use importance::importance;
+pub use power::PowerSelector;
+pub use spatial::SpatialSelector;
 pub use uniform::UniformSelector;
+pub use wald::WaldSelector;
 
+use crate::lights::{LightBounds, LightSource};
 use glam::Vec3;
 
 /// The shading context a selector may use.
@@ -31,7 +56,8 @@ pub struct SelectedLight {
 
 /// Chooses a light for a shading point.
 pub trait LightSelector: Send + Sync {
-    /// Pick a light with the uniform number `u`; `None` if there are no lights.
+    /// Pick a light with the uniform number `u`; `None` if there are no lights (or none can
+    /// contribute at `ctx`).
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<SelectedLight>;
     /// Probability that `sample` picks `light` at `ctx`.
     fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32;
@@ -39,15 +65,186 @@ pub trait LightSelector: Send + Sync {
     fn name(&self) -> &'static str;
 }
 
-/// The selector named `name` (as accepted by `--light-selection`) for `scene`.
+/// A strategy over the finite lights `0..n` (indices into [`LightSet::finite`]).
+pub trait FiniteSelector: Send + Sync {
+    /// Pick a finite light: (local index, pmf).
+    fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)>;
+    /// Probability of local index `i`.
+    fn pmf(&self, ctx: &ShadingPoint, i: u32) -> f32;
+}
+
+/// Probability given to the lights without bounds (infinite and distant) when the scene also
+/// has finite lights: a fixed share, because no spatial bound says how much they matter.
+pub const INFINITE_SHARE: f32 = 0.1;
+
+/// The scene's lights split into finite ones (with bounds) and the rest.
+#[derive(Clone, Debug, Default)]
+pub struct LightSet {
+    /// Scene indices of the lights with bounds.
+    pub finite: Vec<u32>,
+    /// Their bounds, in the same order.
+    pub bounds: Vec<LightBounds>,
+    /// Scene indices of the lights without bounds (infinite, distant).
+    pub other: Vec<u32>,
+    /// Scene index → local index in `finite`, or `u32::MAX` for the others.
+    pub local: Vec<u32>,
+}
+
+impl LightSet {
+    /// Split `lights`.
+    pub fn new(lights: &[crate::lights::Light]) -> Self {
+        let mut s = LightSet {
+            local: vec![u32::MAX; lights.len()],
+            ..Default::default()
+        };
+        for (i, l) in lights.iter().enumerate() {
+            match l.bounds() {
+                Some(b) if !l.is_infinite() && b.min.is_finite() && b.max.is_finite() => {
+                    s.local[i] = s.finite.len() as u32;
+                    s.finite.push(i as u32);
+                    s.bounds.push(sanitize(b));
+                }
+                _ => s.other.push(i as u32),
+            }
+        }
+        s
+    }
+
+    /// Probability of choosing the group of finite lights at all.
+    pub fn finite_share(&self) -> f32 {
+        match (self.finite.is_empty(), self.other.is_empty()) {
+            (true, _) => 0.0,
+            (false, true) => 1.0,
+            (false, false) => 1.0 - INFINITE_SHARE,
+        }
+    }
+}
+
+/// Bounds with a finite non-negative power and unit direction, so no NaN reaches a pmf.
+fn sanitize(mut b: LightBounds) -> LightBounds {
+    if !(b.phi.is_finite() && b.phi >= 0.0) {
+        b.phi = 0.0;
+    }
+    b.w = b.w.try_normalize().unwrap_or(Vec3::Z);
+    if !b.cos_theta_o.is_finite() {
+        b.cos_theta_o = -1.0;
+    }
+    if !b.cos_theta_e.is_finite() {
+        b.cos_theta_e = 0.0;
+    }
+    b
+}
+
+/// A [`FiniteSelector`] plus the fixed share of the unbounded lights: what `make_selector`
+/// returns for every strategy but `uniform`.
+pub struct Selector {
+    name: &'static str,
+    set: LightSet,
+    finite: Box<dyn FiniteSelector>,
+}
+
+impl Selector {
+    /// Wrap `finite`, which selects among `set.finite`.
+    pub fn new(name: &'static str, set: LightSet, finite: Box<dyn FiniteSelector>) -> Self {
+        Self { name, set, finite }
+    }
+
+    /// The inner strategy (for tests and benchmarks).
+    pub fn inner(&self) -> &dyn FiniteSelector {
+        self.finite.as_ref()
+    }
+}
+
+impl LightSelector for Selector {
+    fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<SelectedLight> {
+        let share = self.set.finite_share();
+        if u < share {
+            // Reuse u: rescaled to [0, 1) it still is uniform for the finite strategy.
+            let v = (u / share).min(ONE_MINUS_EPS);
+            let (i, p) = self.finite.sample(ctx, v)?;
+            let pmf = p * share;
+            (pmf > 0.0).then(|| SelectedLight {
+                index: self.set.finite[i as usize],
+                pmf,
+            })
+        } else {
+            let n = self.set.other.len();
+            if n == 0 {
+                return None;
+            }
+            let v = ((u - share) / (1.0 - share)).clamp(0.0, ONE_MINUS_EPS);
+            let k = ((v * n as f32) as usize).min(n - 1);
+            Some(SelectedLight {
+                index: self.set.other[k],
+                pmf: (1.0 - share) / n as f32,
+            })
+        }
+    }
+
+    fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32 {
+        let Some(&local) = self.set.local.get(light as usize) else {
+            return 0.0;
+        };
+        let share = self.set.finite_share();
+        if local == u32::MAX {
+            (1.0 - share) / self.set.other.len().max(1) as f32
+        } else {
+            share * self.finite.pmf(ctx, local)
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        self.name
+    }
+}
+
+/// Largest f32 below 1: keeps rescaled sample numbers in [0, 1).
+pub const ONE_MINUS_EPS: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Every name `make_selector` accepts.
+pub const SELECTORS: &[&str] = &[
+    "uniform",
+    "power",
+    "spatial",
+    "adaptive",
+    "wald",
+    "bvh",
+    "exhaustive",
+];
+
+/// The selector named `name` (as accepted by `--light-selection`) for `scene`. `seed` feeds
+/// the estimation passes of `wald` and `adaptive` (the others are deterministic without it).
 pub fn make_selector(
     name: &str,
     scene: &crate::scene::Scene,
+    seed: u64,
 ) -> anyhow::Result<Box<dyn LightSelector>> {
-    match name {
-        "uniform" => Ok(Box::new(UniformSelector {
+    if name == "uniform" {
+        return Ok(Box::new(UniformSelector {
             count: scene.lights.len() as u32,
-        })),
-        other => anyhow::bail!("unknown light selection '{other}' (expected one of: uniform)"),
+        }));
     }
+    let set = LightSet::new(&scene.lights);
+    let finite: Box<dyn FiniteSelector> = match name {
+        "power" => Box::new(PowerSelector::new(&set.bounds)),
+        "exhaustive" => Box::new(ExhaustiveSelector::new(&set.bounds)),
+        "bvh" => Box::new(BvhSelector::new(&set.bounds)),
+        "wald" => Box::new(WaldSelector::new(scene, &set, &wald::WaldConfig::new(seed))),
+        "spatial" => Box::new(SpatialSelector::new(scene, &set)),
+        "adaptive" => Box::new(AdaptiveSelector::new(
+            scene,
+            &set,
+            &adaptive::AdaptiveConfig::new(seed),
+        )),
+        other => anyhow::bail!(
+            "unknown light selection '{other}' (expected one of: {})",
+            SELECTORS.join(", ")
+        ),
+    };
+    let name = SELECTORS
+        .iter()
+        .copied()
+        .find(|&n| n == name)
+        .unwrap_or("?");
+    Ok(Box::new(Selector::new(name, set, finite)))
 }

@@ -6,6 +6,7 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
+    is_positive,
 };
 use crate::sampling::{Frame, concentric_disk};
 use crate::{Rgb, luminance};
@@ -30,7 +31,7 @@ pub struct DiskLight {
 impl DiskLight {
     /// A disk light; `None` for a zero normal, a non-positive radius or non-finite input.
     pub fn new(center: Vec3, normal: Vec3, radius: f32, l: Rgb, two_sided: bool) -> Option<Self> {
-        if !(radius > 0.0) || !radius.is_finite() || !center.is_finite() || !l.is_finite() {
+        if !is_positive(radius) || !radius.is_finite() || !center.is_finite() || !l.is_finite() {
             return None;
         }
         let n = normal.try_normalize()?;
@@ -76,7 +77,7 @@ impl LightSource for DiskLight {
         let p_light = self.center + self.frame.s * q.x + self.frame.t * q.y;
         let d = p_light - ctx.p;
         let dist = d.length();
-        if !(dist > 0.0) {
+        if !is_positive(dist) {
             return None;
         }
         let wi = d / dist;

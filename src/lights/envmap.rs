@@ -11,7 +11,10 @@
 //! lat-long map, dω = 2π² sin θ du dv), so the solid-angle pdf is pdf_uv / (2π² sin θ).
 
 use super::distant::DEFAULT_SCENE_RADIUS;
-use super::{LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, far_point};
+use super::{
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, far_point,
+    is_positive,
+};
 use crate::material::texture::ImageRgb;
 use crate::sampling::Distribution2D;
 use crate::{Rgb, luminance};
@@ -190,7 +193,7 @@ impl LightSource for EnvMapLight {
     ) -> Option<LightLiSample> {
         let (uv, pdf_uv) = self.distribution.sample(u);
         let (wi, sin_theta) = self.uv_to_direction(uv);
-        if !(sin_theta > 0.0) || !(pdf_uv > 0.0) {
+        if !is_positive(sin_theta) || !is_positive(pdf_uv) {
             return None;
         }
         let pdf = pdf_uv / (2.0 * PI * PI * sin_theta);
@@ -212,7 +215,7 @@ impl LightSource for EnvMapLight {
         _: SamplingMode,
     ) -> f32 {
         let (uv, sin_theta) = self.direction_to_uv(wi);
-        if !(sin_theta > 0.0) {
+        if !is_positive(sin_theta) {
             return 0.0;
         }
         self.distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)

@@ -235,6 +235,31 @@ impl LightSource for Light {
     }
 }
 
+/// Solid angle (sr) of triangle (a, b, c) seen from `p` (Van Oosterom & Strackee 1983, in f64
+/// because it cancels for small triangles); 0 if degenerate. Cheaper than building a
+/// [`crate::sampling::SphericalTriangle`], so `pdf_li` (called for every emitter hit under MIS)
+/// and the sampling-rule decision use it.
+pub(crate) fn triangle_solid_angle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+    let p = p.as_dvec3();
+    let (Some(a), Some(b), Some(c)) = (
+        (a.as_dvec3() - p).try_normalize(),
+        (b.as_dvec3() - p).try_normalize(),
+        (c.as_dvec3() - p).try_normalize(),
+    ) else {
+        return 0.0;
+    };
+    let num = a.dot(b.cross(c)).abs();
+    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+    (2.0 * num.atan2(den)) as f32
+}
+
+/// `x > 0`, false for NaN: guards written as `!is_positive(x)` reject NaN along with
+/// non-positive values (a plain `x <= 0.0` would let NaN through).
+#[inline]
+pub(crate) fn is_positive(x: f32) -> bool {
+    x > 0.0
+}
+
 /// Endpoint of a shadow ray toward a light at infinity: twice the scene radius along `wi`,
 /// safely outside the scene's bounding sphere from any point inside it.
 #[inline]

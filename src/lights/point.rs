@@ -1,6 +1,8 @@
 //! Isotropic point light: a delta distribution in position.
 
-use super::{LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode};
+use super::{
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, is_positive,
+};
 use crate::{Rgb, luminance};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -31,7 +33,7 @@ impl LightSource for PointLight {
     ) -> Option<LightLiSample> {
         let d = self.p - ctx.p;
         let r2 = d.length_squared();
-        if !(r2 > 0.0) || !r2.is_finite() {
+        if !is_positive(r2) || !r2.is_finite() {
             return None;
         }
         Some(LightLiSample {

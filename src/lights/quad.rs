@@ -4,7 +4,7 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
-    spherical_ok,
+    is_positive, spherical_ok, triangle_solid_angle,
 };
 use crate::sampling::SphericalRectangle;
 use crate::{Rgb, luminance};
@@ -44,7 +44,7 @@ impl QuadLight {
         }
         let c = e1.cross(e2);
         let area = c.length();
-        if !(area > 0.0) || !area.is_finite() {
+        if !is_positive(area) || !area.is_finite() {
             return None;
         }
         // The true geometric normal, turned to the side the caller says emits: cosines and the
@@ -82,15 +82,22 @@ impl QuadLight {
         if self.two_sided { s != 0.0 } else { s > 0.0 }
     }
 
-    /// The spherical rectangle to sample from `p` in solid-angle mode, or `None` where area
-    /// sampling is used instead: skewed parallelograms (the sampler needs right angles) and solid
-    /// angles outside [`spherical_ok`]. `sample_li` and `pdf_li` share this rule.
-    fn spherical(&self, p: Vec3, mode: SamplingMode) -> Option<SphericalRectangle> {
+    /// Solid angle Ω to sample uniformly from `p` in solid-angle mode (as two spherical
+    /// triangles: cheaper than setting up the rectangle sampler), or `None` where area sampling
+    /// is used instead: skewed parallelograms (the sampler needs right angles) and solid angles
+    /// outside [`spherical_ok`]. `sample_li` and `pdf_li` share this rule and this Ω.
+    fn spherical_omega(&self, p: Vec3, mode: SamplingMode) -> Option<f32> {
         if mode != SamplingMode::SolidAngle || !self.rectangular {
             return None;
         }
-        let sr = SphericalRectangle::new(p, self.corner, self.e1, self.e2)?;
-        spherical_ok(sr.solid_angle).then_some(sr)
+        let (c, c1, c2, c12) = (
+            self.corner,
+            self.corner + self.e1,
+            self.corner + self.e2,
+            self.corner + self.e1 + self.e2,
+        );
+        let omega = triangle_solid_angle(p, c, c1, c12) + triangle_solid_angle(p, c, c12, c2);
+        spherical_ok(omega).then_some(omega)
     }
 }
 
@@ -104,19 +111,22 @@ impl LightSource for QuadLight {
         if !self.faces(ctx.p) {
             return None;
         }
-        let (p_light, pdf_sa) = match self.spherical(ctx.p, mode) {
-            Some(sr) => (sr.sample(u), Some(1.0 / sr.solid_angle)),
+        let (p_light, pdf_sa) = match self.spherical_omega(ctx.p, mode) {
+            Some(omega) => {
+                let sr = SphericalRectangle::new(ctx.p, self.corner, self.e1, self.e2)?;
+                (sr.sample(u), Some(1.0 / omega))
+            }
             None => (self.corner + u.x * self.e1 + u.y * self.e2, None),
         };
         let d = p_light - ctx.p;
         let dist = d.length();
-        if !(dist > 0.0) {
+        if !is_positive(dist) {
             return None;
         }
         let wi = d / dist;
         let pdf =
             pdf_sa.unwrap_or_else(|| area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n));
-        if !(pdf > 0.0) || !pdf.is_finite() {
+        if !is_positive(pdf) || !pdf.is_finite() {
             return None;
         }
         Some(LightLiSample {
@@ -131,7 +141,7 @@ impl LightSource for QuadLight {
     fn pdf_li(
         &self,
         ctx: &LightSampleContext,
-        wi: Vec3,
+        _wi: Vec3,
         p_light: Vec3,
         _n_light: Vec3,
         mode: SamplingMode,
@@ -139,8 +149,9 @@ impl LightSource for QuadLight {
         if !self.faces(ctx.p) {
             return 0.0;
         }
-        match self.spherical(ctx.p, mode) {
-            Some(sr) => sr.pdf(wi),
+        // The caller guarantees that wi hits the quad, so no inside test is needed.
+        match self.spherical_omega(ctx.p, mode) {
+            Some(omega) => 1.0 / omega,
             None => area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n),
         }
     }

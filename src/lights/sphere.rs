@@ -6,6 +6,7 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
+    is_positive,
 };
 use crate::sampling::{Frame, uniform_cone_sin2, uniform_cone_sin2_pdf, uniform_sphere};
 use crate::{Rgb, luminance};
@@ -39,7 +40,7 @@ enum View {
 impl SphereLight {
     /// A sphere light; `None` for a non-positive or non-finite radius or non-finite input.
     pub fn new(center: Vec3, radius: f32, l: Rgb, inward: bool) -> Option<Self> {
-        if !(radius > 0.0) || !radius.is_finite() || !center.is_finite() || !l.is_finite() {
+        if !is_positive(radius) || !radius.is_finite() || !center.is_finite() || !l.is_finite() {
             return None;
         }
         Some(Self {
@@ -81,7 +82,7 @@ impl SphereLight {
         let c = oc.length_squared() - self.radius * self.radius;
         // Roots −b ± s; the near one from outside (c > 0), the far one from inside.
         let t = if c > 0.0 { -b - s } else { -b + s };
-        if !(t > 0.0) {
+        if !is_positive(t) {
             return None;
         }
         // Project onto the sphere: removes the rounding of t.
@@ -127,7 +128,7 @@ impl LightSource for SphereLight {
                 let p_light = self.center + self.radius * n_out;
                 let d = p_light - ctx.p;
                 let dist = d.length();
-                if !(dist > 0.0) {
+                if !is_positive(dist) {
                     return None;
                 }
                 let wi = d / dist;

@@ -1,7 +1,9 @@
 //! Spot light: a point light whose intensity falls off with the angle from its axis, with
 //! pbrt-v4's smoothstep between the falloff start and the total width.
 
-use super::{LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode};
+use super::{
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, is_positive,
+};
 use crate::{Rgb, luminance};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -81,7 +83,7 @@ impl LightSource for SpotLight {
     ) -> Option<LightLiSample> {
         let d = self.p - ctx.p;
         let r2 = d.length_squared();
-        if !(r2 > 0.0) || !r2.is_finite() {
+        if !is_positive(r2) || !r2.is_finite() {
             return None;
         }
         let wi = d / r2.sqrt();

@@ -3,7 +3,7 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
-    spherical_ok,
+    is_positive, spherical_ok, triangle_solid_angle,
 };
 use crate::sampling::{SphericalTriangle, uniform_triangle_point};
 use crate::{Rgb, luminance};
@@ -29,7 +29,7 @@ impl TriangleLight {
     /// A light on triangle (p0, p1, p2) with emitting normal `n`; `None` if the area is zero.
     pub fn new(p: [Vec3; 3], n: Vec3, l: Rgb, two_sided: bool) -> Option<Self> {
         let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
-        if !(area > 0.0) || !area.is_finite() {
+        if !is_positive(area) || !area.is_finite() {
             return None;
         }
         Some(Self {
@@ -54,15 +54,15 @@ impl TriangleLight {
         if self.two_sided { s != 0.0 } else { s > 0.0 }
     }
 
-    /// The spherical triangle to sample from `p` in solid-angle mode, or `None` where the rule
+    /// Solid angle Ω to sample uniformly from `p` in solid-angle mode, or `None` where the rule
     /// of [`spherical_ok`] says to sample by area. `sample_li` and `pdf_li` both decide through
-    /// this one function, so the sample and its pdf always agree.
-    fn spherical(&self, p: Vec3, mode: SamplingMode) -> Option<SphericalTriangle> {
+    /// this one function (and both use this Ω for the pdf), so the sample and its pdf agree.
+    fn spherical_omega(&self, p: Vec3, mode: SamplingMode) -> Option<f32> {
         if mode != SamplingMode::SolidAngle {
             return None;
         }
-        let st = SphericalTriangle::new(p, self.p[0], self.p[1], self.p[2])?;
-        spherical_ok(st.area).then_some(st)
+        let omega = triangle_solid_angle(p, self.p[0], self.p[1], self.p[2]);
+        spherical_ok(omega).then_some(omega)
     }
 }
 
@@ -76,18 +76,19 @@ impl LightSource for TriangleLight {
         if !self.faces(ctx.p) {
             return None;
         }
-        if let Some(st) = self.spherical(ctx.p, mode) {
+        if let Some(omega) = self.spherical_omega(ctx.p, mode) {
+            let st = SphericalTriangle::new(ctx.p, self.p[0], self.p[1], self.p[2])?;
             let wi = st.sample(u);
             // Where the sampled direction meets the triangle's plane (the shadow-ray target).
             let denom = self.n.dot(wi);
             let t = self.n.dot(self.p[0] - ctx.p) / denom;
-            if !(t > 0.0) || !t.is_finite() {
+            if !is_positive(t) || !t.is_finite() {
                 return None;
             }
             return Some(LightLiSample {
                 wi,
                 li: self.l,
-                pdf: 1.0 / st.area,
+                pdf: 1.0 / omega,
                 p_light: ctx.p + wi * t,
                 delta: false,
             });
@@ -100,7 +101,7 @@ impl LightSource for TriangleLight {
         }
         let wi = d / dist;
         let pdf = area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n);
-        if !(pdf > 0.0) || !pdf.is_finite() {
+        if !is_positive(pdf) || !pdf.is_finite() {
             return None;
         }
         Some(LightLiSample {
@@ -115,7 +116,7 @@ impl LightSource for TriangleLight {
     fn pdf_li(
         &self,
         ctx: &LightSampleContext,
-        wi: Vec3,
+        _wi: Vec3,
         p_light: Vec3,
         _n_light: Vec3,
         mode: SamplingMode,
@@ -124,8 +125,9 @@ impl LightSource for TriangleLight {
         if !self.faces(ctx.p) {
             return 0.0;
         }
-        match self.spherical(ctx.p, mode) {
-            Some(st) => st.pdf(wi),
+        // The caller guarantees that wi hits the triangle, so no inside test is needed.
+        match self.spherical_omega(ctx.p, mode) {
+            Some(omega) => 1.0 / omega,
             None => area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n),
         }
     }

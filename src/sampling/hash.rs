@@ -17,11 +17,24 @@ pub fn mix64(mut x: u64) -> u64 {
 /// Hash any number of 64-bit keys into one well-mixed 64-bit value.
 #[inline]
 pub fn hash_keys(keys: &[u64]) -> u64 {
-    let mut h = 0x9e37_79b9_7f4a_7c15u64;
-    for &k in keys {
-        h = mix64(h ^ k.wrapping_add(0x9e37_79b9_7f4a_7c15).wrapping_add(h << 6));
-    }
-    h
+    keys.iter().fold(HASH_INIT, |h, &k| hash_step(h, k))
+}
+
+/// The state [`hash_keys`] starts from: `hash_keys(&[a, b]) == hash_step(hash_step(HASH_INIT, a), b)`.
+pub const HASH_INIT: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// One step of [`hash_keys`]: lets callers hash a shared key prefix once and extend it.
+#[inline]
+pub fn hash_step(h: u64, k: u64) -> u64 {
+    mix64(h ^ k.wrapping_add(0x9e37_79b9_7f4a_7c15).wrapping_add(h << 6))
+}
+
+/// Two uniform f32 in [0, 1) for element `index` of the stream `key`: one SplitMix64 output
+/// (a Weyl step then [`mix64`]), i.e. a counter-based generator with no state to carry.
+#[inline]
+pub fn uniform_pair(key: u64, index: u32) -> (f32, f32) {
+    let h = mix64(key.wrapping_add((index as u64).wrapping_add(1).wrapping_mul(HASH_INIT)));
+    (u32_to_unit(h as u32), u32_to_unit((h >> 32) as u32))
 }
 
 /// A PCG32 stream seeded from a hash of keys (no state shared between threads).

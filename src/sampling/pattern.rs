@@ -9,7 +9,7 @@
 //! Indices ≥ `count` wrap modulo `count` for the stratified patterns; `count = 0` counts as 1.
 //!
 //! - `fixed`: always the centre (0.5, 0.5) (0.5 in 1D).
-//! - `random`: independent uniform points from a PCG stream keyed by (seed, pixel, dim, index).
+//! - `random`: independent uniform points, a SplitMix64 hash of (seed, pixel, dim, index).
 //! - `grid`: centres of an nx × ny grid with nx·ny = count, where nx is the largest divisor of
 //!   count with nx ≤ √count (x gets nx cells, y gets ny). A prime count therefore gives
 //!   1 × count strip strata: still one sample per stratum, but stratified along y only.
@@ -21,6 +21,10 @@
 //!   projection a (0,2)-sequence). Indices ≥ 2^16 continue in a differently seeded sequence.
 //!
 //! 1D versions are analogous (`grid`: stratum centres, `stratified`/`lhs`: jittered strata).
+//!
+//! Hot path: [`SamplePattern::pixel`] hashes the keys of one pixel's first [`CACHED_DIMS`]
+//! dimensions once ([`PixelSamples`]); per sample only the permutation rounds and one jitter
+//! hash remain. The values are identical to those of `sample_1d` / `sample_2d`.
 
 use glam::{UVec2, Vec2};
 use std::fmt;
@@ -28,8 +32,8 @@ use std::str::FromStr;
 
 use super::ONE_MINUS_EPSILON;
 use super::error::SamplingError;
-use super::hash::{hash_keys, next_f32, pcg_from_keys};
-use super::permutation::permute;
+use super::hash::{hash_keys, hash_step, uniform_pair};
+use super::permutation::Permutation;
 
 /// The pattern names accepted by `--pattern`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -102,11 +106,13 @@ pub trait SamplePattern: Send + Sync {
     fn sample_2d(&self, pixel: UVec2, dim: u32, index: u32, count: u32) -> Vec2;
     /// Which pattern this is.
     fn kind(&self) -> PatternKind;
+    /// The same samples for one pixel, with that pixel's keys hashed once (hot path).
+    fn pixel(&self, pixel: UVec2) -> PixelSamples;
 }
 
 /// Make the pattern of `kind` with a global seed.
 pub fn make_pattern(kind: PatternKind, seed: u64) -> Box<dyn SamplePattern> {
-    Box::new(Pattern { kind, seed })
+    Box::new(Pattern { seed, kind })
 }
 
 /// Near-square factorisation nx × ny = count with nx the largest divisor ≤ √count (nx ≤ ny).
@@ -128,35 +134,134 @@ const TAG_2D: u64 = 0x2d2d;
 const TAG_LHS_Y: u64 = 0x7979_7979;
 const TAG_JITTER: u64 = 0x6a69_7474;
 
+/// Dimensions whose keys [`PixelSamples`] precomputes (the direct-lighting integrator uses 5).
+pub const CACHED_DIMS: usize = 8;
+
 /// The one implementation behind every [`PatternKind`].
 #[derive(Clone, Copy, Debug)]
 pub struct Pattern {
-    /// Which pattern.
-    pub kind: PatternKind,
     /// Global seed.
     pub seed: u64,
+    /// Which pattern.
+    pub kind: PatternKind,
 }
 
 impl Pattern {
-    /// Hash key of one (pixel, dim, 1D/2D) sample set.
+    /// Hash state after (seed, pixel): the prefix shared by every dimension of the pixel.
     #[inline]
-    fn key(&self, pixel: UVec2, dim: u32, tag: u64) -> u64 {
-        hash_keys(&[self.seed, pixel.x as u64, pixel.y as u64, dim as u64, tag])
+    fn pixel_hash(&self, pixel: UVec2) -> u64 {
+        hash_keys(&[self.seed, pixel.x as u64, pixel.y as u64])
     }
 
-    /// Two independent uniform numbers for sample `index` of the set `key`.
+    /// The keys of one (pixel, dim, 1D/2D) sample set, from the pixel's hash prefix.
     #[inline]
-    fn uniforms(key: u64, index: u32, tag: u64) -> (f32, f32) {
-        let mut rng = pcg_from_keys(&[key, index as u64, tag]);
-        (next_f32(&mut rng), next_f32(&mut rng))
+    fn set(&self, prefix: u64, dim: u32, tag: u64) -> SetKeys {
+        SetKeys::new(self.kind, hash_step(hash_step(prefix, dim as u64), tag))
+    }
+}
+
+/// Everything derived from the key of one (pixel, dim, 1D/2D) sample set.
+#[derive(Clone, Copy, Debug, Default)]
+struct SetKeys {
+    /// Strata → index assignment (x axis for LHS).
+    perm: Permutation,
+    /// LHS y-axis permutation.
+    perm_y: Permutation,
+    /// Jitter / random stream key.
+    jitter: u64,
+    /// Set key, for Sobol sequences past the first 2^16 points.
+    key: u64,
+    /// Sobol seed of the first 2^16 points.
+    sobol0: u32,
+}
+
+impl SetKeys {
+    /// Derive only what `kind` needs.
+    #[inline]
+    fn new(kind: PatternKind, key: u64) -> Self {
+        let mut s = SetKeys {
+            key,
+            ..Default::default()
+        };
+        match kind {
+            PatternKind::Fixed => {}
+            PatternKind::Random => s.jitter = hash_step(key, TAG_JITTER),
+            PatternKind::Grid => s.perm = Permutation::new(key),
+            PatternKind::Stratified => {
+                s.perm = Permutation::new(key);
+                s.jitter = hash_step(key, TAG_JITTER);
+            }
+            PatternKind::Lhs => {
+                s.perm = Permutation::new(key);
+                s.perm_y = Permutation::new(hash_keys(&[key, TAG_LHS_Y]));
+                s.jitter = hash_step(key, TAG_JITTER);
+            }
+            PatternKind::Sobol => s.sobol0 = Self::sobol_seed(key, 0),
+        }
+        s
     }
 
-    /// Owen-scrambled Sobol dimension `d` (0 or 1) of sample `index` in the sequence `key`.
+    /// sobol_burley holds 2^16 points per sequence; later indices use a fresh sequence.
     #[inline]
-    fn sobol(key: u64, index: u32, d: u32) -> f32 {
-        // sobol_burley holds 2^16 points per sequence; later indices use a fresh sequence.
-        let seed = hash_keys(&[key, (index >> 16) as u64]) as u32;
+    fn sobol_seed(key: u64, hi: u32) -> u32 {
+        hash_keys(&[key, hi as u64]) as u32
+    }
+
+    /// Owen-scrambled Sobol dimension `d` (0 or 1) of sample `index`.
+    #[inline]
+    fn sobol(&self, index: u32, d: u32) -> f32 {
+        let hi = index >> 16;
+        let seed = if hi == 0 {
+            self.sobol0
+        } else {
+            Self::sobol_seed(self.key, hi)
+        };
         sobol_burley::sample(index & 0xffff, d, seed)
+    }
+
+    #[inline]
+    fn sample_1d(&self, kind: PatternKind, index: u32, count: u32) -> f32 {
+        let count = count.max(1);
+        match kind {
+            PatternKind::Fixed => 0.5,
+            PatternKind::Random => uniform_pair(self.jitter, index).0,
+            PatternKind::Grid => in_stratum(self.perm.apply(index, count), 0.5, count),
+            PatternKind::Stratified | PatternKind::Lhs => {
+                let j = uniform_pair(self.jitter, index % count).0;
+                in_stratum(self.perm.apply(index, count), j, count)
+            }
+            PatternKind::Sobol => self.sobol(index, 0),
+        }
+    }
+
+    #[inline]
+    fn sample_2d(&self, kind: PatternKind, index: u32, count: u32) -> Vec2 {
+        let count = count.max(1);
+        match kind {
+            PatternKind::Fixed => Vec2::splat(0.5),
+            PatternKind::Random => {
+                let (a, b) = uniform_pair(self.jitter, index);
+                Vec2::new(a, b)
+            }
+            PatternKind::Grid => {
+                let (nx, ny) = grid_dims(count);
+                let s = self.perm.apply(index, count);
+                Vec2::new(in_stratum(s % nx, 0.5, nx), in_stratum(s / nx, 0.5, ny))
+            }
+            PatternKind::Stratified => {
+                let (nx, ny) = grid_dims(count);
+                let s = self.perm.apply(index, count);
+                let (jx, jy) = uniform_pair(self.jitter, index % count);
+                Vec2::new(in_stratum(s % nx, jx, nx), in_stratum(s / nx, jy, ny))
+            }
+            PatternKind::Lhs => {
+                let sx = self.perm.apply(index, count);
+                let sy = self.perm_y.apply(index, count);
+                let (jx, jy) = uniform_pair(self.jitter, index % count);
+                Vec2::new(in_stratum(sx, jx, count), in_stratum(sy, jy, count))
+            }
+            PatternKind::Sobol => Vec2::new(self.sobol(index, 0), self.sobol(index, 1)),
+        }
     }
 }
 
@@ -168,50 +273,96 @@ fn in_stratum(stratum: u32, jitter: f32, n: u32) -> f32 {
 
 impl SamplePattern for Pattern {
     fn sample_1d(&self, pixel: UVec2, dim: u32, index: u32, count: u32) -> f32 {
-        let count = count.max(1);
-        let key = self.key(pixel, dim, TAG_1D);
-        match self.kind {
-            PatternKind::Fixed => 0.5,
-            PatternKind::Random => Self::uniforms(key, index, TAG_JITTER).0,
-            PatternKind::Grid => in_stratum(permute(index, count, key), 0.5, count),
-            PatternKind::Stratified | PatternKind::Lhs => {
-                let j = Self::uniforms(key, index % count, TAG_JITTER).0;
-                in_stratum(permute(index, count, key), j, count)
-            }
-            PatternKind::Sobol => Self::sobol(key, index, 0),
-        }
+        self.set(self.pixel_hash(pixel), dim, TAG_1D)
+            .sample_1d(self.kind, index, count)
     }
 
     fn sample_2d(&self, pixel: UVec2, dim: u32, index: u32, count: u32) -> Vec2 {
-        let count = count.max(1);
-        let key = self.key(pixel, dim, TAG_2D);
-        match self.kind {
-            PatternKind::Fixed => Vec2::splat(0.5),
-            PatternKind::Random => {
-                let (a, b) = Self::uniforms(key, index, TAG_JITTER);
-                Vec2::new(a, b)
-            }
-            PatternKind::Grid | PatternKind::Stratified => {
-                let (nx, ny) = grid_dims(count);
-                let s = permute(index, count, key);
-                let (jx, jy) = if self.kind == PatternKind::Grid {
-                    (0.5, 0.5)
-                } else {
-                    Self::uniforms(key, index % count, TAG_JITTER)
-                };
-                Vec2::new(in_stratum(s % nx, jx, nx), in_stratum(s / nx, jy, ny))
-            }
-            PatternKind::Lhs => {
-                let sx = permute(index, count, key);
-                let sy = permute(index, count, hash_keys(&[key, TAG_LHS_Y]));
-                let (jx, jy) = Self::uniforms(key, index % count, TAG_JITTER);
-                Vec2::new(in_stratum(sx, jx, count), in_stratum(sy, jy, count))
-            }
-            PatternKind::Sobol => Vec2::new(Self::sobol(key, index, 0), Self::sobol(key, index, 1)),
-        }
+        self.set(self.pixel_hash(pixel), dim, TAG_2D)
+            .sample_2d(self.kind, index, count)
     }
 
     fn kind(&self) -> PatternKind {
         self.kind
+    }
+
+    fn pixel(&self, pixel: UVec2) -> PixelSamples {
+        let prefix = self.pixel_hash(pixel);
+        PixelSamples {
+            pattern: *self,
+            pixel,
+            sets_1d: std::array::from_fn(|d| self.set(prefix, d as u32, TAG_1D)),
+            sets_2d: std::array::from_fn(|d| self.set(prefix, d as u32, TAG_2D)),
+        }
+    }
+}
+
+/// One pixel's sample sets with the keys of the first [`CACHED_DIMS`] dimensions precomputed;
+/// returns exactly what the pattern's `sample_1d` / `sample_2d` return for this pixel.
+#[derive(Clone, Debug)]
+pub struct PixelSamples {
+    pattern: Pattern,
+    pixel: UVec2,
+    sets_1d: [SetKeys; CACHED_DIMS],
+    sets_2d: [SetKeys; CACHED_DIMS],
+}
+
+impl PixelSamples {
+    /// The pixel these samples belong to.
+    #[inline]
+    pub fn pixel(&self) -> UVec2 {
+        self.pixel
+    }
+
+    /// The 1D sample `index` of `count` for `dim`.
+    #[inline]
+    pub fn sample_1d(&self, dim: u32, index: u32, count: u32) -> f32 {
+        match self.sets_1d.get(dim as usize) {
+            Some(s) => s.sample_1d(self.pattern.kind, index, count),
+            None => self.pattern.sample_1d(self.pixel, dim, index, count),
+        }
+    }
+
+    /// The 2D sample `index` of `count` for `dim`.
+    #[inline]
+    pub fn sample_2d(&self, dim: u32, index: u32, count: u32) -> Vec2 {
+        match self.sets_2d.get(dim as usize) {
+            Some(s) => s.sample_2d(self.pattern.kind, index, count),
+            None => self.pattern.sample_2d(self.pixel, dim, index, count),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixel_samples_equal_the_pattern_values() {
+        // The cached per-pixel path must return bit-identical values, in cached dimensions
+        // and past them, for stratified counts and wrapped indices.
+        for kind in PatternKind::ALL {
+            let pat = Pattern { seed: 7, kind };
+            for pixel in [UVec2::new(0, 0), UVec2::new(13, 511)] {
+                let px = pat.pixel(pixel);
+                assert_eq!(px.pixel(), pixel);
+                for dim in [0u32, 3, 7, 8, 40] {
+                    for (index, count) in [(0u32, 1u32), (5, 16), (63, 64), (70, 64), (9, 37)] {
+                        assert_eq!(
+                            px.sample_1d(dim, index, count).to_bits(),
+                            pat.sample_1d(pixel, dim, index, count).to_bits(),
+                            "{kind} dim {dim} index {index}"
+                        );
+                        assert_eq!(
+                            px.sample_2d(dim, index, count).to_array().map(f32::to_bits),
+                            pat.sample_2d(pixel, dim, index, count)
+                                .to_array()
+                                .map(f32::to_bits),
+                            "{kind} dim {dim} index {index}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }

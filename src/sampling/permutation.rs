@@ -21,29 +21,48 @@ fn round(mut i: u32, mask: u32, bits: u32, k: u32, m: u32) -> u32 {
 /// Indices ≥ n wrap modulo n; n = 0 is treated as 1. Works for any n by cycle-walking a
 /// bijection of the enclosing power of two (expected < 2 steps).
 pub fn permute(index: u32, n: u32, key: u64) -> u32 {
-    if n <= 1 {
-        return 0;
+    Permutation::new(key).apply(index, n)
+}
+
+/// The round keys of one [`permute`] key, derived once so that a sample set that permutes many
+/// indices under the same key (one pixel's strata) pays the two key hashes only once.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Permutation {
+    k: [u32; 4],
+}
+
+impl Permutation {
+    /// The round keys of `key`.
+    #[inline]
+    pub fn new(key: u64) -> Self {
+        let k = super::hash::mix64(key);
+        let k2 = super::hash::mix64(k);
+        Self {
+            k: [k as u32, (k >> 32) as u32, k2 as u32, (k2 >> 32) as u32],
+        }
     }
-    let bits = 32 - (n - 1).leading_zeros();
-    let mask = if bits == 32 {
-        u32::MAX
-    } else {
-        (1 << bits) - 1
-    };
-    let k = super::hash::mix64(key);
-    let (k0, k1, k2, k3) = (
-        k as u32,
-        (k >> 32) as u32,
-        super::hash::mix64(k) as u32,
-        (super::hash::mix64(k) >> 32) as u32,
-    );
-    let mut i = index % n;
-    loop {
-        i = round(i, mask, bits, k0, k1);
-        i = round(i, mask, bits, k2, k3);
-        i = round(i, mask, bits, k1 ^ k2, k0 ^ k3);
-        if i < n {
-            return i;
+
+    /// Same as [`permute`]`(index, n, key)` for the key this was made from.
+    #[inline]
+    pub fn apply(&self, index: u32, n: u32) -> u32 {
+        if n <= 1 {
+            return 0;
+        }
+        let bits = 32 - (n - 1).leading_zeros();
+        let mask = if bits == 32 {
+            u32::MAX
+        } else {
+            (1 << bits) - 1
+        };
+        let [k0, k1, k2, k3] = self.k;
+        let mut i = if index < n { index } else { index % n };
+        loop {
+            i = round(i, mask, bits, k0, k1);
+            i = round(i, mask, bits, k2, k3);
+            i = round(i, mask, bits, k1 ^ k2, k0 ^ k3);
+            if i < n {
+                return i;
+            }
         }
     }
 }

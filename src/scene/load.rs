@@ -2,6 +2,7 @@
 
 use super::Scene;
 use super::builtin::{self, BuiltinOptions};
+use super::view::ViewOptions;
 use anyhow::{Context, bail};
 use std::path::Path;
 
@@ -10,6 +11,10 @@ use std::path::Path;
 pub struct LoadOptions {
     /// Scaling knobs of the built-in scenes.
     pub builtin: BuiltinOptions,
+    /// OBJ: treat `Ka` as emitted radiance (`--obj-ka-emission`).
+    pub obj_ka_emission: bool,
+    /// Camera placement flags (OBJ, glTF).
+    pub view: ViewOptions,
 }
 
 /// A loaded scene and the warnings the loader emitted (unsupported features, approximations).
@@ -48,6 +53,11 @@ pub fn load(spec: &str, opts: &LoadOptions) -> anyhow::Result<Loaded> {
             let (scene, warnings) = super::pbrt::load_pbrt(path)?;
             Ok(Loaded { scene, warnings })
         }
-        other => bail!("{}: unsupported scene format '.{other}'", path.display()),
+        "obj" => super::obj::load_obj(path, opts),
+        "gltf" | "glb" => super::gltf::load_gltf(path, opts),
+        other => bail!(
+            "{}: unsupported scene format '.{other}' (expected .pbrt, .obj, .gltf or .glb)",
+            path.display()
+        ),
     }
 }

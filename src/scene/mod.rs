@@ -1,12 +1,15 @@
 //! Scenes: the [`Scene`] every integrator renders, the [`SceneBuilder`] every loader and built-in
 //! scene fills, and the loaders themselves. Nothing below this module knows about file formats.
 //! TODO(issue 3): builder (meshes → BVH, emissive triangles → lights), built-in `cornell`.
-//! TODO(issue 5): pbrt-v4, OBJ/MTL, glTF loaders.
+//! TODO(issue 5): pbrt-v4 loader (OBJ/MTL and glTF: `obj`, `gltf`, cameras in `view`).
 
 pub mod builder;
 pub mod builtin;
+pub mod gltf;
 pub mod load;
+pub mod obj;
 pub mod pbrt;
+pub mod view;
 
 pub use builder::SceneBuilder;
 

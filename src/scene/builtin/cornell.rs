@@ -96,7 +96,7 @@ pub fn cornell(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
 }
 
 /// The Cornell box with glossy spheres instead of blocks: modified Phong (front row, exponents
-/// 10, 100, 1000) and GGX conductors (back row: gold α = 0.05, copper α = 0.2, aluminium
+/// 10, 100, 1000) and GGX conductors (back row, floating: gold α = 0.05, copper α = 0.2, aluminium
 /// α = 0.5), to show how the estimators handle glossy lobes.
 pub fn cornell_phong(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
     let mut b = SceneBuilder::new();
@@ -108,7 +108,7 @@ pub fn cornell_phong(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
             ks: Rgb::splat(0.6),
             n,
         });
-        let c = Vec3::new(-0.62 + 0.62 * i as f32, r, 0.35);
+        let c = Vec3::new(-0.62 + 0.62 * i as f32, r, 0.3);
         b.add_sphere(Transform::translate(c), r, m, None, false)?;
     }
     for (i, (metal, alpha)) in [("Au", 0.05f32), ("Cu", 0.2), ("Al", 0.5)]
@@ -123,7 +123,8 @@ pub fn cornell_phong(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
             alpha: Vec2::splat(alpha),
             reflectance: None,
         });
-        let c = Vec3::new(-0.62 + 0.62 * i as f32, r, -0.4);
+        // Floating above the front row so the camera sees both rows.
+        let c = Vec3::new(-0.62 + 0.62 * i as f32, 1.0, -0.35);
         b.add_sphere(Transform::translate(c), r, m, None, false)?;
     }
     b.build(cornell_camera(), cornell_film())

@@ -2,6 +2,11 @@
 
 pub mod cornell;
 mod cornell_data;
+mod dense;
+mod many_mesh;
+mod many_open;
+mod many_rooms;
+mod many_util;
 
 use super::Scene;
 
@@ -37,6 +42,26 @@ pub const BUILTINS: &[Builtin] = &[
         name: "cornell-phong",
         description: "Cornell box with Phong (n = 10, 100, 1000) and GGX conductor spheres",
         build: cornell::cornell_phong,
+    },
+    Builtin {
+        name: "dense",
+        description: "Cornell box around a displaced sphere of ~1.05M triangles (--triangles)",
+        build: dense::dense,
+    },
+    Builtin {
+        name: "many-open",
+        description: "10k small area lights over an open floor with occluders (--light-count up to 1M)",
+        build: many_open::many_open,
+    },
+    Builtin {
+        name: "many-rooms",
+        description: "8x8 rooms with doorways, 4 ceiling lights each (--rooms, --light-count)",
+        build: many_rooms::many_rooms,
+    },
+    Builtin {
+        name: "many-mesh",
+        description: "emissive torus of 8192 triangle lights plus strip lights (--light-count)",
+        build: many_mesh::many_mesh,
     },
 ];
 

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Side-by-side speed and error of penumbra and Mitsuba 3 (llvm variant) on the Cornell box:
+# 512², 64 spp, direct lighting with MIS (and light/BSDF sampling alone), both judged against
+# ../shared/reference/cornell-direct-mis-8192spp.exr with `penumbra compare`.
+#
+# Needs a Mitsuba venv (python3 -m venv V && V/bin/pip install mitsuba numpy) and Debian's
+# libllvm19. Usage: scripts/compare-mitsuba.sh [VENV] [PROFILE]   (defaults: /work/mitsuba-venv, dist)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+VENV=${1:-/work/mitsuba-venv}
+PROFILE=${2:-dist}
+SHARED=../shared
+OUT=${OUT:-target/compare-mitsuba}
+mkdir -p "$OUT"
+cargo build --profile "$PROFILE" --bin penumbra >/dev/null
+BIN=target/$PROFILE/penumbra
+REF=$SHARED/reference/cornell-direct-mis-8192spp.exr
+XML=$OUT/scene512.xml
+sed -e 's/name="resy" value="1024"/name="resy" value="512"/' \
+    -e 's/name="resx" value="1024"/name="resx" value="512"/' \
+    "$SHARED/scenes/cornell-box-bitterli/scene_v3.xml" > "$XML"
+# The scene file refers to no external assets, so it renders from the copy.
+for mode in mis emitter bsdf; do
+  case $mode in
+    mis) ours="--strategy mis --mis-light area" ;;
+    emitter) ours="--strategy light-area" ;;
+    bsdf) ours="--strategy bsdf" ;;
+  esac
+  # Mitsuba: the second of two runs (the first includes JIT compilation).
+  "$VENV/bin/python" "$SHARED/peers/mitsuba/render.py" "$XML" $mode 64 "$OUT/mitsuba-$mode.exr" \
+    --variant llvm_ad_rgb --repeat 2 --seed 1 | grep TIME | tail -1
+  $BIN render cornell --spp 64 --seed 1 --quiet $ours -o "$OUT/penumbra-$mode.exr"
+  echo "mitsuba $mode vs reference:";  $BIN compare "$OUT/mitsuba-$mode.exr" "$REF" | grep relMSE
+  echo "penumbra $mode vs reference:"; $BIN compare "$OUT/penumbra-$mode.exr" "$REF" | grep relMSE
+done

@@ -1,0 +1,116 @@
+//! Shared machinery of the estimation passes of [`super::wald`] and [`super::adaptive`]: a
+//! low-resolution grid of eye rays through the scene's camera, and the measured contribution
+//! of one light at one hit (one light sample, shadow ray included).
+//!
+//! Every random number is a pure function of (seed, pass, pixel, draw), and results are
+//! gathered in pixel order, so the passes are deterministic under any thread schedule.
+
+use crate::bsdf::{Bsdf, Bxdf};
+use crate::geometry::{Ray, RayQuery, SurfaceHit};
+use crate::lights::{LightSampleContext, LightSource, SamplingMode};
+use crate::luminance;
+use crate::sampling::Frame;
+use crate::sampling::hash::{next_f32, pcg_from_keys};
+use crate::scene::Scene;
+use glam::{UVec2, Vec2, Vec3};
+use rand_pcg::Pcg32;
+
+use super::ShadingPoint;
+
+/// A camera-ray hit prepared for light sampling.
+pub struct EyeHit {
+    /// The hit.
+    pub hit: SurfaceHit,
+    /// What a selector sees.
+    pub sp: ShadingPoint,
+    bsdf: Bsdf,
+    frame: Frame,
+    wo_local: Vec3,
+}
+
+/// Resolution of an estimation grid whose longer side is `max_side`, with the film's aspect.
+pub fn estimate_resolution(scene: &Scene, max_side: u32) -> UVec2 {
+    let r = scene.film.resolution.as_vec2().max(Vec2::ONE);
+    let s = max_side.max(1) as f32 / r.max_element();
+    UVec2::new(
+        ((r.x * s).round() as u32).max(1),
+        ((r.y * s).round() as u32).max(1),
+    )
+}
+
+/// The per-pixel random stream of an estimation pass.
+pub fn pixel_rng(seed: u64, tag: u64, pass: u32, pixel: u32) -> Pcg32 {
+    pcg_from_keys(&[seed, tag, pass as u64, pixel as u64])
+}
+
+/// The hit of a jittered eye ray through `pixel` of a `res` grid, if it hits a surface with a
+/// material.
+pub fn eye_hit(scene: &Scene, res: UVec2, pixel: u32, rng: &mut Pcg32) -> Option<EyeHit> {
+    let (x, y) = (pixel % res.x, pixel / res.x);
+    let jitter = Vec2::new(next_f32(rng), next_f32(rng));
+    let p_raster = Vec2::new(x as f32, y as f32) + jitter;
+    let ray = scene.camera.generate_ray(p_raster, res);
+    let hit = scene.geometry.intersect(&ray)?;
+    let material = scene.materials.get(hit.material as usize)?;
+    let wo = -ray.d.normalize();
+    let front = ray.d.dot(hit.ng) < 0.0;
+    let ng = if front { hit.ng } else { -hit.ng };
+    let ns = if hit.ns.dot(wo) < 0.0 {
+        -hit.ns
+    } else {
+        hit.ns
+    };
+    let frame = Frame::from_normal(ns);
+    Some(EyeHit {
+        bsdf: material.bsdf(&hit, front),
+        wo_local: frame.to_local(wo),
+        frame,
+        sp: ShadingPoint {
+            p: hit.p,
+            n: ng,
+            wo,
+        },
+        hit,
+    })
+}
+
+/// Luminance of one light-sampling estimate f·Li·cos/pdf_ω of scene light `light` at `eh`
+/// (not divided by any selection probability), zero if occluded.
+pub fn contribution(scene: &Scene, eh: &EyeHit, light: u32, u: Vec2) -> f32 {
+    let Some(l) = scene.lights.get(light as usize) else {
+        return 0.0;
+    };
+    let ctx = LightSampleContext {
+        p: eh.hit.p,
+        n: eh.sp.n,
+    };
+    let Some(ls) = l.sample_li(&ctx, u, SamplingMode::SolidAngle) else {
+        return 0.0;
+    };
+    if (ls.pdf.is_nan() || ls.pdf <= 0.0) || ls.wi.dot(eh.sp.n) <= 0.0 {
+        return 0.0;
+    }
+    let wi_local = eh.frame.to_local(ls.wi);
+    let v = luminance(eh.bsdf.f(eh.wo_local, wi_local) * ls.li) * wi_local.z.abs() / ls.pdf;
+    if (v.is_nan() || v <= 0.0) || !v.is_finite() {
+        return 0.0;
+    }
+    // Shadow ray from just off the surface to just short of the light point.
+    let o = eh.hit.spawn_origin(ls.p_light - eh.hit.p);
+    let ray = Ray {
+        o,
+        d: ls.p_light - o,
+        t_max: 1.0 - 1e-4,
+    };
+    if scene.geometry.occluded(&ray) {
+        0.0
+    } else {
+        v
+    }
+}
+
+/// Two uniform numbers.
+#[inline]
+pub fn next_2d(rng: &mut Pcg32) -> Vec2 {
+    Vec2::new(next_f32(rng), next_f32(rng))
+}

@@ -1,0 +1,130 @@
+//! Both BVH backends must answer every ray query identically (closest hit t and primitive,
+//! any-hit), on the Cornell box and on a random triangle soup. The own BVH must also equal a
+//! brute-force loop over all primitives exactly; obvhs may miss rare hits a few ulps from the
+//! ray origin (its box test is not conservative there), so it only has to agree on ≥ 99.9%.
+
+use glam::{UVec2, Vec3};
+use penumbra::geometry::triangle::intersect_triangle;
+use penumbra::geometry::{Backend, Geometry, MeshShading, PrimKind, Primitive, Ray, RayQuery};
+use penumbra::sampling::{PatternKind, make_pattern};
+
+/// A backend-independent name of a primitive: (mesh, vertex indices) or the quadric index.
+fn identity(g: &Geometry, id: u32) -> (u32, [u32; 3]) {
+    match g.primitive(id).map(|p| p.kind) {
+        Some(PrimKind::Triangle { mesh, v }) => (mesh, v),
+        Some(PrimKind::Quadric(q)) => (u32::MAX, [q; 3]),
+        None => panic!("hit reports primitive {id} out of range"),
+    }
+}
+
+/// Uniform random rays from points in the (enlarged) scene box, some of them finite.
+fn rays(bounds: (Vec3, Vec3), n: u32) -> Vec<Ray> {
+    let pat = make_pattern(PatternKind::Random, 11);
+    let (lo, hi) = bounds;
+    let ext = hi - lo;
+    (0..n)
+        .map(|i| {
+            let px = UVec2::new(i, 0);
+            let a = pat.sample_2d(px, 0, 0, 1);
+            let b = pat.sample_2d(px, 1, 0, 1);
+            let c = pat.sample_2d(px, 2, 0, 1);
+            let o = lo - 0.1 * ext + 1.2 * ext * Vec3::new(a.x, a.y, b.x);
+            let z = 1.0 - 2.0 * b.y;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = std::f32::consts::TAU * c.x;
+            let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            let t_max = if i % 3 == 0 {
+                c.y * ext.length()
+            } else {
+                f32::INFINITY
+            };
+            Ray { o, d, t_max }
+        })
+        .collect()
+}
+
+fn check_agreement(g: &Geometry, n: u32) {
+    let own = g.rebuild(Backend::Own);
+    let obvhs = g.rebuild(Backend::Obvhs);
+    assert_eq!(own.backend(), Some(Backend::Own));
+    assert_eq!(obvhs.backend(), Some(Backend::Obvhs));
+    let (mut hits, mut ties, mut blocked, mut differ) = (0u32, 0u32, 0u32, 0u32);
+    for ray in rays(g.bounds(), n) {
+        let (a, b) = (own.intersect(&ray), obvhs.intersect(&ray));
+        if let Some(a) = &a {
+            assert_eq!(
+                Some(a.t),
+                brute_force_t(&own, &ray),
+                "own BVH t for {ray:?}"
+            );
+        } else {
+            assert_eq!(brute_force_t(&own, &ray), None, "own BVH missed {ray:?}");
+        }
+        match (&a, &b) {
+            (None, None) => {}
+            (Some(a), Some(b)) if a.t == b.t => {
+                hits += 1;
+                if identity(&own, a.prim) != identity(&obvhs, b.prim) {
+                    // Equal t on two primitives (a shared edge): either answer is right.
+                    ties += 1;
+                }
+            }
+            _ => differ += 1,
+        }
+        let occ = own.occluded(&ray);
+        assert_eq!(
+            occ,
+            a.is_some(),
+            "any-hit disagrees with closest hit for {ray:?}"
+        );
+        differ += (occ != obvhs.occluded(&ray)) as u32;
+        blocked += occ as u32;
+    }
+    eprintln!(
+        "{n} rays: {hits} hits ({ties} ties on equal t), {blocked} blocked, {differ} obvhs differences"
+    );
+    assert!(hits > n / 10 && ties < n / 1000 && differ < n / 1000);
+}
+
+/// Closest t over every (triangle) primitive.
+fn brute_force_t(g: &Geometry, ray: &Ray) -> Option<f32> {
+    (0..g.len() as u32)
+        .filter_map(|id| g.primitive(id))
+        .filter_map(|p| intersect_triangle(ray.o, ray.d, ray.t_max, p.p))
+        .map(|(t, ..)| t)
+        .min_by(f32::total_cmp)
+}
+
+#[test]
+fn backends_agree_on_cornell() {
+    let loaded = penumbra::scene::load::load("cornell", &Default::default()).expect("cornell");
+    check_agreement(&loaded.scene.geometry, 100_000);
+}
+
+#[test]
+fn backends_agree_on_a_triangle_soup() {
+    let pat = make_pattern(PatternKind::Random, 5);
+    let prims: Vec<Primitive> = (0..2000u32)
+        .map(|i| {
+            let px = UVec2::new(i, 1);
+            let p = |d| {
+                let a = pat.sample_2d(px, d, 0, 1);
+                let b = pat.sample_2d(px, d + 1, 0, 1);
+                Vec3::new(a.x, a.y, b.x) * 10.0
+            };
+            let p0 = p(0);
+            let (p1, p2) = (p0 + (p(2) - p0) * 0.2, p0 + (p(4) - p0) * 0.2);
+            Primitive {
+                p: [p0, p1, p2],
+                kind: PrimKind::Triangle {
+                    mesh: 0,
+                    v: [i, i, i],
+                },
+                material: 0,
+                light: u32::MAX,
+            }
+        })
+        .collect();
+    let g = Geometry::new(prims, vec![MeshShading::default()], Vec::new());
+    check_agreement(&g, 100_000);
+}
