@@ -61,6 +61,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 light_count: args.light_count,
                 ..BuiltinOptions::default()
             },
+            ..LoadOptions::default()
         },
     };
     let r = run_lab(&opts)?;
