@@ -22,12 +22,15 @@ pub enum Command {
     Bench(bench::Args),
     /// Compare an image with a reference: MSE, relMSE, MAE.
     Compare(compare::Args),
+    /// Render the lecture's comparison figures with timings, relMSE and an HTML report.
+    Lab(lab::Args),
     /// Plot and chi-square-test a sampling routine; dump samples, evaluate its pdf.
     Warp(warp::Args),
 }
 
 pub mod bench;
 pub mod compare;
+pub mod lab;
 pub mod render;
 pub mod warp;
 
@@ -36,6 +39,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Render(a)) => render::run(a),
         Some(Command::Compare(a)) => compare::run(a),
+        Some(Command::Lab(a)) => lab::run(a),
         Some(Command::Scenes) => {
             for b in penumbra::scene::builtin::BUILTINS {
                 println!("{:<16} {}", b.name, b.description);
