@@ -45,6 +45,11 @@ fn main() -> anyhow::Result<()> {
         println!("{}", label.replace('\n', " | "));
         panels.push((img, label));
     }
-    let m = montage(&panels, 4, 0.0, "cornell-phong: four estimators at equal samples");
+    let m = montage(
+        &panels,
+        4,
+        0.0,
+        "cornell-phong: four estimators at equal samples",
+    );
     save_png_atomic(&m, std::path::Path::new(out))
 }
