@@ -4,11 +4,11 @@
 # ../shared/reference/cornell-direct-mis-8192spp.exr with `penumbra compare`.
 #
 # Needs a Mitsuba venv (python3 -m venv V && V/bin/pip install mitsuba numpy) and Debian's
-# libllvm19. Usage: scripts/compare-mitsuba.sh [VENV] [PROFILE]   (defaults: /work/mitsuba-venv, dist)
+# libllvm19. Usage: scripts/compare-mitsuba.sh [VENV] [PROFILE]   (defaults: /work/mitsuba-venv, release)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${1:-/work/mitsuba-venv}
-PROFILE=${2:-dist}
+PROFILE=${2:-release}
 SHARED=../shared
 OUT=${OUT:-target/compare-mitsuba}
 mkdir -p "$OUT"
