@@ -6,12 +6,15 @@
 use super::float::gamma;
 use glam::{DVec2, Vec3};
 
-/// Per-ray constants of the shear that maps the ray to +z through the origin.
+/// Per-ray constants of the shear that maps the ray to +z through the origin, stored as the
+/// rows of the shear matrix so that each vertex is transformed by three dot products instead of
+/// runtime-indexed component shuffles (the same numbers, fewer instructions).
 #[derive(Clone, Copy, Debug)]
 pub struct RayShear {
     o: Vec3,
-    k: [usize; 3],
-    s: Vec3,
+    rx: Vec3,
+    ry: Vec3,
+    rz: Vec3,
 }
 
 impl RayShear {
@@ -32,10 +35,12 @@ impl RayShear {
             std::mem::swap(&mut kx, &mut ky);
         }
         let dz = d[kz];
+        let unit = |k: usize| Vec3::AXES[k];
         Self {
             o,
-            k: [kx, ky, kz],
-            s: Vec3::new(d[kx] / dz, d[ky] / dz, 1.0 / dz),
+            rx: unit(kx) - unit(kz) * (d[kx] / dz),
+            ry: unit(ky) - unit(kz) * (d[ky] / dz),
+            rz: unit(kz) * (1.0 / dz),
         }
     }
 
@@ -48,13 +53,12 @@ impl RayShear {
         p2: Vec3,
         t_max: f32,
     ) -> Option<(f32, f32, f32, f32)> {
-        let [kx, ky, kz] = self.k;
         let a = p0 - self.o;
         let b = p1 - self.o;
         let c = p2 - self.o;
-        let (ax, ay) = (a[kx] - self.s.x * a[kz], a[ky] - self.s.y * a[kz]);
-        let (bx, by) = (b[kx] - self.s.x * b[kz], b[ky] - self.s.y * b[kz]);
-        let (cx, cy) = (c[kx] - self.s.x * c[kz], c[ky] - self.s.y * c[kz]);
+        let (ax, ay) = (self.rx.dot(a), self.ry.dot(a));
+        let (bx, by) = (self.rx.dot(b), self.ry.dot(b));
+        let (cx, cy) = (self.rx.dot(c), self.ry.dot(c));
         let mut e0 = bx * cy - by * cx;
         let mut e1 = cx * ay - cy * ax;
         let mut e2 = ax * by - ay * bx;
@@ -76,7 +80,7 @@ impl RayShear {
         if det == 0.0 {
             return None;
         }
-        let (az, bz, cz) = (self.s.z * a[kz], self.s.z * b[kz], self.s.z * c[kz]);
+        let (az, bz, cz) = (self.rz.dot(a), self.rz.dot(b), self.rz.dot(c));
         let t_scaled = e0 * az + e1 * bz + e2 * cz;
         if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
             return None;
