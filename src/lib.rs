@@ -7,6 +7,7 @@
 
 // `!(x > 0.0)` is how this crate rejects NaN together with non-positive values, on purpose.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![warn(missing_docs)]
 
 pub mod bsdf;
 pub mod camera;
