@@ -19,7 +19,12 @@ pub fn dense(opts: &BuiltinOptions) -> anyhow::Result<Scene> {
     let m = b.add_material(Material::Diffuse {
         reflectance: Texture::Constant(Rgb::new(0.7, 0.65, 0.6)),
     });
-    let target = opts.triangles.unwrap_or(DEFAULT_TRIANGLES).max(64) as f32;
+    let count = opts.triangles.unwrap_or(DEFAULT_TRIANGLES);
+    anyhow::ensure!(
+        (64..=20_000_000).contains(&count),
+        "--triangles must be between 64 and 20000000, got {count}"
+    );
+    let target = count as f32;
     // u = 2v gives square-ish cells: 2·2v·v ≈ target.
     let v = (target / 4.0).sqrt().ceil().max(4.0) as u32;
     let u = 2 * v;
