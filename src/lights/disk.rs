@@ -5,11 +5,11 @@
 //! because `pdf_li` ignores the mode in the same way.
 
 use super::{
-    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
-    is_positive,
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
+    area_to_solid_angle, diffuse_power, is_positive,
 };
+use crate::Rgb;
 use crate::sampling::{Frame, concentric_disk};
-use crate::{Rgb, luminance};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -75,20 +75,7 @@ impl LightSource for DiskLight {
         }
         let q = concentric_disk(u) * self.radius;
         let p_light = self.center + self.frame.s * q.x + self.frame.t * q.y;
-        let d = p_light - ctx.p;
-        let dist = d.length();
-        if !is_positive(dist) {
-            return None;
-        }
-        let wi = d / dist;
-        let pdf = area_to_solid_angle(1.0 / self.area(), ctx.p, p_light, self.frame.n);
-        (pdf > 0.0 && pdf.is_finite()).then_some(LightLiSample {
-            wi,
-            li: self.l,
-            pdf,
-            p_light,
-            delta: false,
-        })
+        area_sample(ctx.p, p_light, self.frame.n, 1.0 / self.area(), self.l)
     }
 
     fn pdf_li(
@@ -114,8 +101,7 @@ impl LightSource for DiskLight {
     }
 
     fn power(&self) -> f32 {
-        let sides = if self.two_sided { 2.0 } else { 1.0 };
-        luminance(self.l) * self.area() * PI * sides
+        diffuse_power(self.l, self.area(), self.two_sided)
     }
 
     fn bounds(&self) -> Option<LightBounds> {

@@ -253,6 +253,56 @@ pub(crate) fn triangle_solid_angle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     (2.0 * num.atan2(den)) as f32
 }
 
+/// The connection from `p` to `p_light`, a point drawn with area density `pdf_area` on an
+/// emitter of radiance `l` whose normal there is `n_light`: the one place where a sampled point
+/// on an area light becomes a [`LightLiSample`] with a solid-angle pdf.
+#[inline]
+pub(crate) fn area_sample(
+    p: Vec3,
+    p_light: Vec3,
+    n_light: Vec3,
+    pdf_area: f32,
+    l: Rgb,
+) -> Option<LightLiSample> {
+    let d = p_light - p;
+    let dist = d.length();
+    if !is_positive(dist) {
+        return None;
+    }
+    let pdf = area_to_solid_angle(pdf_area, p, p_light, n_light);
+    (is_positive(pdf) && pdf.is_finite()).then_some(LightLiSample {
+        wi: d / dist,
+        li: l,
+        pdf,
+        p_light,
+        delta: false,
+    })
+}
+
+/// A direction drawn by solid angle with density `pdf`, reaching the emitter at `p_light`.
+#[inline]
+pub(crate) fn solid_angle_sample(
+    wi: Vec3,
+    p_light: Vec3,
+    pdf: f32,
+    l: Rgb,
+) -> Option<LightLiSample> {
+    (is_positive(pdf) && pdf.is_finite()).then_some(LightLiSample {
+        wi,
+        li: l,
+        pdf,
+        p_light,
+        delta: false,
+    })
+}
+
+/// Power Φ of a diffuse emitter of radiance `l` and area `area`: π·L·A per emitting side.
+#[inline]
+pub(crate) fn diffuse_power(l: Rgb, area: f32, two_sided: bool) -> f32 {
+    let sides = if two_sided { 2.0 } else { 1.0 };
+    crate::luminance(l) * area * std::f32::consts::PI * sides
+}
+
 /// `x > 0`, false for NaN: guards written as `!is_positive(x)` reject NaN along with
 /// non-positive values (a plain `x <= 0.0` would let NaN through).
 #[inline]

@@ -3,13 +3,13 @@
 //! [`crate::sampling::SphericalRectangle`]) when the edges are perpendicular.
 
 use super::{
-    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
-    is_positive, spherical_ok, triangle_solid_angle,
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
+    area_to_solid_angle, diffuse_power, is_positive, solid_angle_sample, spherical_ok,
+    triangle_solid_angle,
 };
+use crate::Rgb;
 use crate::sampling::SphericalRectangle;
-use crate::{Rgb, luminance};
 use glam::{Vec2, Vec3};
-use std::f32::consts::PI;
 
 /// A parallelogram emitting constant radiance `l` on the side of `n` (both sides if `two_sided`).
 #[derive(Clone, Copy, Debug)]
@@ -111,31 +111,21 @@ impl LightSource for QuadLight {
         if !self.faces(ctx.p) {
             return None;
         }
-        let (p_light, pdf_sa) = match self.spherical_omega(ctx.p, mode) {
+        match self.spherical_omega(ctx.p, mode) {
             Some(omega) => {
                 let sr = SphericalRectangle::new(ctx.p, self.corner, self.e1, self.e2)?;
-                (sr.sample(u), Some(1.0 / omega))
+                let p_light = sr.sample(u);
+                let wi = (p_light - ctx.p).normalize_or_zero();
+                if wi == Vec3::ZERO {
+                    return None;
+                }
+                solid_angle_sample(wi, p_light, 1.0 / omega, self.l)
             }
-            None => (self.corner + u.x * self.e1 + u.y * self.e2, None),
-        };
-        let d = p_light - ctx.p;
-        let dist = d.length();
-        if !is_positive(dist) {
-            return None;
+            None => {
+                let p_light = self.corner + u.x * self.e1 + u.y * self.e2;
+                area_sample(ctx.p, p_light, self.n, 1.0 / self.area, self.l)
+            }
         }
-        let wi = d / dist;
-        let pdf =
-            pdf_sa.unwrap_or_else(|| area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n));
-        if !is_positive(pdf) || !pdf.is_finite() {
-            return None;
-        }
-        Some(LightLiSample {
-            wi,
-            li: self.l,
-            pdf,
-            p_light,
-            delta: false,
-        })
     }
 
     fn pdf_li(
@@ -165,8 +155,7 @@ impl LightSource for QuadLight {
     }
 
     fn power(&self) -> f32 {
-        let sides = if self.two_sided { 2.0 } else { 1.0 };
-        luminance(self.l) * self.area * PI * sides
+        diffuse_power(self.l, self.area, self.two_sided)
     }
 
     fn bounds(&self) -> Option<LightBounds> {

@@ -5,8 +5,8 @@
 //! area sampling is used in both modes.
 
 use super::{
-    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
-    is_positive,
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
+    area_to_solid_angle, is_positive, solid_angle_sample,
 };
 use crate::sampling::{Frame, uniform_cone_sin2, uniform_cone_sin2_pdf, uniform_sphere};
 use crate::{Rgb, luminance};
@@ -114,38 +114,16 @@ impl LightSource for SphereLight {
                     let to_c = self.center - ctx.p;
                     ctx.p + wi * wi.dot(to_c).max(0.0)
                 });
-                let pdf = uniform_cone_sin2_pdf(Vec3::Z, sin2);
-                (pdf > 0.0 && pdf.is_finite()).then_some(LightLiSample {
-                    wi,
-                    li: self.l,
-                    pdf,
-                    p_light,
-                    delta: false,
-                })
+                solid_angle_sample(wi, p_light, uniform_cone_sin2_pdf(Vec3::Z, sin2), self.l)
             }
             View::Area => {
                 let n_out = uniform_sphere(u);
                 let p_light = self.center + self.radius * n_out;
-                let d = p_light - ctx.p;
-                let dist = d.length();
-                if !is_positive(dist) {
-                    return None;
-                }
-                let wi = d / dist;
+                let s = area_sample(ctx.p, p_light, n_out, self.pdf_area(), self.l)?;
                 // Only points whose emitting side faces the receiver: the far side of an outward
                 // sphere is hidden behind its near side.
                 let n_emit = if self.inward { -n_out } else { n_out };
-                if n_emit.dot(wi) >= 0.0 {
-                    return None;
-                }
-                let pdf = area_to_solid_angle(self.pdf_area(), ctx.p, p_light, n_out);
-                (pdf > 0.0 && pdf.is_finite()).then_some(LightLiSample {
-                    wi,
-                    li: self.l,
-                    pdf,
-                    p_light,
-                    delta: false,
-                })
+                (n_emit.dot(s.wi) < 0.0).then_some(s)
             }
         }
     }

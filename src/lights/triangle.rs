@@ -2,13 +2,13 @@
 //! (Arvo's spherical triangle, [`crate::sampling::SphericalTriangle`]).
 
 use super::{
-    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_to_solid_angle,
-    is_positive, spherical_ok, triangle_solid_angle,
+    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
+    area_to_solid_angle, diffuse_power, is_positive, solid_angle_sample, spherical_ok,
+    triangle_solid_angle,
 };
+use crate::Rgb;
 use crate::sampling::{SphericalTriangle, uniform_triangle_point};
-use crate::{Rgb, luminance};
 use glam::{Vec2, Vec3};
-use std::f32::consts::PI;
 
 /// A triangle emitting constant radiance `l` on the side of `n` (both sides if `two_sided`).
 #[derive(Clone, Copy, Debug)]
@@ -85,32 +85,10 @@ impl LightSource for TriangleLight {
             if !is_positive(t) || !t.is_finite() {
                 return None;
             }
-            return Some(LightLiSample {
-                wi,
-                li: self.l,
-                pdf: 1.0 / omega,
-                p_light: ctx.p + wi * t,
-                delta: false,
-            });
+            return solid_angle_sample(wi, ctx.p + wi * t, 1.0 / omega, self.l);
         }
         let p_light = uniform_triangle_point(u, self.p[0], self.p[1], self.p[2]);
-        let d = p_light - ctx.p;
-        let dist = d.length();
-        if dist == 0.0 {
-            return None;
-        }
-        let wi = d / dist;
-        let pdf = area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n);
-        if !is_positive(pdf) || !pdf.is_finite() {
-            return None;
-        }
-        Some(LightLiSample {
-            wi,
-            li: self.l,
-            pdf,
-            p_light,
-            delta: false,
-        })
+        area_sample(ctx.p, p_light, self.n, 1.0 / self.area, self.l)
     }
 
     fn pdf_li(
@@ -141,8 +119,7 @@ impl LightSource for TriangleLight {
     }
 
     fn power(&self) -> f32 {
-        let sides = if self.two_sided { 2.0 } else { 1.0 };
-        luminance(self.l) * self.area * PI * sides
+        diffuse_power(self.l, self.area, self.two_sided)
     }
 
     fn bounds(&self) -> Option<LightBounds> {
