@@ -40,23 +40,22 @@ impl Camera {
         }
     }
 
-    /// Camera-space direction (not normalised, z = 1) through raster position `p`.
-    #[inline]
-    fn camera_dir(&self, p: Vec2, res: UVec2, win: &[f32; 4], tan_half: f32) -> Vec3 {
-        let sx = win[0] + (p.x / res.x as f32) * (win[1] - win[0]);
-        let sy = win[3] - (p.y / res.y as f32) * (win[3] - win[2]);
-        Vec3::new(sx * tan_half, sy * tan_half, 1.0)
+    /// Everything `generate_ray` needs for resolution `res`, computed once per render rather
+    /// than once per ray.
+    pub fn rays(&self, res: UVec2) -> CameraRays {
+        CameraRays {
+            origin: self.camera_to_world.point(Vec3::ZERO),
+            camera_to_world: self.camera_to_world,
+            win: self.window(res),
+            tan_half: (self.fov_deg.to_radians() * 0.5).tan(),
+            res: res.as_vec2(),
+        }
     }
 
     /// The ray through continuous raster position `p_raster` (pixels, origin top-left) of a
     /// `res.x × res.y` image. The direction is unit length.
     pub fn generate_ray(&self, p_raster: Vec2, res: UVec2) -> Ray {
-        let win = self.window(res);
-        let tan_half = (self.fov_deg.to_radians() * 0.5).tan();
-        let d = self.camera_dir(p_raster, res, &win, tan_half);
-        let o = self.camera_to_world.point(Vec3::ZERO);
-        let dw = self.camera_to_world.vector(d).normalize();
-        Ray::new(o, dw)
+        self.rays(res).generate(p_raster)
     }
 
     /// Continuous raster position of world point `p`, or `None` if it is behind the camera.
@@ -73,5 +72,27 @@ impl Camera {
             (sx - win[0]) / (win[1] - win[0]) * res.x as f32,
             (win[3] - sy) / (win[3] - win[2]) * res.y as f32,
         ))
+    }
+}
+
+/// A camera set up for one resolution: the per-render constants of [`Camera::generate_ray`].
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRays {
+    origin: Vec3,
+    camera_to_world: Transform,
+    win: [f32; 4],
+    tan_half: f32,
+    res: Vec2,
+}
+
+impl CameraRays {
+    /// The unit-direction ray through continuous raster position `p`.
+    #[inline]
+    pub fn generate(&self, p: Vec2) -> Ray {
+        let w = &self.win;
+        let sx = w[0] + (p.x / self.res.x) * (w[1] - w[0]);
+        let sy = w[3] - (p.y / self.res.y) * (w[3] - w[2]);
+        let d = Vec3::new(sx * self.tan_half, sy * self.tan_half, 1.0);
+        Ray::new(self.origin, self.camera_to_world.vector(d).normalize())
     }
 }

@@ -63,6 +63,7 @@ pub fn render(
         bsdf_sampling: opts.bsdf_sampling,
         mis_light: opts.mis_light,
     };
+    let camera = scene.camera.rays(res);
     let tiles_x = res.x.div_ceil(TILE);
     let tiles_y = res.y.div_ceil(TILE);
     let n_tiles = (tiles_x * tiles_y) as u64;
@@ -98,7 +99,7 @@ pub fn render(
                     for i in 0..opts.spp {
                         let u = px.sample_2d(DIM_FILTER, i, opts.spp);
                         let p = filter_sample(&scene.film.filter, pixel, u);
-                        let ray = scene.camera.generate_ray(p, res);
+                        let ray = camera.generate(p);
                         let (l, r) = est.li(&px, i, &ray);
                         tile_rays += r;
                         if l.is_finite() {
