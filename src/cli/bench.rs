@@ -102,7 +102,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn bvh_section(names: &[String]) -> anyhow::Result<()> {
     use glam::Vec3;
     use penumbra::geometry::{Backend, Ray, RayQuery};
-    use penumbra::sampling::{PatternKind, make_pattern};
+    use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere};
     println!("| scene | backend | prims | build (s) | closest Mrays/s | any-hit Mrays/s |");
     println!("|---|---|---|---|---|---|");
     const N: u32 = 1_000_000;
@@ -113,16 +113,9 @@ fn bvh_section(names: &[String]) -> anyhow::Result<()> {
         let rays: Vec<Ray> = (0..N)
             .map(|i| {
                 let px = UVec2::new(i, 0);
-                let (a, b, c) = (
-                    pat.sample_2d(px, 0, 0, 1),
-                    pat.sample_2d(px, 1, 0, 1),
-                    pat.sample_1d(px, 2, 0, 1),
-                );
-                let o = lo + (hi - lo) * Vec3::new(a.x, a.y, b.x);
-                let z = 1.0 - 2.0 * b.y;
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let phi = std::f32::consts::TAU * c;
-                Ray::new(o, Vec3::new(r * phi.cos(), r * phi.sin(), z))
+                let (a, b) = (pat.sample_2d(px, 0, 0, 1), pat.sample_2d(px, 1, 0, 1));
+                let o = lo + (hi - lo) * Vec3::new(a.x, a.y, pat.sample_1d(px, 2, 0, 1));
+                Ray::new(o, uniform_sphere(b))
             })
             .collect();
         for backend in [Backend::Own, Backend::Obvhs] {
