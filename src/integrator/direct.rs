@@ -221,46 +221,48 @@ impl<'a> DirectLighting<'a> {
         if weight == Rgb::ZERO || !weight.is_finite() {
             return Rgb::ZERO;
         }
+        // One logical ray, resolved in two cheaper queries: the nearest emitter along it (a BVH
+        // of emitters only), then whether the scene blocks the way to it. The first hit of the
+        // ray is an emitter exactly when that emitter is visible, so this is the closest-hit
+        // estimator without a closest-hit query for the many rays that miss every light.
         *rays += 1;
         let ray = Ray::new(sh.hit.spawn_origin(wi), wi);
         let mode = self.mode();
-        match self.scene.geometry.intersect(&ray) {
-            Some(h) if h.light != NO_LIGHT => {
-                let light = &self.scene.lights[h.light as usize];
-                let le = light.radiance(h.p, h.ng, h.uv, -wi);
-                if le == Rgb::ZERO {
-                    return Rgb::ZERO;
-                }
-                let w = if mis && !bs.delta {
-                    let pdf_l = self.selector.pmf(&sh.sp, h.light)
-                        * light.pdf_li(&sh.ctx, wi, h.p, h.ng, mode);
-                    self.heuristic(bs.pdf, pdf_l)
-                } else {
-                    1.0
-                };
-                weight * le * w
+        if let Some(h) = self.scene.emitters.intersect(&ray) {
+            let light = &self.scene.lights[h.light as usize];
+            let le = light.radiance(h.p, h.ng, h.uv, -wi);
+            if le == Rgb::ZERO || self.scene.geometry.occluded(&shadow_ray(&sh.hit, h.p)) {
+                return Rgb::ZERO;
             }
-            Some(_) => Rgb::ZERO,
-            None => {
-                let mut sum = Rgb::ZERO;
-                for &i in &self.scene.infinite_lights {
-                    let light = &self.scene.lights[i as usize];
-                    let le = light.radiance(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, wi);
-                    if le == Rgb::ZERO {
-                        continue;
-                    }
-                    let w = if mis && !bs.delta {
-                        let pdf_l = self.selector.pmf(&sh.sp, i)
-                            * light.pdf_li(&sh.ctx, wi, Vec3::ZERO, Vec3::ZERO, mode);
-                        self.heuristic(bs.pdf, pdf_l)
-                    } else {
-                        1.0
-                    };
-                    sum += le * w;
-                }
-                weight * sum
-            }
+            let w = if mis && !bs.delta {
+                let pdf_l =
+                    self.selector.pmf(&sh.sp, h.light) * light.pdf_li(&sh.ctx, wi, h.p, h.ng, mode);
+                self.heuristic(bs.pdf, pdf_l)
+            } else {
+                1.0
+            };
+            return weight * le * w;
         }
+        if self.scene.infinite_lights.is_empty() || self.scene.geometry.occluded(&ray) {
+            return Rgb::ZERO;
+        }
+        let mut sum = Rgb::ZERO;
+        for &i in &self.scene.infinite_lights {
+            let light = &self.scene.lights[i as usize];
+            let le = light.radiance(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, wi);
+            if le == Rgb::ZERO {
+                continue;
+            }
+            let w = if mis && !bs.delta {
+                let pdf_l = self.selector.pmf(&sh.sp, i)
+                    * light.pdf_li(&sh.ctx, wi, Vec3::ZERO, Vec3::ZERO, mode);
+                self.heuristic(bs.pdf, pdf_l)
+            } else {
+                1.0
+            };
+            sum += le * w;
+        }
+        weight * sum
     }
 }
 

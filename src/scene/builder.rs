@@ -289,6 +289,7 @@ impl SceneBuilder {
             film.resolution.x,
             film.resolution.y
         );
+        let emitters = emitter_geometry(&self.prims, &self.meshes, &self.quadrics);
         let geometry = Geometry::new(self.prims, self.meshes, self.quadrics);
         let mut lights = self.lights;
         let (lo, hi) = geometry.bounds();
@@ -308,6 +309,7 @@ impl SceneBuilder {
             .collect();
         Ok(Scene {
             geometry,
+            emitters,
             materials: self.materials,
             lights,
             infinite_lights,
@@ -315,6 +317,43 @@ impl SceneBuilder {
             film,
         })
     }
+}
+
+/// The emissive primitives alone, behind their own BVH, with only the meshes and quadrics they
+/// use: BSDF rays look for the nearest emitter here first and test visibility only when one is
+/// found, so the many BSDF rays that miss every light cost a few box tests instead of a
+/// closest-hit query of the whole scene.
+fn emitter_geometry(prims: &[Primitive], meshes: &[MeshShading], quadrics: &[Quadric]) -> Geometry {
+    let mut mesh_map = vec![u32::MAX; meshes.len()];
+    let mut quadric_map = vec![u32::MAX; quadrics.len()];
+    let (mut own_meshes, mut own_quadrics) = (Vec::new(), Vec::new());
+    let own_prims = prims
+        .iter()
+        .filter(|p| p.light != NO_LIGHT)
+        .map(|p| {
+            let mut p = *p;
+            p.kind = match p.kind {
+                PrimKind::Triangle { mesh, v } => {
+                    let m = &mut mesh_map[mesh as usize];
+                    if *m == u32::MAX {
+                        *m = own_meshes.len() as u32;
+                        own_meshes.push(meshes[mesh as usize].clone());
+                    }
+                    PrimKind::Triangle { mesh: *m, v }
+                }
+                PrimKind::Quadric(q) => {
+                    let m = &mut quadric_map[q as usize];
+                    if *m == u32::MAX {
+                        *m = own_quadrics.len() as u32;
+                        own_quadrics.push(quadrics[q as usize]);
+                    }
+                    PrimKind::Quadric(*m)
+                }
+            };
+            p
+        })
+        .collect();
+    Geometry::new(own_prims, own_meshes, own_quadrics)
 }
 
 fn check_emission(e: &AreaEmission) -> anyhow::Result<()> {

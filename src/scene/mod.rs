@@ -76,6 +76,8 @@ pub struct TriangleMesh {
 pub struct Scene {
     /// Geometry and its BVH.
     pub geometry: crate::geometry::Geometry,
+    /// The emissive primitives alone, with their own BVH (for BSDF rays seeking emitters).
+    pub emitters: crate::geometry::Geometry,
     /// Materials, indexed by `SurfaceHit::material`.
     pub materials: Vec<Material>,
     /// All lights; area lights are referenced by `SurfaceHit::light`.
