@@ -33,7 +33,8 @@ use std::str::FromStr;
 use super::ONE_MINUS_EPSILON;
 use super::error::SamplingError;
 use super::hash::{hash_keys, hash_step, uniform_pair};
-use super::permutation::Permutation;
+use super::permutation::{PermDomain, Permutation};
+use std::cell::Cell;
 
 /// The pattern names accepted by `--pattern`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -220,23 +221,23 @@ impl SetKeys {
     }
 
     #[inline]
-    fn sample_1d(&self, kind: PatternKind, index: u32, count: u32) -> f32 {
-        let count = count.max(1);
+    fn sample_1d(&self, kind: PatternKind, index: u32, st: &Strata) -> f32 {
+        let count = st.count;
         match kind {
             PatternKind::Fixed => 0.5,
             PatternKind::Random => uniform_pair(self.jitter, index).0,
-            PatternKind::Grid => in_stratum(self.perm.apply(index, count), 0.5, count),
+            PatternKind::Grid => in_stratum(self.perm.apply_in(index, &st.dom), 0.5, count),
             PatternKind::Stratified | PatternKind::Lhs => {
-                let j = uniform_pair(self.jitter, index % count).0;
-                in_stratum(self.perm.apply(index, count), j, count)
+                let j = uniform_pair(self.jitter, st.wrap(index)).0;
+                in_stratum(self.perm.apply_in(index, &st.dom), j, count)
             }
             PatternKind::Sobol => self.sobol(index, 0),
         }
     }
 
     #[inline]
-    fn sample_2d(&self, kind: PatternKind, index: u32, count: u32) -> Vec2 {
-        let count = count.max(1);
+    fn sample_2d(&self, kind: PatternKind, index: u32, st: &Strata) -> Vec2 {
+        let count = st.count;
         match kind {
             PatternKind::Fixed => Vec2::splat(0.5),
             PatternKind::Random => {
@@ -244,23 +245,72 @@ impl SetKeys {
                 Vec2::new(a, b)
             }
             PatternKind::Grid => {
-                let (nx, ny) = grid_dims(count);
-                let s = self.perm.apply(index, count);
-                Vec2::new(in_stratum(s % nx, 0.5, nx), in_stratum(s / nx, 0.5, ny))
+                let (sx, sy) = st.cell(self.perm.apply_in(index, &st.dom));
+                Vec2::new(in_stratum(sx, 0.5, st.nx), in_stratum(sy, 0.5, st.ny))
             }
             PatternKind::Stratified => {
-                let (nx, ny) = grid_dims(count);
-                let s = self.perm.apply(index, count);
-                let (jx, jy) = uniform_pair(self.jitter, index % count);
-                Vec2::new(in_stratum(s % nx, jx, nx), in_stratum(s / nx, jy, ny))
+                let (sx, sy) = st.cell(self.perm.apply_in(index, &st.dom));
+                let (jx, jy) = uniform_pair(self.jitter, st.wrap(index));
+                Vec2::new(in_stratum(sx, jx, st.nx), in_stratum(sy, jy, st.ny))
             }
             PatternKind::Lhs => {
-                let sx = self.perm.apply(index, count);
-                let sy = self.perm_y.apply(index, count);
-                let (jx, jy) = uniform_pair(self.jitter, index % count);
+                let sx = self.perm.apply_in(index, &st.dom);
+                let sy = self.perm_y.apply_in(index, &st.dom);
+                let (jx, jy) = uniform_pair(self.jitter, st.wrap(index));
                 Vec2::new(in_stratum(sx, jx, count), in_stratum(sy, jy, count))
             }
             PatternKind::Sobol => Vec2::new(self.sobol(index, 0), self.sobol(index, 1)),
+        }
+    }
+}
+
+/// What a sample set of `count` points needs besides its keys (grid shape, permutation
+/// width), computed once per count instead of for every sample.
+#[derive(Clone, Copy, Debug, Default)]
+struct Strata {
+    count: u32,
+    nx: u32,
+    ny: u32,
+    /// log2(nx) when nx is a power of two (the common square counts), else `u32::MAX`.
+    nx_log2: u32,
+    dom: PermDomain,
+}
+
+impl Strata {
+    #[inline]
+    fn new(count: u32) -> Self {
+        let count = count.max(1);
+        let (nx, ny) = grid_dims(count);
+        Self {
+            count,
+            nx,
+            ny,
+            nx_log2: if nx.is_power_of_two() {
+                nx.trailing_zeros()
+            } else {
+                u32::MAX
+            },
+            dom: PermDomain::new(count),
+        }
+    }
+
+    /// `index` wrapped into [0, count).
+    #[inline]
+    fn wrap(&self, index: u32) -> u32 {
+        if index < self.count {
+            index
+        } else {
+            index % self.count
+        }
+    }
+
+    /// Grid cell (column, row) of stratum `s`.
+    #[inline]
+    fn cell(&self, s: u32) -> (u32, u32) {
+        if self.nx_log2 != u32::MAX {
+            (s & (self.nx - 1), s >> self.nx_log2)
+        } else {
+            (s % self.nx, s / self.nx)
         }
     }
 }
@@ -273,13 +323,19 @@ fn in_stratum(stratum: u32, jitter: f32, n: u32) -> f32 {
 
 impl SamplePattern for Pattern {
     fn sample_1d(&self, pixel: UVec2, dim: u32, index: u32, count: u32) -> f32 {
-        self.set(self.pixel_hash(pixel), dim, TAG_1D)
-            .sample_1d(self.kind, index, count)
+        self.set(self.pixel_hash(pixel), dim, TAG_1D).sample_1d(
+            self.kind,
+            index,
+            &Strata::new(count),
+        )
     }
 
     fn sample_2d(&self, pixel: UVec2, dim: u32, index: u32, count: u32) -> Vec2 {
-        self.set(self.pixel_hash(pixel), dim, TAG_2D)
-            .sample_2d(self.kind, index, count)
+        self.set(self.pixel_hash(pixel), dim, TAG_2D).sample_2d(
+            self.kind,
+            index,
+            &Strata::new(count),
+        )
     }
 
     fn kind(&self) -> PatternKind {
@@ -293,6 +349,7 @@ impl SamplePattern for Pattern {
             pixel,
             sets_1d: std::array::from_fn(|d| self.set(prefix, d as u32, TAG_1D)),
             sets_2d: std::array::from_fn(|d| self.set(prefix, d as u32, TAG_2D)),
+            strata: Cell::default(),
         }
     }
 }
@@ -305,6 +362,9 @@ pub struct PixelSamples {
     pixel: UVec2,
     sets_1d: [SetKeys; CACHED_DIMS],
     sets_2d: [SetKeys; CACHED_DIMS],
+    /// The two most recently used sample counts' [`Strata`] (an integrator asks for two: N for
+    /// the pixel filter, N·M for the shading dimensions).
+    strata: Cell<[Strata; 2]>,
 }
 
 impl PixelSamples {
@@ -314,11 +374,27 @@ impl PixelSamples {
         self.pixel
     }
 
+    /// The [`Strata`] of `count`, from the two-entry cache.
+    #[inline]
+    fn strata(&self, count: u32) -> Strata {
+        let count = count.max(1);
+        let mut c = self.strata.get();
+        if c[0].count == count {
+            return c[0];
+        }
+        if c[1].count != count {
+            c[1] = Strata::new(count);
+        }
+        c.swap(0, 1);
+        self.strata.set(c);
+        c[0]
+    }
+
     /// The 1D sample `index` of `count` for `dim`.
     #[inline]
     pub fn sample_1d(&self, dim: u32, index: u32, count: u32) -> f32 {
         match self.sets_1d.get(dim as usize) {
-            Some(s) => s.sample_1d(self.pattern.kind, index, count),
+            Some(s) => s.sample_1d(self.pattern.kind, index, &self.strata(count)),
             None => self.pattern.sample_1d(self.pixel, dim, index, count),
         }
     }
@@ -327,7 +403,7 @@ impl PixelSamples {
     #[inline]
     pub fn sample_2d(&self, dim: u32, index: u32, count: u32) -> Vec2 {
         match self.sets_2d.get(dim as usize) {
-            Some(s) => s.sample_2d(self.pattern.kind, index, count),
+            Some(s) => s.sample_2d(self.pattern.kind, index, &self.strata(count)),
             None => self.pattern.sample_2d(self.pixel, dim, index, count),
         }
     }

@@ -45,15 +45,16 @@ impl Permutation {
     /// Same as [`permute`]`(index, n, key)` for the key this was made from.
     #[inline]
     pub fn apply(&self, index: u32, n: u32) -> u32 {
+        self.apply_in(index, &PermDomain::new(n))
+    }
+
+    /// [`Permutation::apply`] with the domain's bit width precomputed (hot path).
+    #[inline]
+    pub fn apply_in(&self, index: u32, dom: &PermDomain) -> u32 {
+        let PermDomain { n, bits, mask } = *dom;
         if n <= 1 {
             return 0;
         }
-        let bits = 32 - (n - 1).leading_zeros();
-        let mask = if bits == 32 {
-            u32::MAX
-        } else {
-            (1 << bits) - 1
-        };
         let [k0, k1, k2, k3] = self.k;
         let mut i = if index < n { index } else { index % n };
         loop {
@@ -64,6 +65,29 @@ impl Permutation {
                 return i;
             }
         }
+    }
+}
+
+/// The length of a permuted range with the width of its enclosing power of two, which
+/// [`Permutation::apply_in`] would otherwise recompute for every index.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PermDomain {
+    n: u32,
+    bits: u32,
+    mask: u32,
+}
+
+impl PermDomain {
+    /// The domain [0, n).
+    #[inline]
+    pub fn new(n: u32) -> Self {
+        let bits = 32 - n.saturating_sub(1).leading_zeros();
+        let mask = if bits == 32 {
+            u32::MAX
+        } else {
+            (1 << bits) - 1
+        };
+        Self { n, bits, mask }
     }
 }
 
