@@ -6,7 +6,7 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
-    area_to_solid_angle, diffuse_power, is_positive,
+    area_to_solid_angle, diffuse_power, is_positive, planar_radiance, sees_emitting_side,
 };
 use crate::Rgb;
 use crate::sampling::{Frame, concentric_disk};
@@ -50,16 +50,10 @@ impl DiskLight {
         PI * self.radius * self.radius
     }
 
-    #[inline]
-    fn emits_toward(&self, w: Vec3) -> bool {
-        self.two_sided || self.frame.n.dot(w) > 0.0
-    }
-
     /// Whether a receiver at `p` can see the emitting side (none from the plane itself).
     #[inline]
     fn faces(&self, p: Vec3) -> bool {
-        let s = self.frame.n.dot(p - self.center);
-        if self.two_sided { s != 0.0 } else { s > 0.0 }
+        sees_emitting_side(self.frame.n, self.center, self.two_sided, p)
     }
 }
 
@@ -93,11 +87,7 @@ impl LightSource for DiskLight {
     }
 
     fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        if self.emits_toward(w) {
-            self.l
-        } else {
-            Rgb::ZERO
-        }
+        planar_radiance(self.frame.n, self.l, self.two_sided, w)
     }
 
     fn power(&self) -> f32 {

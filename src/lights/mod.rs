@@ -296,6 +296,24 @@ pub(crate) fn solid_angle_sample(
     })
 }
 
+/// Whether a receiver at `p` sees the emitting side of the plane through `origin` with unit
+/// normal `n`: one-sided emitters are dark from behind, and nothing is seen from the plane.
+#[inline]
+pub(crate) fn sees_emitting_side(n: Vec3, origin: Vec3, two_sided: bool, p: Vec3) -> bool {
+    let s = n.dot(p - origin);
+    if two_sided { s != 0.0 } else { s > 0.0 }
+}
+
+/// Radiance of a diffuse planar emitter with normal `n` seen along `w` (leaving the surface).
+#[inline]
+pub(crate) fn planar_radiance(n: Vec3, l: Rgb, two_sided: bool, w: Vec3) -> Rgb {
+    if two_sided || n.dot(w) > 0.0 {
+        l
+    } else {
+        Rgb::ZERO
+    }
+}
+
 /// Power Φ of a diffuse emitter of radiance `l` and area `area`: π·L·A per emitting side.
 #[inline]
 pub(crate) fn diffuse_power(l: Rgb, area: f32, two_sided: bool) -> f32 {

@@ -4,8 +4,8 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
-    area_to_solid_angle, diffuse_power, is_positive, solid_angle_sample, spherical_ok,
-    triangle_solid_angle,
+    area_to_solid_angle, diffuse_power, is_positive, planar_radiance, sees_emitting_side,
+    solid_angle_sample, spherical_ok, triangle_solid_angle,
 };
 use crate::Rgb;
 use crate::sampling::SphericalRectangle;
@@ -70,16 +70,10 @@ impl QuadLight {
         })
     }
 
-    #[inline]
-    fn emits_toward(&self, w: Vec3) -> bool {
-        self.two_sided || self.n.dot(w) > 0.0
-    }
-
     /// Whether a receiver at `p` can see the emitting side (none from the plane itself).
     #[inline]
     fn faces(&self, p: Vec3) -> bool {
-        let s = self.n.dot(p - self.corner);
-        if self.two_sided { s != 0.0 } else { s > 0.0 }
+        sees_emitting_side(self.n, self.corner, self.two_sided, p)
     }
 
     /// Solid angle Ω to sample uniformly from `p` in solid-angle mode (as two spherical
@@ -147,11 +141,7 @@ impl LightSource for QuadLight {
     }
 
     fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        if self.emits_toward(w) {
-            self.l
-        } else {
-            Rgb::ZERO
-        }
+        planar_radiance(self.n, self.l, self.two_sided, w)
     }
 
     fn power(&self) -> f32 {

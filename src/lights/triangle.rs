@@ -3,8 +3,8 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
-    area_to_solid_angle, diffuse_power, is_positive, solid_angle_sample, spherical_ok,
-    triangle_solid_angle,
+    area_to_solid_angle, diffuse_power, is_positive, planar_radiance, sees_emitting_side,
+    solid_angle_sample, spherical_ok, triangle_solid_angle,
 };
 use crate::Rgb;
 use crate::sampling::{SphericalTriangle, uniform_triangle_point};
@@ -41,17 +41,11 @@ impl TriangleLight {
         })
     }
 
-    #[inline]
-    fn emits_toward(&self, w: Vec3) -> bool {
-        self.two_sided || self.n.dot(w) > 0.0
-    }
-
     /// Whether a receiver at `p` can see the emitting side at all (one-sided lights are dark
     /// from behind; a receiver in the plane sees nothing).
     #[inline]
     fn faces(&self, p: Vec3) -> bool {
-        let s = self.n.dot(p - self.p[0]);
-        if self.two_sided { s != 0.0 } else { s > 0.0 }
+        sees_emitting_side(self.n, self.p[0], self.two_sided, p)
     }
 
     /// Solid angle Ω to sample uniformly from `p` in solid-angle mode, or `None` where the rule
@@ -111,11 +105,7 @@ impl LightSource for TriangleLight {
     }
 
     fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        if self.emits_toward(w) {
-            self.l
-        } else {
-            Rgb::ZERO
-        }
+        planar_radiance(self.n, self.l, self.two_sided, w)
     }
 
     fn power(&self) -> f32 {
