@@ -174,33 +174,37 @@ impl Geometry {
         self.bounds
     }
 
+    /// Hit distance of primitive `id` below `t_max` (else +∞) and, for triangles, the
+    /// barycentrics of that hit, so the accepted closest hit needs no second triangle test.
     #[inline(always)]
-    fn prim_t(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+    fn prim_hit(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> (f32, Bary) {
         let p = &self.prims[id];
         match p.kind {
             PrimKind::Triangle { .. } => match shear.intersect(p.p[0], p.p[1], p.p[2], t_max) {
-                Some((t, ..)) => t,
-                None => f32::INFINITY,
+                Some((t, b0, b1, b2)) => (t, [b0, b1, b2]),
+                None => (f32::INFINITY, NO_BARY),
             },
-            PrimKind::Quadric(q) => self.quadrics[q as usize]
-                .intersect_t(o, d, t_max)
-                .unwrap_or(f32::INFINITY),
+            PrimKind::Quadric(q) => (
+                self.quadrics[q as usize]
+                    .intersect_t(o, d, t_max)
+                    .unwrap_or(f32::INFINITY),
+                NO_BARY,
+            ),
         }
     }
 
-    fn surface_hit(&self, id: usize, ray: &Ray, t: f32) -> SurfaceHit {
+    /// Hit distance of primitive `id` below `t_max`, or +∞ (any-hit queries).
+    #[inline(always)]
+    fn prim_t(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        self.prim_hit(id, shear, o, d, t_max).0
+    }
+
+    /// The hit record of primitive `id` hit at `t` with triangle barycentrics `b`.
+    fn surface_hit(&self, id: usize, ray: &Ray, t: f32, b: Bary) -> SurfaceHit {
         let p = &self.prims[id];
         match p.kind {
             PrimKind::Triangle { mesh, v } => {
-                let (b0, b1, b2) = match RayShear::new(ray.o, ray.d).intersect(
-                    p.p[0],
-                    p.p[1],
-                    p.p[2],
-                    f32::INFINITY,
-                ) {
-                    Some((_, b0, b1, b2)) => (b0, b1, b2),
-                    None => (1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0),
-                };
+                let [b0, b1, b2] = b;
                 let verts = p.p;
                 let pos = verts[0] * b0 + verts[1] * b1 + verts[2] * b2;
                 let m = &self.meshes[mesh as usize];
@@ -280,6 +284,12 @@ fn prim_bounds(p: &Primitive, quadrics: &[Quadric]) -> (Vec3, Vec3) {
     }
 }
 
+/// Barycentrics (b0, b1, b2) of a triangle hit.
+type Bary = [f32; 3];
+
+/// Placeholder barycentrics for quadric hits (which do not use them).
+const NO_BARY: Bary = [1.0 / 3.0; 3];
+
 #[inline]
 fn to_obvhs(ray: &Ray) -> obvhs::ray::Ray {
     // `+ 0.0` turns −0.0 into +0.0: obvhs derives the child order from the direction's sign
@@ -291,23 +301,29 @@ fn to_obvhs(ray: &Ray) -> obvhs::ray::Ray {
 impl RayQuery for Geometry {
     fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
         let shear = RayShear::new(ray.o, ray.d);
+        // Barycentrics of the best hit so far: a test result is accepted exactly when its t is
+        // below the current best (the contract of both traversals), so record them then.
+        let mut bary = NO_BARY;
+        let mut leaf = |id: usize, t_max: f32| {
+            let (t, b) = self.prim_hit(id, &shear, ray.o, ray.d, t_max);
+            if t < t_max {
+                bary = b;
+            }
+            t
+        };
         let (id, t) = match &self.accel {
             Accel::None => return None,
-            Accel::Own(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                self.prim_t(id, &shear, ray.o, ray.d, t_max)
-            })?,
+            Accel::Own(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, &mut leaf)?,
             Accel::Obvhs(bvh) => {
                 let mut hit = RayHit::none();
-                let found = bvh.ray_traverse(to_obvhs(ray), &mut hit, |r, id| {
-                    self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
-                });
+                let found = bvh.ray_traverse(to_obvhs(ray), &mut hit, |r, id| leaf(id, r.tmax));
                 if !found {
                     return None;
                 }
                 (hit.primitive_id as usize, hit.t)
             }
         };
-        Some(self.surface_hit(id, ray, t))
+        Some(self.surface_hit(id, ray, t, bary))
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
