@@ -4,6 +4,7 @@
 use super::bvh::Bvh;
 use super::quadric::Quadric;
 use super::triangle::{RayShear, barycentric_error};
+use super::wide::WideBvh;
 use super::{Ray, RayQuery, SurfaceHit};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -55,9 +56,11 @@ pub struct Primitive {
 pub enum Backend {
     /// penumbra's binned-SAH BVH2.
     Own,
-    /// obvhs's CWBVH (the default: fewer instructions per ray on cornell, see `penumbra bench`).
+    /// obvhs's CWBVH.
     #[default]
     Obvhs,
+    /// The own BVH2 collapsed to a 4-wide BVH with 4-triangle SoA leaf packets.
+    Wide,
 }
 
 /// The built acceleration structure.
@@ -65,6 +68,7 @@ enum Accel {
     None,
     Own(Bvh),
     Obvhs(CwBvh),
+    Wide(WideBvh),
 }
 
 /// All scene geometry and its BVH.
@@ -101,11 +105,11 @@ impl Geometry {
             bounds.0 = bounds.0.min(*lo);
             bounds.1 = bounds.1.max(*hi);
         }
-        let (order, accel): (Vec<u32>, Accel) = if prims.is_empty() {
+        let (order, mut accel): (Vec<u32>, Accel) = if prims.is_empty() {
             (Vec::new(), Accel::None)
         } else {
             match backend {
-                Backend::Own => {
+                Backend::Own | Backend::Wide => {
                     let mut bvh = Bvh::build(&boxes);
                     (std::mem::take(&mut bvh.indices), Accel::Own(bvh))
                 }
@@ -124,7 +128,13 @@ impl Geometry {
                 }
             }
         };
-        let prims = order.iter().map(|&i| prims[i as usize]).collect();
+        let prims: Vec<Primitive> = order.iter().map(|&i| prims[i as usize]).collect();
+        if backend == Backend::Wide
+            && let Accel::Own(bvh) = &accel
+        {
+            // The wide tree stores its leaf triangles itself, so it needs the leaf order first.
+            accel = Accel::Wide(WideBvh::build(bvh, &prims));
+        }
         Self {
             prims,
             meshes,
@@ -156,6 +166,7 @@ impl Geometry {
             Accel::None => None,
             Accel::Own(_) => Some(Backend::Own),
             Accel::Obvhs(_) => Some(Backend::Obvhs),
+            Accel::Wide(_) => Some(Backend::Wide),
         }
     }
 
@@ -322,6 +333,13 @@ impl RayQuery for Geometry {
                 }
                 (hit.primitive_id as usize, hit.t)
             }
+            Accel::Wide(bvh) => {
+                let (id, t, b) = bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
+                    self.prim_t(id, &shear, ray.o, ray.d, t_max)
+                })?;
+                bary = b;
+                (id, t)
+            }
         };
         Some(self.surface_hit(id, ray, t, bary))
     }
@@ -335,6 +353,9 @@ impl RayQuery for Geometry {
             }),
             Accel::Obvhs(bvh) => !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
                 self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
+            }),
+            Accel::Wide(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                self.prim_t(id, &shear, ray.o, ray.d, ray.t_max) < ray.t_max
             }),
         }
     }

@@ -1,0 +1,330 @@
+//! A 4-wide BVH: the binned-SAH BVH2 of [`super::bvh`] collapsed so that each node holds up to
+//! four children whose boxes are tested together (SoA, one `Vec4` per box plane), and leaves are
+//! runs of [`TriPacket`]s whose four triangles are tested together ([`RayShear4`]).
+//!
+//! The box test is the conservative slab test of the BVH2 (same slack, so rounding never culls a
+//! box the exact ray touches). Per ray, the near and far plane of each axis are picked once from
+//! the direction's sign instead of a min/max per box; this also makes the inverted boxes
+//! (lo = +∞, hi = −∞) of unused child slots miss every ray.
+
+use super::accel::{PrimKind, Primitive};
+use super::bvh::{Bvh, NEAR_SLACK, ROUNDING_SLACK, safe_inverse};
+use super::tri4::{RayShear4, TriPacket};
+use glam::{Vec3, Vec4};
+use std::mem::MaybeUninit;
+use std::ops::Range;
+
+/// Child-reference flag: the low bits are the first packet of a leaf, not a node index.
+const LEAF: u32 = 1 << 31;
+/// Traversal stack depth: the BVH2 is at most 64 levels deep, each wide level consumes at least
+/// one of them, and a node pushes at most three children.
+const STACK: usize = 3 * 64 + 1;
+
+/// Triangle barycentrics (b0, b1, b2) of a hit (unused for other primitives).
+pub type Bary = [f32; 3];
+
+/// One node: `b[axis]` / `b[3 + axis]` hold the lower / upper box plane of the four children.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node4 {
+    b: [Vec4; 6],
+    /// Node index, or `LEAF | first packet` (unused slots have inverted boxes and are never
+    /// followed).
+    child: [u32; 4],
+}
+
+impl Node4 {
+    const EMPTY: Node4 = Node4 {
+        b: [
+            Vec4::INFINITY,
+            Vec4::INFINITY,
+            Vec4::INFINITY,
+            Vec4::NEG_INFINITY,
+            Vec4::NEG_INFINITY,
+            Vec4::NEG_INFINITY,
+        ],
+        child: [LEAF; 4],
+    };
+
+    /// Entry distances of the four child boxes and the mask of those entered before `t_max`.
+    #[inline(always)]
+    fn hit(&self, r: &RayBox, t_max: f32) -> (Vec4, u32) {
+        let t = |plane: usize, axis: usize| (self.b[plane] - r.o[axis]) * r.inv[axis];
+        let near = t(r.near[0], 0)
+            .max(t(r.near[1], 1))
+            .max(t(r.near[2], 2))
+            .max(Vec4::ZERO)
+            * NEAR_SLACK;
+        let far = t(r.far[0], 0).min(t(r.far[1], 1)).min(t(r.far[2], 2)) * ROUNDING_SLACK;
+        (near, near.cmple(far.min(Vec4::splat(t_max))).bitmask())
+    }
+}
+
+/// Per-ray constants of the 4-wide slab test.
+struct RayBox {
+    o: [Vec4; 3],
+    inv: [Vec4; 3],
+    /// Plane index (into `Node4::b`) of the entry / exit plane of each axis.
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+impl RayBox {
+    #[inline(always)]
+    fn new(o: Vec3, d: Vec3) -> Self {
+        let inv = safe_inverse(d);
+        let near = [0, 1, 2].map(|a| if inv[a] < 0.0 { 3 + a } else { a });
+        Self {
+            o: [0, 1, 2].map(|a| Vec4::splat(o[a])),
+            inv: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
+            near,
+            far: [0, 1, 2].map(|a| if near[a] == a { 3 + a } else { a }),
+        }
+    }
+}
+
+/// The 4-wide BVH (see the module docs). Primitive ids are leaf-order indices of the BVH2.
+#[derive(Clone, Debug, Default)]
+pub struct WideBvh {
+    nodes: Vec<Node4>,
+    packets: Vec<TriPacket>,
+}
+
+impl WideBvh {
+    /// Collapse `bvh` over `prims` (already in the BVH2's leaf order).
+    pub fn build(bvh: &Bvh, prims: &[Primitive]) -> Self {
+        let mut w = Self::default();
+        if !prims.is_empty() {
+            w.collapse(bvh, prims, 0);
+        }
+        w
+    }
+
+    /// Number of nodes and of leaf packets (statistics).
+    pub fn size(&self) -> (usize, usize) {
+        (self.nodes.len(), self.packets.len())
+    }
+
+    /// Emit the wide node for BVH2 node `n2`: its children, with the largest interior child
+    /// repeatedly replaced by its two children (largest surface area first, as in the SAH) until
+    /// there are four.
+    fn collapse(&mut self, bvh: &Bvh, prims: &[Primitive], n2: usize) -> u32 {
+        let mut kids: Vec<usize> = match bvh.node_kind(n2) {
+            Ok(c) => vec![c, c + 1],
+            Err(_) => vec![n2],
+        };
+        while kids.len() < 4 {
+            let area = |k: usize| {
+                let (lo, hi) = bvh.node_bounds(k);
+                let e = (hi - lo).max(Vec3::ZERO);
+                e.x * e.y + e.y * e.z + e.z * e.x
+            };
+            let widest = kids
+                .iter()
+                .enumerate()
+                .filter_map(|(i, &k)| bvh.node_kind(k).ok().map(|c| (i, c, area(k))))
+                .max_by(|a, b| a.2.total_cmp(&b.2));
+            let Some((i, c, _)) = widest else { break };
+            kids[i] = c;
+            kids.push(c + 1);
+        }
+        let idx = self.nodes.len();
+        self.nodes.push(Node4::EMPTY);
+        for (lane, &k) in kids.iter().enumerate() {
+            let (lo, hi) = bvh.node_bounds(k);
+            let child = match bvh.node_kind(k) {
+                Ok(_) => self.collapse(bvh, prims, k),
+                Err(range) => LEAF | self.leaf(prims, range),
+            };
+            let node = &mut self.nodes[idx];
+            for a in 0..3 {
+                node.b[a][lane] = lo[a];
+                node.b[3 + a][lane] = hi[a];
+            }
+            node.child[lane] = child;
+        }
+        idx as u32
+    }
+
+    /// Pack the leaf-order primitives `range` into consecutive packets; returns the first.
+    fn leaf(&mut self, prims: &[Primitive], range: Range<usize>) -> u32 {
+        let first = self.packets.len();
+        let ids: Vec<usize> = range.collect();
+        for chunk in ids.chunks(4) {
+            let mut pk = TriPacket::EMPTY;
+            for (lane, &id) in chunk.iter().enumerate() {
+                match prims[id].kind {
+                    PrimKind::Triangle { .. } => pk.set_triangle(lane, id as u32, prims[id].p),
+                    PrimKind::Quadric(_) => pk.set_other(lane, id as u32),
+                }
+            }
+            self.packets.push(pk);
+        }
+        if let Some(last) = self.packets.last_mut() {
+            last.last = true;
+        }
+        first as u32
+    }
+
+    /// Closest hit of the ray (o, d) in (0, t_max): (leaf-order id, t, barycentrics).
+    /// Triangles are tested here; `other(id, t_best)` returns the hit distance of a
+    /// non-triangle primitive if below `t_best`, else +∞.
+    #[inline]
+    pub fn closest(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+        mut other: impl FnMut(usize, f32) -> f32,
+    ) -> Option<(usize, f32, Bary)> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let r = RayBox::new(o, d);
+        let shear = RayShear4::new(o, d);
+        let mut best = t_max;
+        let mut hit: Option<(usize, Bary)> = None;
+        // Not cleared per ray: only entries below `sp` are ever read, and those were written.
+        let mut stack = [const { MaybeUninit::<(u32, f32)>::uninit() }; STACK];
+        let mut sp = 0usize;
+        let mut cur = 0u32;
+        loop {
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let (near, mut mask) = node.hit(&r, best);
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if mask == 0 {
+                        cur = node.child[first];
+                        continue;
+                    }
+                    // Two to four children: visit the nearest, push the others far to near.
+                    let near = near.to_array();
+                    let mut items = [(0u32, 0f32); 4];
+                    items[0] = (node.child[first], near[first]);
+                    let mut k = 1;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let mut j = k;
+                        while j > 0 && items[j - 1].1 > near[i] {
+                            items[j] = items[j - 1];
+                            j -= 1;
+                        }
+                        items[j] = (node.child[i], near[i]);
+                        k += 1;
+                    }
+                    for &item in items[1..k].iter().rev() {
+                        stack[sp].write(item);
+                        sp += 1;
+                    }
+                    cur = items[0].0;
+                    continue;
+                }
+            } else {
+                let mut pi = (cur & !LEAF) as usize;
+                loop {
+                    let pk = &self.packets[pi];
+                    if pk.tri != 0
+                        && let Some((lane, t, b)) = shear.closest(pk, best)
+                    {
+                        best = t;
+                        hit = Some((pk.ids[lane] as usize, b));
+                    }
+                    let mut others = pk.other;
+                    while others != 0 {
+                        let id = pk.ids[others.trailing_zeros() as usize] as usize;
+                        others &= others - 1;
+                        let t = other(id, best);
+                        if t < best {
+                            best = t;
+                            hit = Some((id, [1.0 / 3.0; 3]));
+                        }
+                    }
+                    if pk.last {
+                        break;
+                    }
+                    pi += 1;
+                }
+            }
+            // Pop the nearest pending subtree that can still hold a closer hit.
+            loop {
+                if sp == 0 {
+                    return hit.map(|(id, b)| (id, best, b));
+                }
+                sp -= 1;
+                // SAFETY: every slot below the stack pointer was written by a push above.
+                let (c, t) = unsafe { stack[sp].assume_init() };
+                if t < best {
+                    cur = c;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// True if a triangle, or a primitive for which `other(id, t_max)` is true, blocks the ray
+    /// (o, d) in (0, t_max); stops at the first hit.
+    #[inline]
+    pub fn any(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+        mut other: impl FnMut(usize) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let r = RayBox::new(o, d);
+        let shear = RayShear4::new(o, d);
+        // Not cleared per ray: only entries below `sp` are ever read, and those were written.
+        let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
+        let mut sp = 0usize;
+        let mut cur = 0u32;
+        loop {
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let (_, mut mask) = node.hit(&r, t_max);
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        stack[sp].write(node.child[mask.trailing_zeros() as usize]);
+                        sp += 1;
+                        mask &= mask - 1;
+                    }
+                    cur = node.child[first];
+                    continue;
+                }
+            } else {
+                let mut pi = (cur & !LEAF) as usize;
+                loop {
+                    let pk = &self.packets[pi];
+                    if pk.tri != 0 && shear.any(pk, t_max) {
+                        return true;
+                    }
+                    let mut others = pk.other;
+                    while others != 0 {
+                        let id = pk.ids[others.trailing_zeros() as usize] as usize;
+                        others &= others - 1;
+                        if other(id) {
+                            return true;
+                        }
+                    }
+                    if pk.last {
+                        break;
+                    }
+                    pi += 1;
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            // SAFETY: every slot below the stack pointer was written by a push above.
+            cur = unsafe { stack[sp].assume_init() };
+        }
+    }
+}
