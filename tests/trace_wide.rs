@@ -12,7 +12,7 @@ use penumbra::geometry::{
 use penumbra::sampling::{PatternKind, make_pattern};
 
 /// Uniform random rays from points in the (enlarged) scene box, a third of them finite.
-fn rays(bounds: (Vec3, Vec3), n: u32, seed: u32) -> Vec<Ray> {
+fn rays(bounds: (Vec3, Vec3), n: u32, seed: u64) -> Vec<Ray> {
     let pat = make_pattern(PatternKind::Random, seed);
     let (lo, hi) = bounds;
     let ext = hi - lo;

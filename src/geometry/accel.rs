@@ -57,9 +57,9 @@ pub enum Backend {
     /// penumbra's binned-SAH BVH2.
     Own,
     /// obvhs's CWBVH.
-    #[default]
     Obvhs,
     /// The own BVH2 collapsed to a 4-wide BVH with 4-triangle SoA leaf packets.
+    #[default]
     Wide,
 }
 
@@ -204,6 +204,17 @@ impl Geometry {
         }
     }
 
+    /// Hit distance of non-triangle primitive `id` below `t_max`, or +∞.
+    #[inline(always)]
+    fn quadric_t(&self, id: usize, ray: &Ray, t_max: f32) -> f32 {
+        match self.prims[id].kind {
+            PrimKind::Quadric(q) => self.quadrics[q as usize]
+                .intersect_t(ray.o, ray.d, t_max)
+                .unwrap_or(f32::INFINITY),
+            PrimKind::Triangle { .. } => f32::INFINITY,
+        }
+    }
+
     /// Hit distance of primitive `id` below `t_max`, or +∞ (any-hit queries).
     #[inline(always)]
     fn prim_t(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> f32 {
@@ -311,6 +322,13 @@ fn to_obvhs(ray: &Ray) -> obvhs::ray::Ray {
 
 impl RayQuery for Geometry {
     fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        if let Accel::Wide(bvh) = &self.accel {
+            // The wide BVH tests triangles itself; only quadrics come back here.
+            let (id, t, b) = bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
+                self.quadric_t(id, ray, t_max)
+            })?;
+            return Some(self.surface_hit(id, ray, t, b));
+        }
         let shear = RayShear::new(ray.o, ray.d);
         // Barycentrics of the best hit so far: a test result is accepted exactly when its t is
         // below the current best (the contract of both traversals), so record them then.
@@ -333,18 +351,17 @@ impl RayQuery for Geometry {
                 }
                 (hit.primitive_id as usize, hit.t)
             }
-            Accel::Wide(bvh) => {
-                let (id, t, b) = bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                    self.prim_t(id, &shear, ray.o, ray.d, t_max)
-                })?;
-                bary = b;
-                (id, t)
-            }
+            Accel::Wide(_) => unreachable!("handled above"),
         };
         Some(self.surface_hit(id, ray, t, bary))
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
+        if let Accel::Wide(bvh) = &self.accel {
+            return bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                self.quadric_t(id, ray, ray.t_max) < ray.t_max
+            });
+        }
         let shear = RayShear::new(ray.o, ray.d);
         match &self.accel {
             Accel::None => false,
@@ -354,9 +371,7 @@ impl RayQuery for Geometry {
             Accel::Obvhs(bvh) => !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
                 self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
             }),
-            Accel::Wide(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.prim_t(id, &shear, ray.o, ray.d, ray.t_max) < ray.t_max
-            }),
+            Accel::Wide(_) => unreachable!("handled above"),
         }
     }
 }

@@ -69,7 +69,8 @@ pub struct RayShear4 {
     k: [usize; 3],
     o: [Vec4; 3],
     s: [Vec4; 3],
-    scalar: RayShear,
+    /// The ray, for the scalar redo of exact-zero lanes (rare, so its shear is built lazily).
+    ray: (Vec3, Vec3),
 }
 
 /// The vector part of a packet test.
@@ -85,19 +86,19 @@ struct Lanes {
 
 impl RayShear4 {
     /// Precompute the shear for ray (o, d); `d` must be non-zero.
-    #[inline]
+    #[inline(always)]
     pub fn new(o: Vec3, d: Vec3) -> Self {
         let k = shear_axes(d);
         let dz = d[k[2]];
         Self {
             k,
-            o: k.map(|a| Vec4::splat(o[a])),
+            o: [Vec4::splat(o[k[0]]), Vec4::splat(o[k[1]]), Vec4::splat(o[k[2]])],
             s: [
                 Vec4::splat(-(d[k[0]] / dz)),
                 Vec4::splat(-(d[k[1]] / dz)),
                 Vec4::splat(1.0 / dz),
             ],
-            scalar: RayShear::new(o, d),
+            ray: (o, d),
         }
     }
 
@@ -158,7 +159,8 @@ impl RayShear4 {
                 }
             } else if h.redo & bit != 0 {
                 let (p0, p1, p2) = (pk.vertex(lane, 0), pk.vertex(lane, 1), pk.vertex(lane, 2));
-                if let Some((tl, b0, b1, b2)) = self.scalar.intersect(p0, p1, p2, best_t) {
+                let scalar = RayShear::new(self.ray.0, self.ray.1);
+                if let Some((tl, b0, b1, b2)) = scalar.intersect(p0, p1, p2, best_t) {
                     best_t = tl;
                     best = Some((lane, tl, [b0, b1, b2]));
                 }
@@ -175,11 +177,12 @@ impl RayShear4 {
             return true;
         }
         let mut redo = h.redo;
+        let scalar = RayShear::new(self.ray.0, self.ray.1);
         while redo != 0 {
             let lane = redo.trailing_zeros() as usize;
             redo &= redo - 1;
             let (p0, p1, p2) = (pk.vertex(lane, 0), pk.vertex(lane, 1), pk.vertex(lane, 2));
-            if self.scalar.intersect(p0, p1, p2, t_max).is_some() {
+            if scalar.intersect(p0, p1, p2, t_max).is_some() {
                 return true;
             }
         }

@@ -20,14 +20,30 @@ const LEAF: u32 = 1 << 31;
 /// one of them, and a node pushes at most three children.
 const STACK: usize = 3 * 64 + 1;
 
+/// Subtrees with at most this many primitives become a single leaf.
+const LEAF_PRIMS: usize = 4;
+
+/// The leaf-order range of every BVH2 node's subtree (contiguous, because the build partitions
+/// the index array in place). Children have larger indices than their parent.
+fn subtree_ranges(bvh: &Bvh) -> Vec<Range<usize>> {
+    let mut ranges = vec![0..0; bvh.node_count()];
+    for i in (0..ranges.len()).rev() {
+        ranges[i] = match bvh.node_kind(i) {
+            Ok(c) => ranges[c].start..ranges[c + 1].end,
+            Err(r) => r,
+        };
+    }
+    ranges
+}
+
 /// Triangle barycentrics (b0, b1, b2) of a hit (unused for other primitives).
 pub type Bary = [f32; 3];
 
-/// One node: `b[axis]` / `b[3 + axis]` hold the lower / upper box plane of the four children.
+/// One node: `b[0][axis]` / `b[1][axis]` hold the lower / upper box plane of the four children.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node4 {
-    b: [Vec4; 6],
+    b: [[Vec4; 3]; 2],
     /// Node index, or `LEAF | first packet` (unused slots have inverted boxes and are never
     /// followed).
     child: [u32; 4],
@@ -35,27 +51,24 @@ struct Node4 {
 
 impl Node4 {
     const EMPTY: Node4 = Node4 {
-        b: [
-            Vec4::INFINITY,
-            Vec4::INFINITY,
-            Vec4::INFINITY,
-            Vec4::NEG_INFINITY,
-            Vec4::NEG_INFINITY,
-            Vec4::NEG_INFINITY,
-        ],
+        b: [[Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3]],
         child: [LEAF; 4],
     };
 
     /// Entry distances of the four child boxes and the mask of those entered before `t_max`.
     #[inline(always)]
     fn hit(&self, r: &RayBox, t_max: f32) -> (Vec4, u32) {
-        let t = |plane: usize, axis: usize| (self.b[plane] - r.o[axis]) * r.inv[axis];
+        // `& 1` lets the compiler drop the bounds checks of the runtime plane choice.
+        let t = |side: usize, axis: usize| (self.b[side & 1][axis] - r.o[axis]) * r.inv[axis];
         let near = t(r.near[0], 0)
             .max(t(r.near[1], 1))
             .max(t(r.near[2], 2))
             .max(Vec4::ZERO)
             * NEAR_SLACK;
-        let far = t(r.far[0], 0).min(t(r.far[1], 1)).min(t(r.far[2], 2)) * ROUNDING_SLACK;
+        let far = t(r.near[0] ^ 1, 0)
+            .min(t(r.near[1] ^ 1, 1))
+            .min(t(r.near[2] ^ 1, 2))
+            * ROUNDING_SLACK;
         (near, near.cmple(far.min(Vec4::splat(t_max))).bitmask())
     }
 }
@@ -64,21 +77,18 @@ impl Node4 {
 struct RayBox {
     o: [Vec4; 3],
     inv: [Vec4; 3],
-    /// Plane index (into `Node4::b`) of the entry / exit plane of each axis.
+    /// Side (0 = lower, 1 = upper box plane) through which the ray enters, per axis.
     near: [usize; 3],
-    far: [usize; 3],
 }
 
 impl RayBox {
     #[inline(always)]
     fn new(o: Vec3, d: Vec3) -> Self {
         let inv = safe_inverse(d);
-        let near = [0, 1, 2].map(|a| if inv[a] < 0.0 { 3 + a } else { a });
         Self {
-            o: [0, 1, 2].map(|a| Vec4::splat(o[a])),
-            inv: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
-            near,
-            far: [0, 1, 2].map(|a| if near[a] == a { 3 + a } else { a }),
+            o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
+            inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            near: [(inv.x < 0.0) as usize, (inv.y < 0.0) as usize, (inv.z < 0.0) as usize],
         }
     }
 }
@@ -95,7 +105,8 @@ impl WideBvh {
     pub fn build(bvh: &Bvh, prims: &[Primitive]) -> Self {
         let mut w = Self::default();
         if !prims.is_empty() {
-            w.collapse(bvh, prims, 0);
+            let ranges = subtree_ranges(bvh);
+            w.collapse(bvh, &ranges, prims, 0);
         }
         w
     }
@@ -107,11 +118,13 @@ impl WideBvh {
 
     /// Emit the wide node for BVH2 node `n2`: its children, with the largest interior child
     /// repeatedly replaced by its two children (largest surface area first, as in the SAH) until
-    /// there are four.
-    fn collapse(&mut self, bvh: &Bvh, prims: &[Primitive], n2: usize) -> u32 {
+    /// there are four. Subtrees of at most [`LEAF_PRIMS`] primitives become one leaf: a packet
+    /// tests four triangles for little more than the price of one.
+    fn collapse(&mut self, bvh: &Bvh, ranges: &[Range<usize>], prims: &[Primitive], n2: usize) {
+        let is_leaf = |k: usize| ranges[k].len() <= LEAF_PRIMS || bvh.node_kind(k).is_err();
         let mut kids: Vec<usize> = match bvh.node_kind(n2) {
-            Ok(c) => vec![c, c + 1],
-            Err(_) => vec![n2],
+            Ok(c) if !is_leaf(n2) => vec![c, c + 1],
+            _ => vec![n2],
         };
         while kids.len() < 4 {
             let area = |k: usize| {
@@ -122,9 +135,10 @@ impl WideBvh {
             let widest = kids
                 .iter()
                 .enumerate()
-                .filter_map(|(i, &k)| bvh.node_kind(k).ok().map(|c| (i, c, area(k))))
-                .max_by(|a, b| a.2.total_cmp(&b.2));
-            let Some((i, c, _)) = widest else { break };
+                .filter(|&(_, &k)| !is_leaf(k))
+                .max_by(|a, b| area(*a.1).total_cmp(&area(*b.1)));
+            let Some((i, &k)) = widest else { break };
+            let Ok(c) = bvh.node_kind(k) else { break };
             kids[i] = c;
             kids.push(c + 1);
         }
@@ -132,18 +146,20 @@ impl WideBvh {
         self.nodes.push(Node4::EMPTY);
         for (lane, &k) in kids.iter().enumerate() {
             let (lo, hi) = bvh.node_bounds(k);
-            let child = match bvh.node_kind(k) {
-                Ok(_) => self.collapse(bvh, prims, k),
-                Err(range) => LEAF | self.leaf(prims, range),
+            let child = if is_leaf(k) {
+                LEAF | self.leaf(prims, ranges[k].clone())
+            } else {
+                let child = self.nodes.len() as u32;
+                self.collapse(bvh, ranges, prims, k);
+                child
             };
             let node = &mut self.nodes[idx];
             for a in 0..3 {
-                node.b[a][lane] = lo[a];
-                node.b[3 + a][lane] = hi[a];
+                node.b[0][a][lane] = lo[a];
+                node.b[1][a][lane] = hi[a];
             }
             node.child[lane] = child;
         }
-        idx as u32
     }
 
     /// Pack the leaf-order primitives `range` into consecutive packets; returns the first.
@@ -328,3 +344,4 @@ impl WideBvh {
         }
     }
 }
+
