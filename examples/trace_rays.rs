@@ -1,5 +1,6 @@
 //! Ray-query micro-benchmark of one BVH backend (for profiling the query path):
-//! `cargo run --release --example trace_rays -- SCENE BACKEND [closest|any] [RAYS]`.
+//! `cargo run --release --example trace_rays -- SCENE BACKEND [closest|any|render] [RAYS|SPP]`.
+//! `render` renders 512² with MIS (area light sampling) and prints the time.
 
 use glam::{UVec2, Vec3};
 use penumbra::geometry::{Backend, Ray, RayQuery};
@@ -16,8 +17,26 @@ fn main() -> anyhow::Result<()> {
         _ => Backend::Wide,
     };
     let any = args.get(3).is_some_and(|s| s == "any");
-    let n: u32 = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(2_000_000);
-    let g = load(scene, &LoadOptions::default())?.scene.geometry.rebuild(backend);
+    if args.get(3).is_some_and(|s| s == "render") {
+        let mut scene = load(scene, &LoadOptions::default())?.scene;
+        scene.geometry = scene.geometry.rebuild(backend);
+        let opts = penumbra::integrator::RenderOptions {
+            spp: args.get(4).and_then(|s| s.parse().ok()).unwrap_or(64),
+            mis_light: penumbra::lights::SamplingMode::Area,
+            ..Default::default()
+        };
+        let (_, stats) = penumbra::integrator::render(&scene, glam::UVec2::new(512, 512), &opts)?;
+        println!("render {backend:?}: {:.3} s", stats.time.as_secs_f64());
+        return Ok(());
+    }
+    let n: u32 = args
+        .get(4)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2_000_000);
+    let g = load(scene, &LoadOptions::default())?
+        .scene
+        .geometry
+        .rebuild(backend);
     let (lo, hi) = g.bounds();
     println!("prims {}", g.len());
     let pat = make_pattern(PatternKind::Random, 1);
@@ -36,6 +55,9 @@ fn main() -> anyhow::Result<()> {
         rays.iter().filter(|r| g.intersect(r).is_some()).count()
     };
     let s = t.elapsed().as_secs_f64();
-    println!("{scene} {backend:?} any={any}: {hits} hits, {:.2} Mrays/s", n as f64 / s / 1e6);
+    println!(
+        "{scene} {backend:?} any={any}: {hits} hits, {:.2} Mrays/s",
+        n as f64 / s / 1e6
+    );
     Ok(())
 }

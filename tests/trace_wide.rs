@@ -59,9 +59,17 @@ fn check(g: &Geometry, rays: &[Ray], brute: bool) -> (u32, u32) {
     let (mut hits, mut ties) = (0, 0);
     for ray in rays {
         let (w, o) = (wide.intersect(ray), own.intersect(ray));
-        assert_eq!(w.map(|h| h.t), o.map(|h| h.t), "wide vs own BVH t for {ray:?}");
+        assert_eq!(
+            w.map(|h| h.t),
+            o.map(|h| h.t),
+            "wide vs own BVH t for {ray:?}"
+        );
         if brute {
-            assert_eq!(w.map(|h| h.t), brute_force_t(&wide, ray), "brute force {ray:?}");
+            assert_eq!(
+                w.map(|h| h.t),
+                brute_force_t(&wide, ray),
+                "brute force {ray:?}"
+            );
         }
         if let (Some(w), Some(o)) = (w, o) {
             hits += 1;
@@ -78,7 +86,11 @@ fn check(g: &Geometry, rays: &[Ray], brute: bool) -> (u32, u32) {
                 ties += 1;
             }
         }
-        assert_eq!(wide.occluded(ray), w.is_some(), "any-hit vs closest {ray:?}");
+        assert_eq!(
+            wide.occluded(ray),
+            w.is_some(),
+            "any-hit vs closest {ray:?}"
+        );
     }
     (hits, ties)
 }
@@ -183,5 +195,8 @@ fn wide_matches_own_bvh_on_a_dense_mesh() {
         aimed.push(Ray::new(o, target - o));
     }
     let (hits, _) = check(&g, &aimed, false);
-    assert!(hits > 19_000, "{hits} of 20000 vertex/edge rays hit (cracks?)");
+    assert!(
+        hits > 19_000,
+        "{hits} of 20000 vertex/edge rays hit (cracks?)"
+    );
 }

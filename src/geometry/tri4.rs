@@ -92,7 +92,11 @@ impl RayShear4 {
         let dz = d[k[2]];
         Self {
             k,
-            o: [Vec4::splat(o[k[0]]), Vec4::splat(o[k[1]]), Vec4::splat(o[k[2]])],
+            o: [
+                Vec4::splat(o[k[0]]),
+                Vec4::splat(o[k[1]]),
+                Vec4::splat(o[k[2]]),
+            ],
             s: [
                 Vec4::splat(-(d[k[0]] / dz)),
                 Vec4::splat(-(d[k[1]] / dz)),
@@ -227,16 +231,23 @@ mod tests {
             } else {
                 rnd3(&mut s)
             };
-            let t_max = if lcg(&mut s) < 0.5 { f32::INFINITY } else { 3.0 };
+            let t_max = if lcg(&mut s) < 0.5 {
+                f32::INFINITY
+            } else {
+                3.0
+            };
             let r4 = RayShear4::new(o, d);
             let want = tris
                 .iter()
                 .enumerate()
                 .filter_map(|(i, p)| intersect_triangle(o, d, t_max, *p).map(|h| (i, h)))
-                .fold(None::<(usize, (f32, f32, f32, f32))>, |best, (i, h)| match best {
-                    Some((_, b)) if b.0 <= h.0 => best,
-                    _ => Some((i, h)),
-                });
+                .fold(
+                    None::<(usize, (f32, f32, f32, f32))>,
+                    |best, (i, h)| match best {
+                        Some((_, b)) if b.0 <= h.0 => best,
+                        _ => Some((i, h)),
+                    },
+                );
             let got = r4.closest(&pk, t_max);
             checked += 1;
             match (want, got) {

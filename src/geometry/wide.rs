@@ -88,7 +88,11 @@ impl RayBox {
         Self {
             o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
             inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
-            near: [(inv.x < 0.0) as usize, (inv.y < 0.0) as usize, (inv.z < 0.0) as usize],
+            near: [
+                (inv.x < 0.0) as usize,
+                (inv.y < 0.0) as usize,
+                (inv.z < 0.0) as usize,
+            ],
         }
     }
 }
@@ -280,60 +284,78 @@ impl WideBvh {
         }
     }
 
+    /// True if leaf `child` (a `LEAF` reference) holds a triangle, or a primitive for which
+    /// `other(id)` is true, that blocks the ray in (0, t_max).
+    #[inline(always)]
+    fn leaf_any(
+        &self,
+        child: u32,
+        shear: &RayShear4,
+        t_max: f32,
+        other: &mut impl FnMut(usize) -> bool,
+    ) -> bool {
+        let mut pi = (child & !LEAF) as usize;
+        loop {
+            let pk = &self.packets[pi];
+            if pk.tri != 0 && shear.any(pk, t_max) {
+                return true;
+            }
+            let mut others = pk.other;
+            while others != 0 {
+                let id = pk.ids[others.trailing_zeros() as usize] as usize;
+                others &= others - 1;
+                if other(id) {
+                    return true;
+                }
+            }
+            if pk.last {
+                return false;
+            }
+            pi += 1;
+        }
+    }
+
     /// True if a triangle, or a primitive for which `other(id, t_max)` is true, blocks the ray
     /// (o, d) in (0, t_max); stops at the first hit.
     #[inline]
-    pub fn any(
-        &self,
-        o: Vec3,
-        d: Vec3,
-        t_max: f32,
-        mut other: impl FnMut(usize) -> bool,
-    ) -> bool {
+    pub fn any(&self, o: Vec3, d: Vec3, t_max: f32, mut other: impl FnMut(usize) -> bool) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
         let r = RayBox::new(o, d);
         let shear = RayShear4::new(o, d);
         // Not cleared per ray: only entries below `sp` are ever read, and those were written.
+        // Only interior nodes are pushed (leaves are tested on sight).
         let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
         let mut sp = 0usize;
         let mut cur = 0u32;
         loop {
-            if cur & LEAF == 0 {
-                let node = &self.nodes[cur as usize];
-                let (_, mut mask) = node.hit(&r, t_max);
-                if mask != 0 {
-                    let first = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    while mask != 0 {
-                        stack[sp].write(node.child[mask.trailing_zeros() as usize]);
-                        sp += 1;
-                        mask &= mask - 1;
-                    }
-                    cur = node.child[first];
-                    continue;
+            let node = &self.nodes[cur as usize];
+            let (_, mask) = node.hit(&r, t_max);
+            // Leaves first: a leaf hit ends the query, while a subtree may be descended
+            // without result (large occluders such as walls sit in leaves near the root).
+            let mut inner = 0u32;
+            let mut bits = mask;
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let c = node.child[i];
+                if c & LEAF == 0 {
+                    inner |= 1 << i;
+                } else if self.leaf_any(c, &shear, t_max, &mut other) {
+                    return true;
                 }
-            } else {
-                let mut pi = (cur & !LEAF) as usize;
-                loop {
-                    let pk = &self.packets[pi];
-                    if pk.tri != 0 && shear.any(pk, t_max) {
-                        return true;
-                    }
-                    let mut others = pk.other;
-                    while others != 0 {
-                        let id = pk.ids[others.trailing_zeros() as usize] as usize;
-                        others &= others - 1;
-                        if other(id) {
-                            return true;
-                        }
-                    }
-                    if pk.last {
-                        break;
-                    }
-                    pi += 1;
+            }
+            if inner != 0 {
+                let first = inner.trailing_zeros() as usize;
+                inner &= inner - 1;
+                while inner != 0 {
+                    stack[sp].write(node.child[inner.trailing_zeros() as usize]);
+                    sp += 1;
+                    inner &= inner - 1;
                 }
+                cur = node.child[first];
+                continue;
             }
             if sp == 0 {
                 return false;
@@ -344,4 +366,3 @@ impl WideBvh {
         }
     }
 }
-
