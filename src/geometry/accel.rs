@@ -3,6 +3,7 @@
 
 use super::bvh::Bvh;
 use super::quadric::Quadric;
+use super::tree2::Tree2;
 use super::triangle::{RayShear, barycentric_error};
 use super::wide::WideBvh;
 use super::{Ray, RayQuery, SurfaceHit};
@@ -105,11 +106,24 @@ impl Geometry {
             bounds.0 = bounds.0.min(*lo);
             bounds.1 = bounds.1.max(*hi);
         }
-        let (order, mut accel): (Vec<u32>, Accel) = if prims.is_empty() {
+        let (order, accel): (Vec<u32>, Accel) = if prims.is_empty() {
             (Vec::new(), Accel::None)
         } else {
             match backend {
-                Backend::Own | Backend::Wide => {
+                Backend::Wide => {
+                    // PLOC + reinsertion gives the better tree; the binned-SAH one is
+                    // depth-limited, so it is the fallback for degenerate inputs.
+                    let mut tree = Tree2::ploc(&boxes);
+                    let wide = match WideBvh::build(&tree, &prims) {
+                        Some(w) => w,
+                        None => {
+                            tree = Tree2::from_bvh(Bvh::build(&boxes));
+                            WideBvh::build(&tree, &prims).unwrap_or_default()
+                        }
+                    };
+                    (tree.order, Accel::Wide(wide))
+                }
+                Backend::Own => {
                     let mut bvh = Bvh::build(&boxes);
                     (std::mem::take(&mut bvh.indices), Accel::Own(bvh))
                 }
@@ -129,12 +143,6 @@ impl Geometry {
             }
         };
         let prims: Vec<Primitive> = order.iter().map(|&i| prims[i as usize]).collect();
-        if backend == Backend::Wide
-            && let Accel::Own(bvh) = &accel
-        {
-            // The wide tree stores its leaf triangles itself, so it needs the leaf order first.
-            accel = Accel::Wide(WideBvh::build(bvh, &prims));
-        }
         Self {
             prims,
             meshes,

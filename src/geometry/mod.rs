@@ -8,6 +8,7 @@ pub mod interaction;
 pub mod quadric;
 pub mod ray;
 pub mod transform;
+pub mod tree2;
 pub mod tri4;
 pub mod triangle;
 pub mod wide;

@@ -1,4 +1,4 @@
-//! A 4-wide BVH: the binned-SAH BVH2 of [`super::bvh`] collapsed so that each node holds up to
+//! A 4-wide BVH: a binary BVH ([`Tree2`]: obvhs's PLOC tree or penumbra's binned-SAH one) collapsed so that each node holds up to
 //! four children whose boxes are tested together (SoA, one `Vec4` per box plane), and leaves are
 //! runs of [`TriPacket`]s whose four triangles are tested together ([`RayShear4`]).
 //!
@@ -8,7 +8,8 @@
 //! (lo = +∞, hi = −∞) of unused child slots miss every ray.
 
 use super::accel::{PrimKind, Primitive};
-use super::bvh::{Bvh, NEAR_SLACK, ROUNDING_SLACK, safe_inverse};
+use super::bvh::{NEAR_SLACK, ROUNDING_SLACK, safe_inverse};
+use super::tree2::Tree2;
 use super::tri4::{RayShear4, TriPacket};
 use glam::{Vec3, Vec4};
 use std::mem::MaybeUninit;
@@ -16,32 +17,21 @@ use std::ops::Range;
 
 /// Child-reference flag: the low bits are the first packet of a leaf, not a node index.
 const LEAF: u32 = 1 << 31;
-/// Traversal stack depth: the BVH2 is at most 64 levels deep, each wide level consumes at least
-/// one of them, and a node pushes at most three children.
-const STACK: usize = 3 * 64 + 1;
+/// Deepest binary tree that is collapsed (deeper ones are rejected by [`WideBvh::build`]).
+pub const MAX_TREE_DEPTH: usize = 96;
+/// Traversal stack depth: each wide level consumes at least one binary level, and a node
+/// pushes at most three children.
+const STACK: usize = 3 * MAX_TREE_DEPTH + 1;
 
 /// Subtrees with at most this many primitives become a single leaf.
 const LEAF_PRIMS: usize = 4;
-
-/// The leaf-order range of every BVH2 node's subtree (contiguous, because the build partitions
-/// the index array in place). Children have larger indices than their parent.
-fn subtree_ranges(bvh: &Bvh) -> Vec<Range<usize>> {
-    let mut ranges = vec![0..0; bvh.node_count()];
-    for i in (0..ranges.len()).rev() {
-        ranges[i] = match bvh.node_kind(i) {
-            Ok(c) => ranges[c].start..ranges[c + 1].end,
-            Err(r) => r,
-        };
-    }
-    ranges
-}
 
 /// Triangle barycentrics (b0, b1, b2) of a hit (unused for other primitives).
 pub type Bary = [f32; 3];
 
 /// One node: `b[0][axis]` / `b[1][axis]` hold the lower / upper box plane of the four children.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
+#[repr(C, align(16))]
 struct Node4 {
     b: [[Vec4; 3]; 2],
     /// Node index, or `LEAF | first packet` (unused slots have inverted boxes and are never
@@ -105,14 +95,17 @@ pub struct WideBvh {
 }
 
 impl WideBvh {
-    /// Collapse `bvh` over `prims` (already in the BVH2's leaf order).
-    pub fn build(bvh: &Bvh, prims: &[Primitive]) -> Self {
+    /// Collapse `tree` over `prims` (input order; `tree.order` maps leaf order to it). Returns
+    /// `None` if the tree is deeper than [`MAX_TREE_DEPTH`] (the traversal stack's bound).
+    pub fn build(tree: &Tree2, prims: &[Primitive]) -> Option<Self> {
         let mut w = Self::default();
-        if !prims.is_empty() {
-            let ranges = subtree_ranges(bvh);
-            w.collapse(bvh, &ranges, prims, 0);
+        if !tree.nodes.is_empty() {
+            if tree.depth() > MAX_TREE_DEPTH {
+                return None;
+            }
+            w.collapse(tree, prims, 0);
         }
-        w
+        Some(w)
     }
 
     /// Number of nodes and of leaf packets (statistics).
@@ -120,61 +113,59 @@ impl WideBvh {
         (self.nodes.len(), self.packets.len())
     }
 
-    /// Emit the wide node for BVH2 node `n2`: its children, with the largest interior child
+    /// Emit the wide node for binary node `n2`: its children, with the largest interior child
     /// repeatedly replaced by its two children (largest surface area first, as in the SAH) until
     /// there are four. Subtrees of at most [`LEAF_PRIMS`] primitives become one leaf: a packet
     /// tests four triangles for little more than the price of one.
-    fn collapse(&mut self, bvh: &Bvh, ranges: &[Range<usize>], prims: &[Primitive], n2: usize) {
-        let is_leaf = |k: usize| ranges[k].len() <= LEAF_PRIMS || bvh.node_kind(k).is_err();
-        let mut kids: Vec<usize> = match bvh.node_kind(n2) {
-            Ok(c) if !is_leaf(n2) => vec![c, c + 1],
+    fn collapse(&mut self, tree: &Tree2, prims: &[Primitive], n2: usize) {
+        let nodes = &tree.nodes;
+        let is_leaf = |k: usize| nodes[k].range.len() <= LEAF_PRIMS || nodes[k].children.is_none();
+        let mut kids: Vec<usize> = match nodes[n2].children {
+            Some(c) if !is_leaf(n2) => c.to_vec(),
             _ => vec![n2],
         };
         while kids.len() < 4 {
-            let area = |k: usize| {
-                let (lo, hi) = bvh.node_bounds(k);
-                let e = (hi - lo).max(Vec3::ZERO);
-                e.x * e.y + e.y * e.z + e.z * e.x
-            };
             let widest = kids
                 .iter()
                 .enumerate()
                 .filter(|&(_, &k)| !is_leaf(k))
-                .max_by(|a, b| area(*a.1).total_cmp(&area(*b.1)));
+                .max_by(|a, b| nodes[*a.1].half_area().total_cmp(&nodes[*b.1].half_area()));
             let Some((i, &k)) = widest else { break };
-            let Ok(c) = bvh.node_kind(k) else { break };
-            kids[i] = c;
-            kids.push(c + 1);
+            let Some([a, b]) = nodes[k].children else {
+                break;
+            };
+            kids[i] = a;
+            kids.push(b);
         }
         let idx = self.nodes.len();
         self.nodes.push(Node4::EMPTY);
         for (lane, &k) in kids.iter().enumerate() {
-            let (lo, hi) = bvh.node_bounds(k);
             let child = if is_leaf(k) {
-                LEAF | self.leaf(prims, ranges[k].clone())
+                LEAF | self.leaf(tree, prims, nodes[k].range.clone())
             } else {
                 let child = self.nodes.len() as u32;
-                self.collapse(bvh, ranges, prims, k);
+                self.collapse(tree, prims, k);
                 child
             };
             let node = &mut self.nodes[idx];
             for a in 0..3 {
-                node.b[0][a][lane] = lo[a];
-                node.b[1][a][lane] = hi[a];
+                node.b[0][a][lane] = nodes[k].lo[a];
+                node.b[1][a][lane] = nodes[k].hi[a];
             }
             node.child[lane] = child;
         }
     }
 
     /// Pack the leaf-order primitives `range` into consecutive packets; returns the first.
-    fn leaf(&mut self, prims: &[Primitive], range: Range<usize>) -> u32 {
+    fn leaf(&mut self, tree: &Tree2, prims: &[Primitive], range: Range<usize>) -> u32 {
         let first = self.packets.len();
         let ids: Vec<usize> = range.collect();
         for chunk in ids.chunks(4) {
             let mut pk = TriPacket::EMPTY;
             for (lane, &id) in chunk.iter().enumerate() {
-                match prims[id].kind {
-                    PrimKind::Triangle { .. } => pk.set_triangle(lane, id as u32, prims[id].p),
+                let p = &prims[tree.order[id] as usize];
+                match p.kind {
+                    PrimKind::Triangle { .. } => pk.set_triangle(lane, id as u32, p.p),
                     PrimKind::Quadric(_) => pk.set_other(lane, id as u32),
                 }
             }
