@@ -98,7 +98,8 @@ pub(super) fn safe_inverse(d: Vec3) -> Vec3 {
             x
         }
     };
-    Vec3::new(fix(d.x), fix(d.y), fix(d.z)).recip()
+    // Vec3A: one vector division instead of three scalar ones (same IEEE quotients).
+    Vec3::from(Vec3A::new(fix(d.x), fix(d.y), fix(d.z)).recip())
 }
 
 /// A binary BVH over primitive boxes (see the module docs).

@@ -130,11 +130,22 @@ impl RayShear4 {
         let tmd = Vec4::splat(t_max) * det;
         let in_range = (det.cmplt(zero) & t_scaled.cmplt(zero) & t_scaled.cmpge(tmd))
             | (det.cmpgt(zero) & t_scaled.cmpgt(zero) & t_scaled.cmple(tmd));
+        let candidates = (!(neg & pos) & in_range).bitmask() & pk.tri & !redo;
+        if candidates == 0 {
+            // The common miss: skip the division.
+            return Lanes {
+                hit: 0,
+                redo,
+                t: zero,
+                e: [e0, e1, e2],
+                inv: zero,
+            };
+        }
         let inv = Vec4::ONE / det;
         let t = t_scaled * inv;
-        let ok = !(neg & pos) & in_range & t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
+        let ok = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
         Lanes {
-            hit: ok.bitmask() & pk.tri & !redo,
+            hit: ok.bitmask() & candidates,
             redo,
             t,
             e: [e0, e1, e2],
