@@ -163,16 +163,19 @@ impl RayShear4 {
         let t = h.t.to_array();
         let mut best_t = t_max;
         let mut best: Option<LaneHit> = None;
-        for lane in 0..4 {
-            let bit = 1 << lane;
-            if h.hit & bit != 0 {
+        // Lanes in increasing order, so that equal t keeps the lowest lane.
+        let mut lanes = h.hit | h.redo;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize & 3;
+            lanes &= lanes - 1;
+            if h.hit & (1 << lane) != 0 {
                 if t[lane] < best_t {
                     best_t = t[lane];
                     let inv = h.inv[lane];
                     let b = [h.e[0][lane] * inv, h.e[1][lane] * inv, h.e[2][lane] * inv];
                     best = Some((lane, t[lane], b));
                 }
-            } else if h.redo & bit != 0 {
+            } else {
                 let (p0, p1, p2) = (pk.vertex(lane, 0), pk.vertex(lane, 1), pk.vertex(lane, 2));
                 let scalar = RayShear::new(self.ray.0, self.ray.1);
                 if let Some((tl, b0, b1, b2)) = scalar.intersect(p0, p1, p2, best_t) {
@@ -221,7 +224,7 @@ mod tests {
     #[test]
     fn lanes_match_the_scalar_test_bit_for_bit() {
         let mut s = 7u64;
-        let mut rnd3 = |s: &mut u64| Vec3::new(lcg(s), lcg(s), lcg(s)) * 2.0 - 1.0;
+        let rnd3 = |s: &mut u64| Vec3::new(lcg(s), lcg(s), lcg(s)) * 2.0 - 1.0;
         let (mut hits, mut checked) = (0, 0);
         for _ in 0..20_000 {
             let mut pk = TriPacket::EMPTY;
