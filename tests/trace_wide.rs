@@ -200,3 +200,45 @@ fn wide_matches_own_bvh_on_a_dense_mesh() {
         "{hits} of 20000 vertex/edge rays hit (cracks?)"
     );
 }
+
+#[test]
+fn wide_handles_coincident_and_degenerate_triangles() {
+    // 5000 copies of one triangle plus zero-area slivers: PLOC may build a deep tree here (then
+    // the binned-SAH fallback is used); either way every answer must match brute force.
+    let tri = [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    let mut prims: Vec<Primitive> = (0..5000u32)
+        .map(|i| Primitive {
+            p: tri,
+            kind: PrimKind::Triangle {
+                mesh: 0,
+                v: [i, i, i],
+            },
+            material: 0,
+            light: u32::MAX,
+        })
+        .collect();
+    for i in 0..100u32 {
+        let x = i as f32 * 0.01;
+        prims.push(Primitive {
+            p: [
+                Vec3::new(x, 0.0, 0.5),
+                Vec3::new(x, 1.0, 0.5),
+                Vec3::new(x, 0.5, 0.5),
+            ],
+            kind: PrimKind::Triangle {
+                mesh: 0,
+                v: [i, i, i],
+            },
+            material: 0,
+            light: u32::MAX,
+        });
+    }
+    let g = Geometry::new(prims, vec![MeshShading::default()], Vec::new());
+    let rays = rays(g.bounds(), 5_000, 13);
+    let (hits, _) = check(&g, &rays, true);
+    assert!(hits > 100, "{hits} hits");
+}

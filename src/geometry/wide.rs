@@ -357,3 +357,80 @@ impl WideBvh {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::bvh::Bvh;
+    use crate::geometry::triangle::intersect_triangle;
+
+    /// A tiny deterministic generator (tests only need varied inputs, not statistics).
+    fn lcg(state: &mut u64) -> f32 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*state >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    #[test]
+    fn both_binary_trees_collapse_to_correct_wide_trees() {
+        let mut s = 3u64;
+        let rnd3 = |s: &mut u64| Vec3::new(lcg(s), lcg(s), lcg(s)) * 10.0;
+        let prims: Vec<Primitive> = (0..500u32)
+            .map(|i| {
+                let p0 = rnd3(&mut s);
+                let (p1, p2) = (p0 + rnd3(&mut s) * 0.1, p0 + rnd3(&mut s) * 0.1);
+                Primitive {
+                    p: [p0, p1, p2],
+                    kind: PrimKind::Triangle { mesh: 0, v: [i; 3] },
+                    material: 0,
+                    light: u32::MAX,
+                }
+            })
+            .collect();
+        let boxes: Vec<(Vec3, Vec3)> = prims
+            .iter()
+            .map(|p| {
+                (
+                    p.p[0].min(p.p[1]).min(p.p[2]),
+                    p.p[0].max(p.p[1]).max(p.p[2]),
+                )
+            })
+            .collect();
+        for tree in [Tree2::ploc(&boxes), Tree2::from_bvh(Bvh::build(&boxes))] {
+            // Every primitive appears once in the leaf order; parents span their children.
+            let mut seen = vec![0; prims.len()];
+            tree.order.iter().for_each(|&i| seen[i as usize] += 1);
+            assert!(seen.iter().all(|&c| c == 1));
+            for n in &tree.nodes {
+                if let Some([a, b]) = n.children {
+                    assert_eq!(n.range, tree.nodes[a].range.start..tree.nodes[b].range.end);
+                }
+            }
+            let Some(w) = WideBvh::build(&tree, &prims) else {
+                panic!("500 triangles gave a tree deeper than {MAX_TREE_DEPTH}");
+            };
+            let mut hits = 0;
+            for _ in 0..2000 {
+                let (o, d) = (rnd3(&mut s), rnd3(&mut s) - Vec3::splat(5.0));
+                let want = prims
+                    .iter()
+                    .filter_map(|p| intersect_triangle(o, d, f32::INFINITY, p.p))
+                    .map(|h| h.0)
+                    .min_by(f32::total_cmp);
+                let got = w.closest(o, d, f32::INFINITY, |_, _| f32::INFINITY);
+                assert_eq!(want, got.map(|h| h.1));
+                if let Some((id, t, _)) = got {
+                    hits += 1;
+                    let p = prims[tree.order[id] as usize].p;
+                    assert_eq!(
+                        intersect_triangle(o, d, f32::INFINITY, p).map(|h| h.0),
+                        Some(t)
+                    );
+                }
+                assert_eq!(w.any(o, d, f32::INFINITY, |_| false), want.is_some());
+            }
+            assert!(hits > 100, "{hits} hits");
+        }
+    }
+}
