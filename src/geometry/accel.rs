@@ -6,7 +6,7 @@ use super::bvh::Bvh;
 use super::quadric::Quadric;
 use super::tree2::Tree2;
 use super::triangle::{RayShear, barycentric_error};
-use super::wide::WideBvh;
+use super::wide::{Bary, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -120,6 +120,7 @@ impl Geometry {
                         Some(w) => w,
                         None => {
                             tree = Tree2::from_bvh(Bvh::build(&boxes));
+                            // Never empty: the binned-SAH tree is at most 64 levels deep.
                             WideBvh::build(&tree, &prims).unwrap_or_default()
                         }
                     };
@@ -144,7 +145,7 @@ impl Geometry {
                 }
             }
         };
-        let prims: Vec<Primitive> = order.iter().map(|&i| prims[i as usize]).collect();
+        let prims = order.iter().map(|&i| prims[i as usize]).collect();
         Self {
             prims,
             meshes,
@@ -316,9 +317,6 @@ fn prim_bounds(p: &Primitive, quadrics: &[Quadric]) -> (Vec3, Vec3) {
     }
 }
 
-/// Barycentrics (b0, b1, b2) of a triangle hit.
-type Bary = [f32; 3];
-
 /// Placeholder barycentrics for quadric hits (which do not use them).
 const NO_BARY: Bary = [1.0 / 3.0; 3];
 
@@ -330,15 +328,10 @@ fn to_obvhs(ray: &Ray) -> obvhs::ray::Ray {
     obvhs::ray::Ray::new(Vec3A::from(ray.o), Vec3A::from(d), 0.0, ray.t_max)
 }
 
-impl RayQuery for Geometry {
-    fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
-        if let Accel::Wide(bvh) = &self.accel {
-            // The wide BVH tests triangles itself; only quadrics come back here.
-            let (id, t, b) = bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                self.quadric_t(id, ray, t_max)
-            })?;
-            return Some(self.surface_hit(id, ray, t, b));
-        }
+impl Geometry {
+    /// Closest hit through a backend that calls back per primitive (own BVH2, obvhs):
+    /// (leaf-order id, t, barycentrics).
+    fn closest_by_callback(&self, ray: &Ray) -> Option<(usize, f32, Bary)> {
         let shear = RayShear::new(ray.o, ray.d);
         // Barycentrics of the best hit so far: a test result is accepted exactly when its t is
         // below the current best (the contract of both traversals), so record them then.
@@ -351,7 +344,7 @@ impl RayQuery for Geometry {
             t
         };
         let (id, t) = match &self.accel {
-            Accel::None => return None,
+            Accel::None | Accel::Wide(_) => return None,
             Accel::Own(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, &mut leaf)?,
             Accel::Obvhs(bvh) => {
                 let mut hit = RayHit::none();
@@ -361,27 +354,42 @@ impl RayQuery for Geometry {
                 }
                 (hit.primitive_id as usize, hit.t)
             }
-            Accel::Wide(_) => unreachable!("handled above"),
         };
-        Some(self.surface_hit(id, ray, t, bary))
+        Some((id, t, bary))
+    }
+}
+
+impl RayQuery for Geometry {
+    fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        let (id, t, b) = match &self.accel {
+            // The wide BVH tests triangles itself; only quadrics come back here.
+            Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
+                self.quadric_t(id, ray, t_max)
+            })?,
+            _ => self.closest_by_callback(ray)?,
+        };
+        Some(self.surface_hit(id, ray, t, b))
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
-        if let Accel::Wide(bvh) = &self.accel {
-            return bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.quadric_t(id, ray, ray.t_max) < ray.t_max
-            });
-        }
-        let shear = RayShear::new(ray.o, ray.d);
+        let shear = || RayShear::new(ray.o, ray.d);
         match &self.accel {
             Accel::None => false,
-            Accel::Own(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.prim_t(id, &shear, ray.o, ray.d, ray.t_max) < ray.t_max
+            Accel::Wide(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                self.quadric_t(id, ray, ray.t_max) < ray.t_max
             }),
-            Accel::Obvhs(bvh) => !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
-                self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
-            }),
-            Accel::Wide(_) => unreachable!("handled above"),
+            Accel::Own(bvh) => {
+                let shear = shear();
+                bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                    self.prim_t(id, &shear, ray.o, ray.d, ray.t_max) < ray.t_max
+                })
+            }
+            Accel::Obvhs(bvh) => {
+                let shear = shear();
+                !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
+                    self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
+                })
+            }
         }
     }
 }
