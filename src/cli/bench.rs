@@ -118,7 +118,7 @@ fn bvh_section(names: &[String]) -> anyhow::Result<()> {
                 Ray::new(o, uniform_sphere(b))
             })
             .collect();
-        for backend in [Backend::Own, Backend::Obvhs] {
+        for backend in [Backend::Own, Backend::Obvhs, Backend::Wide] {
             let g = scene.geometry.rebuild(backend);
             let t = Instant::now();
             let hits = rays.iter().filter(|r| g.intersect(r).is_some()).count();

@@ -1,9 +1,12 @@
-//! [`Geometry`]: every primitive of a scene behind one BVH — penumbra's own binned-SAH BVH2
-//! ([`super::bvh`]) or obvhs's compressed-wide BVH (CWBVH), see [`Backend`].
+//! [`Geometry`]: every primitive of a scene behind one BVH — penumbra's 4-wide BVH with
+//! 4-triangle packets ([`super::wide`], the default), its own binned-SAH BVH2 ([`super::bvh`]) or
+//! obvhs's compressed-wide BVH (CWBVH), see [`Backend`].
 
 use super::bvh::Bvh;
 use super::quadric::Quadric;
+use super::tree2::Tree2;
 use super::triangle::{RayShear, barycentric_error};
+use super::wide::{Bary, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -55,9 +58,12 @@ pub struct Primitive {
 pub enum Backend {
     /// penumbra's binned-SAH BVH2.
     Own,
-    /// obvhs's CWBVH (the default: fewer instructions per ray on cornell, see `penumbra bench`).
-    #[default]
+    /// obvhs's CWBVH.
     Obvhs,
+    /// obvhs's PLOC BVH2 collapsed to a 4-wide BVH with 4-triangle SoA leaf packets (the
+    /// default: fastest closest- and any-hit queries on cornell and dense, see `penumbra bench`).
+    #[default]
+    Wide,
 }
 
 /// The built acceleration structure.
@@ -65,6 +71,7 @@ enum Accel {
     None,
     Own(Bvh),
     Obvhs(CwBvh),
+    Wide(WideBvh),
 }
 
 /// All scene geometry and its BVH.
@@ -105,6 +112,20 @@ impl Geometry {
             (Vec::new(), Accel::None)
         } else {
             match backend {
+                Backend::Wide => {
+                    // PLOC + reinsertion gives the better tree; the binned-SAH one is
+                    // depth-limited, so it is the fallback for degenerate inputs.
+                    let mut tree = Tree2::ploc(&boxes);
+                    let wide = match WideBvh::build(&tree, &prims) {
+                        Some(w) => w,
+                        None => {
+                            tree = Tree2::from_bvh(Bvh::build(&boxes));
+                            // Never empty: the binned-SAH tree is at most 64 levels deep.
+                            WideBvh::build(&tree, &prims).unwrap_or_default()
+                        }
+                    };
+                    (tree.order, Accel::Wide(wide))
+                }
                 Backend::Own => {
                     let mut bvh = Bvh::build(&boxes);
                     (std::mem::take(&mut bvh.indices), Accel::Own(bvh))
@@ -156,6 +177,7 @@ impl Geometry {
             Accel::None => None,
             Accel::Own(_) => Some(Backend::Own),
             Accel::Obvhs(_) => Some(Backend::Obvhs),
+            Accel::Wide(_) => Some(Backend::Wide),
         }
     }
 
@@ -174,33 +196,48 @@ impl Geometry {
         self.bounds
     }
 
+    /// Hit distance of primitive `id` below `t_max` (else +∞) and, for triangles, the
+    /// barycentrics of that hit, so the accepted closest hit needs no second triangle test.
     #[inline(always)]
-    fn prim_t(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+    fn prim_hit(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> (f32, Bary) {
         let p = &self.prims[id];
         match p.kind {
             PrimKind::Triangle { .. } => match shear.intersect(p.p[0], p.p[1], p.p[2], t_max) {
-                Some((t, ..)) => t,
-                None => f32::INFINITY,
+                Some((t, b0, b1, b2)) => (t, [b0, b1, b2]),
+                None => (f32::INFINITY, NO_BARY),
             },
-            PrimKind::Quadric(q) => self.quadrics[q as usize]
-                .intersect_t(o, d, t_max)
-                .unwrap_or(f32::INFINITY),
+            PrimKind::Quadric(q) => (
+                self.quadrics[q as usize]
+                    .intersect_t(o, d, t_max)
+                    .unwrap_or(f32::INFINITY),
+                NO_BARY,
+            ),
         }
     }
 
-    fn surface_hit(&self, id: usize, ray: &Ray, t: f32) -> SurfaceHit {
+    /// Hit distance of non-triangle primitive `id` below `t_max`, or +∞.
+    #[inline(always)]
+    fn quadric_t(&self, id: usize, ray: &Ray, t_max: f32) -> f32 {
+        match self.prims[id].kind {
+            PrimKind::Quadric(q) => self.quadrics[q as usize]
+                .intersect_t(ray.o, ray.d, t_max)
+                .unwrap_or(f32::INFINITY),
+            PrimKind::Triangle { .. } => f32::INFINITY,
+        }
+    }
+
+    /// Hit distance of primitive `id` below `t_max`, or +∞ (any-hit queries).
+    #[inline(always)]
+    fn prim_t(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        self.prim_hit(id, shear, o, d, t_max).0
+    }
+
+    /// The hit record of primitive `id` hit at `t` with triangle barycentrics `b`.
+    fn surface_hit(&self, id: usize, ray: &Ray, t: f32, b: Bary) -> SurfaceHit {
         let p = &self.prims[id];
         match p.kind {
             PrimKind::Triangle { mesh, v } => {
-                let (b0, b1, b2) = match RayShear::new(ray.o, ray.d).intersect(
-                    p.p[0],
-                    p.p[1],
-                    p.p[2],
-                    f32::INFINITY,
-                ) {
-                    Some((_, b0, b1, b2)) => (b0, b1, b2),
-                    None => (1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0),
-                };
+                let [b0, b1, b2] = b;
                 let verts = p.p;
                 let pos = verts[0] * b0 + verts[1] * b1 + verts[2] * b2;
                 let m = &self.meshes[mesh as usize];
@@ -280,6 +317,9 @@ fn prim_bounds(p: &Primitive, quadrics: &[Quadric]) -> (Vec3, Vec3) {
     }
 }
 
+/// Placeholder barycentrics for quadric hits (which do not use them).
+const NO_BARY: Bary = [1.0 / 3.0; 3];
+
 #[inline]
 fn to_obvhs(ray: &Ray) -> obvhs::ray::Ray {
     // `+ 0.0` turns −0.0 into +0.0: obvhs derives the child order from the direction's sign
@@ -288,38 +328,68 @@ fn to_obvhs(ray: &Ray) -> obvhs::ray::Ray {
     obvhs::ray::Ray::new(Vec3A::from(ray.o), Vec3A::from(d), 0.0, ray.t_max)
 }
 
-impl RayQuery for Geometry {
-    fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+impl Geometry {
+    /// Closest hit through a backend that calls back per primitive (own BVH2, obvhs):
+    /// (leaf-order id, t, barycentrics).
+    fn closest_by_callback(&self, ray: &Ray) -> Option<(usize, f32, Bary)> {
         let shear = RayShear::new(ray.o, ray.d);
+        // Barycentrics of the best hit so far: a test result is accepted exactly when its t is
+        // below the current best (the contract of both traversals), so record them then.
+        let mut bary = NO_BARY;
+        let mut leaf = |id: usize, t_max: f32| {
+            let (t, b) = self.prim_hit(id, &shear, ray.o, ray.d, t_max);
+            if t < t_max {
+                bary = b;
+            }
+            t
+        };
         let (id, t) = match &self.accel {
-            Accel::None => return None,
-            Accel::Own(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                self.prim_t(id, &shear, ray.o, ray.d, t_max)
-            })?,
+            Accel::None | Accel::Wide(_) => return None,
+            Accel::Own(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, &mut leaf)?,
             Accel::Obvhs(bvh) => {
                 let mut hit = RayHit::none();
-                let found = bvh.ray_traverse(to_obvhs(ray), &mut hit, |r, id| {
-                    self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
-                });
+                let found = bvh.ray_traverse(to_obvhs(ray), &mut hit, |r, id| leaf(id, r.tmax));
                 if !found {
                     return None;
                 }
                 (hit.primitive_id as usize, hit.t)
             }
         };
-        Some(self.surface_hit(id, ray, t))
+        Some((id, t, bary))
+    }
+}
+
+impl RayQuery for Geometry {
+    fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        let (id, t, b) = match &self.accel {
+            // The wide BVH tests triangles itself; only quadrics come back here.
+            Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
+                self.quadric_t(id, ray, t_max)
+            })?,
+            _ => self.closest_by_callback(ray)?,
+        };
+        Some(self.surface_hit(id, ray, t, b))
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
-        let shear = RayShear::new(ray.o, ray.d);
+        let shear = || RayShear::new(ray.o, ray.d);
         match &self.accel {
             Accel::None => false,
-            Accel::Own(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.prim_t(id, &shear, ray.o, ray.d, ray.t_max) < ray.t_max
+            Accel::Wide(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                self.quadric_t(id, ray, ray.t_max) < ray.t_max
             }),
-            Accel::Obvhs(bvh) => !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
-                self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
-            }),
+            Accel::Own(bvh) => {
+                let shear = shear();
+                bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                    self.prim_t(id, &shear, ray.o, ray.d, ray.t_max) < ray.t_max
+                })
+            }
+            Accel::Obvhs(bvh) => {
+                let shear = shear();
+                !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
+                    self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
+                })
+            }
         }
     }
 }

@@ -66,10 +66,10 @@ fn max(a: f32, b: f32) -> f32 {
 
 /// 1 − 2γ(3): the entry distance is shrunk just as conservatively, because closest-hit
 /// traversal culls boxes whose entry lies beyond the best hit (a triangle in a box face).
-const NEAR_SLACK: f32 = 1.0 - 2.0 * gamma(3);
+pub(super) const NEAR_SLACK: f32 = 1.0 - 2.0 * gamma(3);
 
 /// 1 + 2γ(3): the widening of the slab test's far distance that keeps it conservative.
-const ROUNDING_SLACK: f32 = 1.0 + 2.0 * gamma(3);
+pub(super) const ROUNDING_SLACK: f32 = 1.0 + 2.0 * gamma(3);
 
 /// Per-ray constants of the slab test.
 struct RayPre {
@@ -80,21 +80,26 @@ struct RayPre {
 impl RayPre {
     #[inline(always)]
     fn new(o: Vec3, d: Vec3) -> Self {
-        // A zero direction component would give 0·∞ = NaN in the slab test; a tiny stand-in
-        // gives ±huge distances instead, which the min/max logic handles.
-        let fix = |x: f32| {
-            if x.abs() < 1e-30 {
-                if x.is_sign_negative() { -1e-30 } else { 1e-30 }
-            } else {
-                x
-            }
-        };
-        let d = Vec3::new(fix(d.x), fix(d.y), fix(d.z));
         Self {
             o: o.into(),
-            inv: d.recip().into(),
+            inv: safe_inverse(d).into(),
         }
     }
+}
+
+/// 1/d per axis, with zero components replaced by ±1e-30 first: a zero would give 0·∞ = NaN in
+/// the slab test, the tiny stand-in gives ±huge distances, which the min/max logic handles.
+#[inline(always)]
+pub(super) fn safe_inverse(d: Vec3) -> Vec3 {
+    let fix = |x: f32| {
+        if x.abs() < 1e-30 {
+            if x.is_sign_negative() { -1e-30 } else { 1e-30 }
+        } else {
+            x
+        }
+    };
+    // Vec3A: one vector division instead of three scalar ones (same IEEE quotients).
+    Vec3::from(Vec3A::new(fix(d.x), fix(d.y), fix(d.z)).recip())
 }
 
 /// A binary BVH over primitive boxes (see the module docs).
@@ -198,6 +203,22 @@ impl Bvh {
             todo.push((left, depth + 1));
         }
         Self { nodes, indices }
+    }
+
+    /// Box (lo, hi) of node `i` (the root is node 0); used to collapse this tree into a wide one.
+    pub(super) fn node_bounds(&self, i: usize) -> (Vec3, Vec3) {
+        let n = &self.nodes[i];
+        (Vec3::from_array(n.lo), Vec3::from_array(n.hi))
+    }
+
+    /// Node `i` as `Ok(first child)` (the second is `first + 1`) or `Err(leaf-order range)`.
+    pub(super) fn node_kind(&self, i: usize) -> Result<usize, std::ops::Range<usize>> {
+        let n = &self.nodes[i];
+        if n.count == 0 {
+            Ok(n.first as usize)
+        } else {
+            Err(n.first as usize..(n.first + n.count) as usize)
+        }
     }
 
     /// Number of nodes (for statistics).

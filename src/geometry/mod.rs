@@ -1,4 +1,5 @@
-//! Shapes, transforms, rays and the ray-query acceleration structures (own BVH2, obvhs CWBVH).
+//! Shapes, transforms, rays and the ray-query acceleration structures (own BVH2 and its 4-wide
+//! collapse, obvhs CWBVH).
 
 pub mod accel;
 pub mod bvh;
@@ -7,7 +8,10 @@ pub mod interaction;
 pub mod quadric;
 pub mod ray;
 pub mod transform;
+pub mod tree2;
+pub mod tri4;
 pub mod triangle;
+pub mod wide;
 
 pub use accel::{Backend, Geometry, MeshShading, PrimKind, Primitive};
 pub use interaction::SurfaceHit;

@@ -21,19 +21,7 @@ impl RayShear {
     /// Precompute the shear for ray (o, d); `d` must be non-zero.
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        let a = d.abs();
-        let kz = if a.x > a.y {
-            if a.x > a.z { 0 } else { 2 }
-        } else if a.y > a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let [kx, ky, kz] = shear_axes(d);
         let dz = d[kz];
         let unit = |k: usize| Vec3::AXES[k];
         Self {
@@ -95,6 +83,27 @@ impl RayShear {
         }
         Some((t, e0 * inv, e1 * inv, e2 * inv))
     }
+}
+
+/// The axes (kx, ky, kz) of the ray-space permutation: kz is the dominant axis of `d`, and kx,
+/// ky are swapped when d[kz] < 0 to keep the handedness (so edge-function signs are consistent).
+/// Shared by [`RayShear`] and the 4-wide test so that both transform vertices identically.
+#[inline]
+pub fn shear_axes(d: Vec3) -> [usize; 3] {
+    let a = d.abs();
+    let kz = if a.x > a.y {
+        if a.x > a.z { 0 } else { 2 }
+    } else if a.y > a.z {
+        1
+    } else {
+        2
+    };
+    let mut kx = (kz + 1) % 3;
+    let mut ky = (kx + 1) % 3;
+    if d[kz] < 0.0 {
+        std::mem::swap(&mut kx, &mut ky);
+    }
+    [kx, ky, kz]
 }
 
 /// Intersect the ray (o, d) with triangle (p0, p1, p2); returns (t, b0, b1, b2).

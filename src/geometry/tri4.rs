@@ -1,0 +1,279 @@
+//! Four triangles against one ray at once: the watertight test of [`super::triangle`] with each
+//! step done on four lanes (glam's `Vec4`, SSE2 on x86-64, a scalar fallback elsewhere).
+//!
+//! Every lane performs the same f32 operations in the same order as [`RayShear::intersect`]
+//! (the shear rows there have one unit and one zero entry, so their dot products round exactly
+//! like `a[kx] + sx·a[kz]` here), hence t and the barycentrics are bit-identical. Lanes whose
+//! edge functions are exactly 0 in f32 are redone by the scalar test, whose f64 fallback keeps
+//! neighbouring triangles in agreement on shared edges (watertightness).
+
+use super::triangle::{RayShear, shear_axes};
+use glam::{Vec3, Vec4};
+
+/// Four triangles in SoA layout, one leaf packet of the wide BVH.
+#[derive(Clone, Copy, Debug)]
+pub struct TriPacket {
+    /// `v[vertex][axis]`: that coordinate of the four lanes (unused lanes hold NaN).
+    pub v: [[Vec4; 3]; 3],
+    /// Leaf-order primitive ids of the lanes (`u32::MAX` for unused lanes).
+    pub ids: [u32; 4],
+    /// Lanes that hold triangles (bit i = lane i).
+    pub tri: u32,
+    /// Lanes that hold other primitives (quadrics), which the caller tests.
+    pub other: u32,
+    /// True for the last packet of a leaf (leaves are runs of consecutive packets).
+    pub last: bool,
+}
+
+impl TriPacket {
+    /// A packet with no primitive in any lane.
+    pub const EMPTY: TriPacket = TriPacket {
+        v: [[Vec4::NAN; 3]; 3],
+        ids: [u32::MAX; 4],
+        tri: 0,
+        other: 0,
+        last: false,
+    };
+
+    /// Put triangle `p` (leaf-order id `id`) into `lane`.
+    pub fn set_triangle(&mut self, lane: usize, id: u32, p: [Vec3; 3]) {
+        for (j, v) in p.iter().enumerate() {
+            for axis in 0..3 {
+                self.v[j][axis][lane] = v[axis];
+            }
+        }
+        self.ids[lane] = id;
+        self.tri |= 1 << lane;
+    }
+
+    /// Put a non-triangle primitive (leaf-order id `id`) into `lane`.
+    pub fn set_other(&mut self, lane: usize, id: u32) {
+        self.ids[lane] = id;
+        self.other |= 1 << lane;
+    }
+
+    /// Vertex `j` of the triangle in `lane`.
+    #[inline]
+    fn vertex(&self, lane: usize, j: usize) -> Vec3 {
+        Vec3::new(self.v[j][0][lane], self.v[j][1][lane], self.v[j][2][lane])
+    }
+}
+
+/// A triangle hit inside a packet: lane, t and barycentrics (b0, b1, b2).
+pub type LaneHit = (usize, f32, [f32; 3]);
+
+/// Per-ray constants of the 4-wide test (the shear of [`RayShear`] as axis permutation plus
+/// three factors, each splatted to four lanes).
+#[derive(Clone, Copy, Debug)]
+pub struct RayShear4 {
+    k: [usize; 3],
+    o: [Vec4; 3],
+    s: [Vec4; 3],
+    /// The ray, for the scalar redo of exact-zero lanes (rare, so its shear is built lazily).
+    ray: (Vec3, Vec3),
+}
+
+/// The vector part of a packet test.
+struct Lanes {
+    /// Lanes accepted by the f32 test.
+    hit: u32,
+    /// Triangle lanes with an exactly-zero edge function: to be redone by the scalar test.
+    redo: u32,
+    t: Vec4,
+    e: [Vec4; 3],
+    inv: Vec4,
+}
+
+impl RayShear4 {
+    /// Precompute the shear for ray (o, d); `d` must be non-zero.
+    #[inline(always)]
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        let k = shear_axes(d);
+        let dz = d[k[2]];
+        Self {
+            k,
+            o: [
+                Vec4::splat(o[k[0]]),
+                Vec4::splat(o[k[1]]),
+                Vec4::splat(o[k[2]]),
+            ],
+            s: [
+                Vec4::splat(-(d[k[0]] / dz)),
+                Vec4::splat(-(d[k[1]] / dz)),
+                Vec4::splat(1.0 / dz),
+            ],
+            ray: (o, d),
+        }
+    }
+
+    #[inline(always)]
+    fn lanes(&self, pk: &TriPacket, t_max: f32) -> Lanes {
+        let [kx, ky, kz] = self.k;
+        // Ray-space vertex j: (x, y, z) with the same roundings as RayShear's dot products.
+        let sheared = |j: usize| {
+            let v = &pk.v[j];
+            let (ax, ay, az) = (v[kx] - self.o[0], v[ky] - self.o[1], v[kz] - self.o[2]);
+            (ax + az * self.s[0], ay + az * self.s[1], az * self.s[2])
+        };
+        let (ax, ay, az) = sheared(0);
+        let (bx, by, bz) = sheared(1);
+        let (cx, cy, cz) = sheared(2);
+        let e0 = bx * cy - by * cx;
+        let e1 = cx * ay - cy * ax;
+        let e2 = ax * by - ay * bx;
+        let zero = Vec4::ZERO;
+        let redo = (e0.cmpeq(zero) | e1.cmpeq(zero) | e2.cmpeq(zero)).bitmask() & pk.tri;
+        let neg = e0.cmplt(zero) | e1.cmplt(zero) | e2.cmplt(zero);
+        let pos = e0.cmpgt(zero) | e1.cmpgt(zero) | e2.cmpgt(zero);
+        let det = e0 + e1 + e2;
+        let t_scaled = e0 * az + e1 * bz + e2 * cz;
+        let tmd = Vec4::splat(t_max) * det;
+        let in_range = (det.cmplt(zero) & t_scaled.cmplt(zero) & t_scaled.cmpge(tmd))
+            | (det.cmpgt(zero) & t_scaled.cmpgt(zero) & t_scaled.cmple(tmd));
+        let candidates = (!(neg & pos) & in_range).bitmask() & pk.tri & !redo;
+        if candidates == 0 {
+            // The common miss: skip the division.
+            return Lanes {
+                hit: 0,
+                redo,
+                t: zero,
+                e: [e0, e1, e2],
+                inv: zero,
+            };
+        }
+        let inv = Vec4::ONE / det;
+        let t = t_scaled * inv;
+        let ok = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
+        Lanes {
+            hit: ok.bitmask() & candidates,
+            redo,
+            t,
+            e: [e0, e1, e2],
+            inv,
+        }
+    }
+
+    /// Closest triangle hit in `pk` with t in (0, t_max); ties go to the lowest lane.
+    #[inline(always)]
+    pub fn closest(&self, pk: &TriPacket, t_max: f32) -> Option<LaneHit> {
+        let h = self.lanes(pk, t_max);
+        if h.hit | h.redo == 0 {
+            return None;
+        }
+        let t = h.t.to_array();
+        let mut best_t = t_max;
+        let mut best: Option<LaneHit> = None;
+        // Lanes in increasing order, so that equal t keeps the lowest lane.
+        let mut lanes = h.hit | h.redo;
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize & 3;
+            lanes &= lanes - 1;
+            if h.hit & (1 << lane) != 0 {
+                if t[lane] < best_t {
+                    best_t = t[lane];
+                    let inv = h.inv[lane];
+                    let b = [h.e[0][lane] * inv, h.e[1][lane] * inv, h.e[2][lane] * inv];
+                    best = Some((lane, t[lane], b));
+                }
+            } else {
+                let (p0, p1, p2) = (pk.vertex(lane, 0), pk.vertex(lane, 1), pk.vertex(lane, 2));
+                let scalar = RayShear::new(self.ray.0, self.ray.1);
+                if let Some((tl, b0, b1, b2)) = scalar.intersect(p0, p1, p2, best_t) {
+                    best_t = tl;
+                    best = Some((lane, tl, [b0, b1, b2]));
+                }
+            }
+        }
+        best
+    }
+
+    /// True if any triangle of `pk` is hit with t in (0, t_max).
+    #[inline(always)]
+    pub fn any(&self, pk: &TriPacket, t_max: f32) -> bool {
+        let h = self.lanes(pk, t_max);
+        if h.hit != 0 {
+            return true;
+        }
+        let mut redo = h.redo;
+        let scalar = RayShear::new(self.ray.0, self.ray.1);
+        while redo != 0 {
+            let lane = redo.trailing_zeros() as usize;
+            redo &= redo - 1;
+            let (p0, p1, p2) = (pk.vertex(lane, 0), pk.vertex(lane, 1), pk.vertex(lane, 2));
+            if scalar.intersect(p0, p1, p2, t_max).is_some() {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::triangle::intersect_triangle;
+
+    /// A tiny deterministic generator (tests only need varied inputs, not statistics).
+    fn lcg(state: &mut u64) -> f32 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*state >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    #[test]
+    fn lanes_match_the_scalar_test_bit_for_bit() {
+        let mut s = 7u64;
+        let rnd3 = |s: &mut u64| Vec3::new(lcg(s), lcg(s), lcg(s)) * 2.0 - 1.0;
+        let (mut hits, mut checked) = (0, 0);
+        for _ in 0..20_000 {
+            let mut pk = TriPacket::EMPTY;
+            let mut tris = Vec::new();
+            for lane in 0..3 {
+                let p = [rnd3(&mut s), rnd3(&mut s), rnd3(&mut s)];
+                pk.set_triangle(lane, lane as u32, p);
+                tris.push(p);
+            }
+            // Lane 3 shares an edge with lane 0 so that exact-zero edge functions occur.
+            let p = [tris[0][1], tris[0][0], rnd3(&mut s)];
+            pk.set_triangle(3, 3, p);
+            tris.push(p);
+            let o = rnd3(&mut s) * 2.0;
+            let d = if lcg(&mut s) < 0.2 {
+                // Rays through a shared vertex.
+                tris[0][0] - o
+            } else {
+                rnd3(&mut s)
+            };
+            let t_max = if lcg(&mut s) < 0.5 {
+                f32::INFINITY
+            } else {
+                3.0
+            };
+            let r4 = RayShear4::new(o, d);
+            let want = tris
+                .iter()
+                .enumerate()
+                .filter_map(|(i, p)| intersect_triangle(o, d, t_max, *p).map(|h| (i, h)))
+                .fold(
+                    None::<(usize, (f32, f32, f32, f32))>,
+                    |best, (i, h)| match best {
+                        Some((_, b)) if b.0 <= h.0 => best,
+                        _ => Some((i, h)),
+                    },
+                );
+            let got = r4.closest(&pk, t_max);
+            checked += 1;
+            match (want, got) {
+                (None, None) => {}
+                (Some((i, (t, b0, b1, b2))), Some((lane, tg, bg))) => {
+                    hits += 1;
+                    assert_eq!((i, t, [b0, b1, b2]), (lane, tg, bg));
+                }
+                _ => panic!("scalar {want:?} vs packet {got:?}"),
+            }
+            assert_eq!(r4.any(&pk, t_max), want.is_some());
+        }
+        assert!(hits > checked / 20, "{hits} hits of {checked}");
+    }
+}
