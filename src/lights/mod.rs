@@ -240,17 +240,9 @@ impl LightSource for Light {
 /// [`crate::sampling::SphericalTriangle`], so `pdf_li` (called for every emitter hit under MIS)
 /// and the sampling-rule decision use it.
 pub(crate) fn triangle_solid_angle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
-    let p = p.as_dvec3();
-    let (Some(a), Some(b), Some(c)) = (
-        (a.as_dvec3() - p).try_normalize(),
-        (b.as_dvec3() - p).try_normalize(),
-        (c.as_dvec3() - p).try_normalize(),
-    ) else {
-        return 0.0;
-    };
-    let num = a.dot(b.cross(c)).abs();
-    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
-    (2.0 * num.atan2(den)) as f32
+    // The same projection `sample_li` starts from, so both see bit-identical solid angles.
+    crate::sampling::SphericalProjection::new(p, a, b, c)
+        .map_or(0.0, |proj| proj.solid_angle() as f32)
 }
 
 /// The connection from `p` to `p_light`, a point drawn with area density `pdf_area` on an

@@ -7,7 +7,7 @@ use super::{
     solid_angle_sample, spherical_ok, triangle_solid_angle,
 };
 use crate::Rgb;
-use crate::sampling::{SphericalTriangle, uniform_triangle_point};
+use crate::sampling::{SphericalProjection, uniform_triangle_point};
 use glam::{Vec2, Vec3};
 
 /// A triangle emitting constant radiance `l` on the side of `n` (both sides if `two_sided`).
@@ -70,16 +70,27 @@ impl LightSource for TriangleLight {
         if !self.faces(ctx.p) {
             return None;
         }
-        if let Some(omega) = self.spherical_omega(ctx.p, mode) {
-            let st = SphericalTriangle::new(ctx.p, self.p[0], self.p[1], self.p[2])?;
-            let wi = st.sample(u);
-            // Where the sampled direction meets the triangle's plane (the shadow-ray target).
-            let denom = self.n.dot(wi);
-            let t = self.n.dot(self.p[0] - ctx.p) / denom;
-            if !is_positive(t) || !t.is_finite() {
-                return None;
+        // One projection serves both the sampling-rule decision and the sampler (the same
+        // Ω as `spherical_omega`, without normalising and measuring the triangle twice).
+        let proj = match mode {
+            SamplingMode::SolidAngle => {
+                SphericalProjection::new(ctx.p, self.p[0], self.p[1], self.p[2])
             }
-            return solid_angle_sample(wi, ctx.p + wi * t, 1.0 / omega, self.l);
+            SamplingMode::Area => None,
+        };
+        if let Some(proj) = proj {
+            let omega = proj.solid_angle() as f32;
+            if spherical_ok(omega) {
+                let st = proj.sampler()?;
+                let wi = st.sample(u);
+                // Where the sampled direction meets the triangle's plane (the shadow-ray target).
+                let denom = self.n.dot(wi);
+                let t = self.n.dot(self.p[0] - ctx.p) / denom;
+                if !is_positive(t) || !t.is_finite() {
+                    return None;
+                }
+                return solid_angle_sample(wi, ctx.p + wi * t, 1.0 / omega, self.l);
+            }
         }
         let p_light = uniform_triangle_point(u, self.p[0], self.p[1], self.p[2]);
         area_sample(ctx.p, p_light, self.n, 1.0 / self.area, self.l)

@@ -25,7 +25,7 @@ pub use frame::Frame;
 pub use pattern::{Pattern, PatternKind, PixelSamples, SamplePattern, make_pattern};
 pub use permutation::{Permutation, permute};
 pub use spherical_rectangle::SphericalRectangle;
-pub use spherical_triangle::SphericalTriangle;
+pub use spherical_triangle::{SphericalProjection, SphericalTriangle};
 pub use warps::*;
 
 /// The largest f32 strictly below 1, so that samples stay in [0, 1).

@@ -48,24 +48,50 @@ fn angle_between(x: DVec3, y: DVec3) -> f64 {
     x.cross(y).length().atan2(x.dot(y))
 }
 
-impl SphericalTriangle {
-    /// Smallest solid angle (sr) this sampler accepts: below it f64 Arvo loses accuracy, and
-    /// callers should sample by area instead.
-    pub const MIN_SOLID_ANGLE: f64 = 1e-10;
+/// The first, cheap half of [`SphericalTriangle::new`]: the vertex directions and the solid
+/// angle. A light decides from the solid angle whether to sample by solid angle at all, then
+/// finishes the same projection with [`SphericalProjection::sampler`] instead of normalising
+/// and measuring the triangle a second time.
+#[derive(Clone, Copy, Debug)]
+pub struct SphericalProjection {
+    da: DVec3,
+    db: DVec3,
+    dc: DVec3,
+    area64: f64,
+}
 
-    /// Project triangle (v0, v1, v2) onto the unit sphere around `p`; `None` if degenerate.
+impl SphericalProjection {
+    /// Unit directions from `p` to (v0, v1, v2); `None` if a vertex coincides with `p`.
+    #[inline]
     pub fn new(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<Self> {
         let p = p.as_dvec3();
         let da = (v0.as_dvec3() - p).try_normalize()?;
         let db = (v1.as_dvec3() - p).try_normalize()?;
         let dc = (v2.as_dvec3() - p).try_normalize()?;
-        let area64 = solid_angle(da, db, dc);
-        if !(area64 >= Self::MIN_SOLID_ANGLE && area64.is_finite()) {
+        Some(Self {
+            da,
+            db,
+            dc,
+            area64: solid_angle(da, db, dc),
+        })
+    }
+
+    /// Solid angle (sr), f64.
+    #[inline]
+    pub fn solid_angle(&self) -> f64 {
+        self.area64
+    }
+
+    /// The sampler of this triangle; `None` if it is too small or degenerate to sample.
+    #[inline]
+    pub fn sampler(self) -> Option<SphericalTriangle> {
+        let Self { da, db, dc, area64 } = self;
+        if !(area64 >= SphericalTriangle::MIN_SOLID_ANGLE && area64.is_finite()) {
             return None;
         }
         let alpha = angle_between(tangent(da, db)?, tangent(da, dc)?);
         let triple = da.dot(db.cross(dc));
-        Some(Self {
+        Some(SphericalTriangle {
             a: da.as_vec3(),
             b: db.as_vec3(),
             c: dc.as_vec3(),
@@ -77,6 +103,17 @@ impl SphericalTriangle {
             alpha,
             orientation: if triple >= 0.0 { 1.0 } else { -1.0 },
         })
+    }
+}
+
+impl SphericalTriangle {
+    /// Smallest solid angle (sr) this sampler accepts: below it f64 Arvo loses accuracy, and
+    /// callers should sample by area instead.
+    pub const MIN_SOLID_ANGLE: f64 = 1e-10;
+
+    /// Project triangle (v0, v1, v2) onto the unit sphere around `p`; `None` if degenerate.
+    pub fn new(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<Self> {
+        SphericalProjection::new(p, v0, v1, v2)?.sampler()
     }
 
     /// Unit direction uniformly distributed in the spherical triangle; pdf = 1/area.
