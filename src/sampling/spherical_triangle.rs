@@ -24,8 +24,12 @@ pub struct SphericalTriangle {
     dc: DVec3,
     /// Solid angle in f64.
     area64: f64,
-    /// Interior angle at A.
-    alpha: f64,
+    /// cos and sin of the interior angle α at A (Arvo needs only these and sin(ξ₁Ω − α),
+    /// which the angle-difference identity gives without an atan2 and a second sincos).
+    cos_alpha: f64,
+    sin_alpha: f64,
+    /// Unit tangent at A of the arc AC (where the sub-triangle's far vertex Ĉ moves).
+    c_perp: DVec3,
     /// +1 or −1: orientation of (a, b, c), for the inside test.
     orientation: f64,
 }
@@ -41,11 +45,6 @@ fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 /// Unit tangent at `a` of the great-circle arc towards `b` (`None` if b = ±a).
 fn tangent(a: DVec3, b: DVec3) -> Option<DVec3> {
     (b - a * a.dot(b)).try_normalize()
-}
-
-/// Angle between two unit vectors, accurate near 0 and π.
-fn angle_between(x: DVec3, y: DVec3) -> f64 {
-    x.cross(y).length().atan2(x.dot(y))
 }
 
 /// The first, cheap half of [`SphericalTriangle::new`]: the vertex directions and the solid
@@ -89,7 +88,9 @@ impl SphericalProjection {
         if !(area64 >= SphericalTriangle::MIN_SOLID_ANGLE && area64.is_finite()) {
             return None;
         }
-        let alpha = angle_between(tangent(da, db)?, tangent(da, dc)?);
+        let (t_ab, t_ac) = (tangent(da, db)?, tangent(da, dc)?);
+        // α = angle between the two unit tangents: its cosine and sine directly.
+        let (cos_alpha, sin_alpha) = (t_ab.dot(t_ac), t_ab.cross(t_ac).length());
         let triple = da.dot(db.cross(dc));
         Some(SphericalTriangle {
             a: da.as_vec3(),
@@ -100,7 +101,9 @@ impl SphericalProjection {
             db,
             dc,
             area64,
-            alpha,
+            cos_alpha,
+            sin_alpha,
+            c_perp: t_ac,
             orientation: if triple >= 0.0 { 1.0 } else { -1.0 },
         })
     }
@@ -120,8 +123,11 @@ impl SphericalTriangle {
     pub fn sample(&self, u: Vec2) -> Vec3 {
         let (a, b) = (self.da, self.db);
         let sub_area = u.x as f64 * self.area64;
-        let (s, t) = (sub_area - self.alpha).sin_cos();
-        let (sin_alpha, cos_alpha) = self.alpha.sin_cos();
+        let (sin_alpha, cos_alpha) = (self.sin_alpha, self.cos_alpha);
+        // (s, t) = (sin, cos) of (ξ₁Ω − α).
+        let (sin_sub, cos_sub) = sub_area.sin_cos();
+        let s = sin_sub * cos_alpha - cos_sub * sin_alpha;
+        let t = cos_sub * cos_alpha + sin_sub * sin_alpha;
         let uu = t - cos_alpha;
         let v = s + sin_alpha * a.dot(b);
         // q = cos of the arc from A to Ĉ, the far vertex of the sub-triangle of area ξ₁·Ω.
@@ -131,7 +137,7 @@ impl SphericalTriangle {
         } else {
             1.0
         };
-        let c_perp = tangent(a, self.dc).unwrap_or(DVec3::ZERO);
+        let c_perp = self.c_perp;
         let c_hat = (a * q + c_perp * (1.0 - q * q).max(0.0).sqrt()).normalize();
         // cos of the arc from B is uniform between Ĉ·B and 1.
         let z = 1.0 - u.y as f64 * (1.0 - c_hat.dot(b));
