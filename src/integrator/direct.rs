@@ -53,12 +53,36 @@ pub struct DirectLighting<'a> {
     pub mis_light: SamplingMode,
 }
 
-/// Where the samples of one eye ray come from.
-#[derive(Clone, Copy)]
-struct SampleIndex<'p> {
-    px: &'p PixelSamples,
-    index: u32,
-    count: u32,
+/// The pattern values one light sample and one BSDF sample consume, drawn together up front:
+/// the permutation hash chains of the four dimensions are independent, so evaluating them
+/// back to back lets the CPU overlap them instead of waiting on each behind a ray query.
+#[derive(Clone, Copy, Default)]
+struct Draws {
+    /// Light-selection number (`DIM_LIGHT_SELECT`).
+    light_select: f32,
+    /// Point on the light (`DIM_LIGHT`).
+    light: Vec2,
+    /// Lobe choice (`DIM_LOBE`).
+    lobe: f32,
+    /// BSDF direction (`DIM_BSDF`).
+    bsdf: Vec2,
+}
+
+impl Draws {
+    /// The draws of sample `index` of `count`; only the dimensions the strategy reads.
+    #[inline]
+    fn new(px: &PixelSamples, index: u32, count: u32, light: bool, bsdf: bool) -> Self {
+        let mut d = Draws::default();
+        if light {
+            d.light_select = px.sample_1d(DIM_LIGHT_SELECT, index, count);
+            d.light = px.sample_2d(DIM_LIGHT, index, count);
+        }
+        if bsdf {
+            d.lobe = px.sample_1d(DIM_LOBE, index, count);
+            d.bsdf = px.sample_2d(DIM_BSDF, index, count);
+        }
+        d
+    }
 }
 
 /// The shading state at a camera-ray hit.
@@ -133,22 +157,20 @@ impl<'a> DirectLighting<'a> {
         };
         let m = self.shadow_rays.max(1);
         let count = self.eye_rays.max(1) * m;
+        let (use_light, use_bsdf) = match self.strategy {
+            Strategy::LightArea | Strategy::LightSolidAngle => (true, false),
+            Strategy::Bsdf => (false, true),
+            Strategy::Mis => (true, true),
+        };
+        let mis = self.strategy == Strategy::Mis;
         let mut sum = Rgb::ZERO;
         for j in 0..m {
-            let si = SampleIndex {
-                px,
-                index: eye * m + j,
-                count,
-            };
-            match self.strategy {
-                Strategy::LightArea | Strategy::LightSolidAngle => {
-                    sum += self.light_sample(&sh, si, false, &mut rays);
-                }
-                Strategy::Bsdf => sum += self.bsdf_sample(&sh, si, false, &mut rays),
-                Strategy::Mis => {
-                    sum += self.light_sample(&sh, si, true, &mut rays);
-                    sum += self.bsdf_sample(&sh, si, true, &mut rays);
-                }
+            let d = Draws::new(px, eye * m + j, count, use_light, use_bsdf);
+            if use_light {
+                sum += self.light_sample(&sh, &d, mis, &mut rays);
+            }
+            if use_bsdf {
+                sum += self.bsdf_sample(&sh, &d, mis, &mut rays);
             }
         }
         l += sum / m as f32;
@@ -166,14 +188,12 @@ impl<'a> DirectLighting<'a> {
     }
 
     /// One light-sampling estimate f·Li·cos / (pmf·pdf), MIS-weighted when `mis`.
-    fn light_sample(&self, sh: &Shading, si: SampleIndex<'_>, mis: bool, rays: &mut u64) -> Rgb {
-        let uc = si.px.sample_1d(DIM_LIGHT_SELECT, si.index, si.count);
-        let Some(sel) = self.selector.sample(&sh.sp, uc) else {
+    fn light_sample(&self, sh: &Shading, d: &Draws, mis: bool, rays: &mut u64) -> Rgb {
+        let Some(sel) = self.selector.sample(&sh.sp, d.light_select) else {
             return Rgb::ZERO;
         };
         let light = &self.scene.lights[sel.index as usize];
-        let u = si.px.sample_2d(DIM_LIGHT, si.index, si.count);
-        let Some(ls) = light.sample_li(&sh.ctx, u, self.mode()) else {
+        let Some(ls) = light.sample_li(&sh.ctx, d.light, self.mode()) else {
             return Rgb::ZERO;
         };
         if !(ls.pdf > 0.0) || sel.pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(sh.ng) <= 0.0 {
@@ -202,10 +222,8 @@ impl<'a> DirectLighting<'a> {
     }
 
     /// One BSDF-sampling estimate f·cos·Le / pdf, MIS-weighted when `mis`.
-    fn bsdf_sample(&self, sh: &Shading, si: SampleIndex<'_>, mis: bool, rays: &mut u64) -> Rgb {
-        let uc = si.px.sample_1d(DIM_LOBE, si.index, si.count);
-        let u = si.px.sample_2d(DIM_BSDF, si.index, si.count);
-        let Some(bs) = sh.bsdf.sample(sh.wo_local, uc, u) else {
+    fn bsdf_sample(&self, sh: &Shading, d: &Draws, mis: bool, rays: &mut u64) -> Rgb {
+        let Some(bs) = sh.bsdf.sample(sh.wo_local, d.lobe, d.bsdf) else {
             return Rgb::ZERO;
         };
         if !(bs.pdf > 0.0) {
