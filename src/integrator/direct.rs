@@ -118,6 +118,17 @@ impl<'a> DirectLighting<'a> {
     /// (from [`SamplePattern::pixel`]); also returns the number of rays traced.
     pub fn li(&self, px: &PixelSamples, eye: u32, ray: &Ray) -> (Rgb, u64) {
         let scene = self.scene;
+        let m = self.shadow_rays.max(1);
+        let count = self.eye_rays.max(1) * m;
+        let (use_light, use_bsdf) = match self.strategy {
+            Strategy::LightArea | Strategy::LightSolidAngle => (true, false),
+            Strategy::Bsdf => (false, true),
+            Strategy::Mis => (true, true),
+        };
+        // The first sample's draws are pure arithmetic that does not depend on the hit: issued
+        // before the camera ray's traversal, they overlap with its memory-bound work (wasted
+        // only for camera rays that escape).
+        let first = Draws::new(px, eye * m, count, use_light, use_bsdf);
         let Some(hit) = scene.geometry.intersect(ray) else {
             return (self.escaped(ray.d), 1);
         };
@@ -155,17 +166,14 @@ impl<'a> DirectLighting<'a> {
             },
             hit,
         };
-        let m = self.shadow_rays.max(1);
-        let count = self.eye_rays.max(1) * m;
-        let (use_light, use_bsdf) = match self.strategy {
-            Strategy::LightArea | Strategy::LightSolidAngle => (true, false),
-            Strategy::Bsdf => (false, true),
-            Strategy::Mis => (true, true),
-        };
         let mis = self.strategy == Strategy::Mis;
         let mut sum = Rgb::ZERO;
         for j in 0..m {
-            let d = Draws::new(px, eye * m + j, count, use_light, use_bsdf);
+            let d = if j == 0 {
+                first
+            } else {
+                Draws::new(px, eye * m + j, count, use_light, use_bsdf)
+            };
             if use_light {
                 sum += self.light_sample(&sh, &d, mis, &mut rays);
             }
