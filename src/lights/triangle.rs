@@ -81,8 +81,7 @@ impl LightSource for TriangleLight {
         if let Some(proj) = proj {
             let omega = proj.solid_angle() as f32;
             if spherical_ok(omega) {
-                let st = proj.sampler()?;
-                let wi = st.sample(u);
+                let wi = proj.sample(u)?;
                 // Where the sampled direction meets the triangle's plane (the shadow-ray target).
                 let denom = self.n.dot(wi);
                 let t = self.n.dot(self.p[0] - ctx.p) / denom;

@@ -24,12 +24,8 @@ pub struct SphericalTriangle {
     dc: DVec3,
     /// Solid angle in f64.
     area64: f64,
-    /// cos and sin of the interior angle α at A (Arvo needs only these and sin(ξ₁Ω − α),
-    /// which the angle-difference identity gives without an atan2 and a second sincos).
-    cos_alpha: f64,
-    sin_alpha: f64,
-    /// Unit tangent at A of the arc AC (where the sub-triangle's far vertex Ĉ moves).
-    c_perp: DVec3,
+    /// What [`Self::sample`] needs.
+    arvo: Arvo,
     /// +1 or −1: orientation of (a, b, c), for the inside test.
     orientation: f64,
 }
@@ -81,16 +77,38 @@ impl SphericalProjection {
         self.area64
     }
 
-    /// The sampler of this triangle; `None` if it is too small or degenerate to sample.
-    #[inline]
-    pub fn sampler(self) -> Option<SphericalTriangle> {
-        let Self { da, db, dc, area64 } = self;
+    /// The sampler's state, without the inside-test data (`None` as for [`Self::sampler`]).
+    #[inline(always)]
+    fn arvo(&self) -> Option<Arvo> {
+        let Self { da, db, dc, area64 } = *self;
         if !(area64 >= SphericalTriangle::MIN_SOLID_ANGLE && area64.is_finite()) {
             return None;
         }
         let (t_ab, t_ac) = (tangent(da, db)?, tangent(da, dc)?);
         // α = angle between the two unit tangents: its cosine and sine directly.
         let (cos_alpha, sin_alpha) = (t_ab.dot(t_ac), t_ab.cross(t_ac).length());
+        Some(Arvo {
+            a: da,
+            b: db,
+            area64,
+            cos_alpha,
+            sin_alpha,
+            c_perp: t_ac,
+        })
+    }
+
+    /// One direction drawn as [`SphericalTriangle::sample`] draws it, without building the
+    /// whole sampler (the hot path of triangle lights: one sample per projection).
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> Option<Vec3> {
+        Some(self.arvo()?.sample(u))
+    }
+
+    /// The sampler of this triangle; `None` if it is too small or degenerate to sample.
+    #[inline]
+    pub fn sampler(self) -> Option<SphericalTriangle> {
+        let arvo = self.arvo()?;
+        let Self { da, db, dc, area64 } = self;
         let triple = da.dot(db.cross(dc));
         Some(SphericalTriangle {
             a: da.as_vec3(),
@@ -101,27 +119,33 @@ impl SphericalProjection {
             db,
             dc,
             area64,
-            cos_alpha,
-            sin_alpha,
-            c_perp: t_ac,
+            arvo,
             orientation: if triple >= 0.0 { 1.0 } else { -1.0 },
         })
     }
 }
 
-impl SphericalTriangle {
-    /// Smallest solid angle (sr) this sampler accepts: below it f64 Arvo loses accuracy, and
-    /// callers should sample by area instead.
-    pub const MIN_SOLID_ANGLE: f64 = 1e-10;
+/// The state of Arvo's inversion for one triangle.
+#[derive(Clone, Copy, Debug)]
+struct Arvo {
+    /// Vertex directions A and B.
+    a: DVec3,
+    b: DVec3,
+    /// Solid angle.
+    area64: f64,
+    /// cos and sin of the interior angle α at A (Arvo needs only these and sin(ξ₁Ω − α),
+    /// which the angle-difference identity gives without an atan2 and a second sincos).
+    cos_alpha: f64,
+    sin_alpha: f64,
+    /// Unit tangent at A of the arc AC (where the sub-triangle's far vertex Ĉ moves).
+    c_perp: DVec3,
+}
 
-    /// Project triangle (v0, v1, v2) onto the unit sphere around `p`; `None` if degenerate.
-    pub fn new(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<Self> {
-        SphericalProjection::new(p, v0, v1, v2)?.sampler()
-    }
-
-    /// Unit direction uniformly distributed in the spherical triangle; pdf = 1/area.
-    pub fn sample(&self, u: Vec2) -> Vec3 {
-        let (a, b) = (self.da, self.db);
+impl Arvo {
+    /// Unit direction uniformly distributed in the spherical triangle.
+    #[inline]
+    fn sample(&self, u: Vec2) -> Vec3 {
+        let (a, b) = (self.a, self.b);
         let sub_area = u.x as f64 * self.area64;
         let (sin_alpha, cos_alpha) = (self.sin_alpha, self.cos_alpha);
         // (s, t) = (sin, cos) of (ξ₁Ω − α).
@@ -149,6 +173,22 @@ impl SphericalTriangle {
         };
         // Unit up to f64 rounding (b ⟂ t, z² + (1 − z²) = 1), far below the f32 result's ulp.
         dir.as_vec3()
+    }
+}
+
+impl SphericalTriangle {
+    /// Smallest solid angle (sr) this sampler accepts: below it f64 Arvo loses accuracy, and
+    /// callers should sample by area instead.
+    pub const MIN_SOLID_ANGLE: f64 = 1e-10;
+
+    /// Project triangle (v0, v1, v2) onto the unit sphere around `p`; `None` if degenerate.
+    pub fn new(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<Self> {
+        SphericalProjection::new(p, v0, v1, v2)?.sampler()
+    }
+
+    /// Unit direction uniformly distributed in the spherical triangle; pdf = 1/area.
+    pub fn sample(&self, u: Vec2) -> Vec3 {
+        self.arvo.sample(u)
     }
 
     /// Inverse of [`Self::sample`] for a direction inside the triangle.
