@@ -290,13 +290,13 @@ pub fn balance_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
 /// pdf(x) = (r − |x|)/r².
 #[inline]
 pub fn tent(u: f32, r: f32) -> f32 {
-    if u < 0.5 {
-        let v = 2.0 * u;
-        -r * (1.0 - v.sqrt())
-    } else {
-        let v = 2.0 * u - 1.0;
-        r * (1.0 - (1.0 - v).sqrt())
-    }
+    // Both halves as one computation with selects instead of a branch: the pixel filter draws
+    // u uniformly, so a branch on u < 0.5 mispredicts half the time. Same values bit for bit:
+    // w is 2u (left) or 1 − (2u − 1) (right), and −r·x = −(r·x) exactly.
+    let left = u < 0.5;
+    let w = if left { 2.0 * u } else { 1.0 - (2.0 * u - 1.0) };
+    let m = r * (1.0 - w.sqrt());
+    if left { -m } else { m }
 }
 
 /// Pdf of [`tent`].
