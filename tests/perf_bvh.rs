@@ -3,9 +3,11 @@
 //! brute-force loop over all primitives exactly; obvhs may miss rare hits a few ulps from the
 //! ray origin (its box test is not conservative there), so it only has to agree on ≥ 99.9%.
 
+mod geometry_support;
+
+use geometry_support::{brute_force_t, random_rays};
 use glam::{UVec2, Vec3};
-use penumbra::geometry::triangle::intersect_triangle;
-use penumbra::geometry::{Backend, Geometry, MeshShading, PrimKind, Primitive, Ray, RayQuery};
+use penumbra::geometry::{Backend, Geometry, MeshShading, PrimKind, Primitive, RayQuery};
 use penumbra::sampling::{PatternKind, make_pattern};
 
 /// A backend-independent name of a primitive: (mesh, vertex indices) or the quadric index.
@@ -17,39 +19,13 @@ fn identity(g: &Geometry, id: u32) -> (u32, [u32; 3]) {
     }
 }
 
-/// Uniform random rays from points in the (enlarged) scene box, some of them finite.
-fn rays(bounds: (Vec3, Vec3), n: u32) -> Vec<Ray> {
-    let pat = make_pattern(PatternKind::Random, 11);
-    let (lo, hi) = bounds;
-    let ext = hi - lo;
-    (0..n)
-        .map(|i| {
-            let px = UVec2::new(i, 0);
-            let a = pat.sample_2d(px, 0, 0, 1);
-            let b = pat.sample_2d(px, 1, 0, 1);
-            let c = pat.sample_2d(px, 2, 0, 1);
-            let o = lo - 0.1 * ext + 1.2 * ext * Vec3::new(a.x, a.y, b.x);
-            let z = 1.0 - 2.0 * b.y;
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let phi = std::f32::consts::TAU * c.x;
-            let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            let t_max = if i % 3 == 0 {
-                c.y * ext.length()
-            } else {
-                f32::INFINITY
-            };
-            Ray { o, d, t_max }
-        })
-        .collect()
-}
-
 fn check_agreement(g: &Geometry, n: u32) {
     let own = g.rebuild(Backend::Own);
     let obvhs = g.rebuild(Backend::Obvhs);
     assert_eq!(own.backend(), Some(Backend::Own));
     assert_eq!(obvhs.backend(), Some(Backend::Obvhs));
     let (mut hits, mut ties, mut blocked, mut differ) = (0u32, 0u32, 0u32, 0u32);
-    for ray in rays(g.bounds(), n) {
+    for ray in random_rays(g.bounds(), n, 11) {
         let (a, b) = (own.intersect(&ray), obvhs.intersect(&ray));
         if let Some(a) = &a {
             assert_eq!(
@@ -84,15 +60,6 @@ fn check_agreement(g: &Geometry, n: u32) {
         "{n} rays: {hits} hits ({ties} ties on equal t), {blocked} blocked, {differ} obvhs differences"
     );
     assert!(hits > n / 10 && ties < n / 1000 && differ < n / 1000);
-}
-
-/// Closest t over every (triangle) primitive.
-fn brute_force_t(g: &Geometry, ray: &Ray) -> Option<f32> {
-    (0..g.len() as u32)
-        .filter_map(|id| g.primitive(id))
-        .filter_map(|p| intersect_triangle(ray.o, ray.d, ray.t_max, p.p))
-        .map(|(t, ..)| t)
-        .min_by(f32::total_cmp)
 }
 
 #[test]

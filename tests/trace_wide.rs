@@ -3,53 +3,15 @@
 //! the Cornell box, a random triangle soup mixed with spheres and disks, and the
 //! shared-edge/vertex-heavy `dense` mesh (watertightness through the packet test).
 
+mod geometry_support;
+
+use geometry_support::{brute_force_t, random_rays};
 use glam::{UVec2, Vec3};
-use penumbra::geometry::triangle::intersect_triangle;
 use penumbra::geometry::{
     Backend, Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Ray, RayQuery,
     Transform,
 };
 use penumbra::sampling::{PatternKind, make_pattern};
-
-/// Uniform random rays from points in the (enlarged) scene box, a third of them finite.
-fn rays(bounds: (Vec3, Vec3), n: u32, seed: u64) -> Vec<Ray> {
-    let pat = make_pattern(PatternKind::Random, seed);
-    let (lo, hi) = bounds;
-    let ext = hi - lo;
-    (0..n)
-        .map(|i| {
-            let px = UVec2::new(i, 0);
-            let a = pat.sample_2d(px, 0, 0, 1);
-            let b = pat.sample_2d(px, 1, 0, 1);
-            let c = pat.sample_2d(px, 2, 0, 1);
-            let o = lo - 0.1 * ext + 1.2 * ext * Vec3::new(a.x, a.y, b.x);
-            let z = 1.0 - 2.0 * b.y;
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let phi = std::f32::consts::TAU * c.x;
-            let d = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            let t_max = if i % 3 == 0 {
-                c.y * ext.length()
-            } else {
-                f32::INFINITY
-            };
-            Ray { o, d, t_max }
-        })
-        .collect()
-}
-
-/// Closest t over every primitive, tested one by one.
-fn brute_force_t(g: &Geometry, ray: &Ray) -> Option<f32> {
-    (0..g.len() as u32)
-        .filter_map(|id| g.primitive(id))
-        .filter_map(|p| match p.kind {
-            PrimKind::Triangle { .. } => intersect_triangle(ray.o, ray.d, ray.t_max, p.p),
-            PrimKind::Quadric(q) => g.quadrics[q as usize]
-                .intersect_t(ray.o, ray.d, ray.t_max)
-                .map(|t| (t, 0.0, 0.0, 0.0)),
-        })
-        .map(|(t, ..)| t)
-        .min_by(f32::total_cmp)
-}
 
 /// Checks the wide backend ray by ray; returns (hits, ties on equal t with a different prim).
 fn check(g: &Geometry, rays: &[Ray], brute: bool) -> (u32, u32) {
@@ -101,7 +63,7 @@ fn wide_matches_brute_force_on_cornell() {
         .expect("cornell")
         .scene
         .geometry;
-    let rays = rays(g.bounds(), 50_000, 3);
+    let rays = random_rays(g.bounds(), 50_000, 3);
     let (hits, ties) = check(&g, &rays, true);
     eprintln!("cornell: {hits} hits, {ties} ties");
     assert!(hits > 20_000 && ties < 50);
@@ -156,7 +118,7 @@ fn wide_matches_brute_force_on_triangles_spheres_and_disks() {
         });
     }
     let g = Geometry::new(prims, vec![MeshShading::default()], quadrics);
-    let rays = rays(g.bounds(), 30_000, 7);
+    let rays = random_rays(g.bounds(), 30_000, 7);
     let (hits, ties) = check(&g, &rays, true);
     eprintln!("soup: {hits} hits, {ties} ties");
     assert!(hits > 3_000 && ties < 30);
@@ -238,7 +200,7 @@ fn wide_handles_coincident_and_degenerate_triangles() {
         });
     }
     let g = Geometry::new(prims, vec![MeshShading::default()], Vec::new());
-    let rays = rays(g.bounds(), 5_000, 13);
+    let rays = random_rays(g.bounds(), 5_000, 13);
     let (hits, _) = check(&g, &rays, true);
     assert!(hits > 100, "{hits} hits");
 }

@@ -1,0 +1,42 @@
+//! Shared by the BVH tests: random query rays and the brute-force closest hit they are judged by.
+
+use glam::{UVec2, Vec2, Vec3};
+use penumbra::geometry::triangle::intersect_triangle;
+use penumbra::geometry::{Geometry, PrimKind, Ray};
+use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere};
+
+/// Uniform random rays from points in the (enlarged) scene box, a third of them finite.
+pub fn random_rays(bounds: (Vec3, Vec3), n: u32, seed: u64) -> Vec<Ray> {
+    let pat = make_pattern(PatternKind::Random, seed);
+    let (lo, hi) = bounds;
+    let ext = hi - lo;
+    (0..n)
+        .map(|i| {
+            let px = UVec2::new(i, 0);
+            let a = pat.sample_2d(px, 0, 0, 1);
+            let b = pat.sample_2d(px, 1, 0, 1);
+            let c = pat.sample_2d(px, 2, 0, 1);
+            let o = lo - 0.1 * ext + 1.2 * ext * Vec3::new(a.x, a.y, b.x);
+            let d = uniform_sphere(Vec2::new(b.y, c.x));
+            let t_max = if i % 3 == 0 {
+                c.y * ext.length()
+            } else {
+                f32::INFINITY
+            };
+            Ray { o, d, t_max }
+        })
+        .collect()
+}
+
+/// Closest t over every primitive (triangles and quadrics), tested one by one.
+pub fn brute_force_t(g: &Geometry, ray: &Ray) -> Option<f32> {
+    (0..g.len() as u32)
+        .filter_map(|id| g.primitive(id))
+        .filter_map(|p| match p.kind {
+            PrimKind::Triangle { .. } => {
+                intersect_triangle(ray.o, ray.d, ray.t_max, p.p).map(|(t, ..)| t)
+            }
+            PrimKind::Quadric(q) => g.quadrics[q as usize].intersect_t(ray.o, ray.d, ray.t_max),
+        })
+        .min_by(f32::total_cmp)
+}
