@@ -8,7 +8,7 @@
 
 use super::{MisHeuristic, Strategy};
 use crate::Rgb;
-use crate::bsdf::{Bsdf, Bxdf, LobeSampling};
+use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::{Ray, RayQuery, SurfaceHit};
 use crate::light_selection::{LightSelector, ShadingPoint};
@@ -253,21 +253,13 @@ impl<'a> DirectLighting<'a> {
         // estimator without a closest-hit query for the many rays that miss every light.
         *rays += 1;
         let ray = Ray::new(sh.hit.spawn_origin(wi), wi);
-        let mode = self.mode();
         if let Some(h) = self.scene.emitters.intersect(&ray) {
             let light = &self.scene.lights[h.light as usize];
             let le = light.radiance(h.p, h.ng, h.uv, -wi);
             if le == Rgb::ZERO || self.scene.geometry.occluded(&shadow_ray(&sh.hit, h.p)) {
                 return Rgb::ZERO;
             }
-            let w = if mis && !bs.delta {
-                let pdf_l =
-                    self.selector.pmf(&sh.sp, h.light) * light.pdf_li(&sh.ctx, wi, h.p, h.ng, mode);
-                self.heuristic(bs.pdf, pdf_l)
-            } else {
-                1.0
-            };
-            return weight * le * w;
+            return weight * le * self.bsdf_mis_weight(sh, &bs, mis, h.light, wi, h.p, h.ng);
         }
         if self.scene.infinite_lights.is_empty() || self.scene.geometry.occluded(&ray) {
             return Rgb::ZERO;
@@ -279,16 +271,29 @@ impl<'a> DirectLighting<'a> {
             if le == Rgb::ZERO {
                 continue;
             }
-            let w = if mis && !bs.delta {
-                let pdf_l = self.selector.pmf(&sh.sp, i)
-                    * light.pdf_li(&sh.ctx, wi, Vec3::ZERO, Vec3::ZERO, mode);
-                self.heuristic(bs.pdf, pdf_l)
-            } else {
-                1.0
-            };
-            sum += le * w;
+            sum += le * self.bsdf_mis_weight(sh, &bs, mis, i, wi, Vec3::ZERO, Vec3::ZERO);
         }
         weight * sum
+    }
+    /// MIS weight of BSDF sample `bs` that reached light `light` at (p, n) along `wi`
+    /// (1 without MIS and for delta lobes, which light sampling cannot produce).
+    #[allow(clippy::too_many_arguments)]
+    fn bsdf_mis_weight(
+        &self,
+        sh: &Shading,
+        bs: &BsdfSample,
+        mis: bool,
+        light: u32,
+        wi: Vec3,
+        p: Vec3,
+        n: Vec3,
+    ) -> f32 {
+        if !mis || bs.delta {
+            return 1.0;
+        }
+        let pdf_l = self.selector.pmf(&sh.sp, light)
+            * self.scene.lights[light as usize].pdf_li(&sh.ctx, wi, p, n, self.mode());
+        self.heuristic(bs.pdf, pdf_l)
     }
 }
 
