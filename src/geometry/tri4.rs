@@ -212,19 +212,13 @@ impl RayShear4 {
 mod tests {
     use super::*;
     use crate::geometry::triangle::intersect_triangle;
-
-    /// A tiny deterministic generator (tests only need varied inputs, not statistics).
-    fn lcg(state: &mut u64) -> f32 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 40) as f32 / (1u64 << 24) as f32
-    }
+    use crate::sampling::hash::{next_f32, pcg_from_keys};
+    use rand_pcg::Pcg32;
 
     #[test]
     fn lanes_match_the_scalar_test_bit_for_bit() {
-        let mut s = 7u64;
-        let rnd3 = |s: &mut u64| Vec3::new(lcg(s), lcg(s), lcg(s)) * 2.0 - 1.0;
+        let mut s = pcg_from_keys(&[7]);
+        let rnd3 = |s: &mut Pcg32| Vec3::new(next_f32(s), next_f32(s), next_f32(s)) * 2.0 - 1.0;
         let (mut hits, mut checked) = (0, 0);
         for _ in 0..20_000 {
             let mut pk = TriPacket::EMPTY;
@@ -239,13 +233,13 @@ mod tests {
             pk.set_triangle(3, 3, p);
             tris.push(p);
             let o = rnd3(&mut s) * 2.0;
-            let d = if lcg(&mut s) < 0.2 {
+            let d = if next_f32(&mut s) < 0.2 {
                 // Rays through a shared vertex.
                 tris[0][0] - o
             } else {
                 rnd3(&mut s)
             };
-            let t_max = if lcg(&mut s) < 0.5 {
+            let t_max = if next_f32(&mut s) < 0.5 {
                 f32::INFINITY
             } else {
                 3.0

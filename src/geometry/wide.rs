@@ -363,19 +363,13 @@ mod tests {
     use super::*;
     use crate::geometry::bvh::Bvh;
     use crate::geometry::triangle::intersect_triangle;
-
-    /// A tiny deterministic generator (tests only need varied inputs, not statistics).
-    fn lcg(state: &mut u64) -> f32 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 40) as f32 / (1u64 << 24) as f32
-    }
+    use crate::sampling::hash::{next_f32, pcg_from_keys};
+    use rand_pcg::Pcg32;
 
     #[test]
     fn both_binary_trees_collapse_to_correct_wide_trees() {
-        let mut s = 3u64;
-        let rnd3 = |s: &mut u64| Vec3::new(lcg(s), lcg(s), lcg(s)) * 10.0;
+        let mut s = pcg_from_keys(&[3]);
+        let rnd3 = |s: &mut Pcg32| Vec3::new(next_f32(s), next_f32(s), next_f32(s)) * 10.0;
         let prims: Vec<Primitive> = (0..500u32)
             .map(|i| {
                 let p0 = rnd3(&mut s);
