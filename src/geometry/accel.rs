@@ -206,21 +206,16 @@ impl Geometry {
                 Some((t, b0, b1, b2)) => (t, [b0, b1, b2]),
                 None => (f32::INFINITY, NO_BARY),
             },
-            PrimKind::Quadric(q) => (
-                self.quadrics[q as usize]
-                    .intersect_t(o, d, t_max)
-                    .unwrap_or(f32::INFINITY),
-                NO_BARY,
-            ),
+            PrimKind::Quadric(_) => (self.quadric_t(id, o, d, t_max), NO_BARY),
         }
     }
 
     /// Hit distance of non-triangle primitive `id` below `t_max`, or +∞.
     #[inline(always)]
-    fn quadric_t(&self, id: usize, ray: &Ray, t_max: f32) -> f32 {
+    fn quadric_t(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
         match self.prims[id].kind {
             PrimKind::Quadric(q) => self.quadrics[q as usize]
-                .intersect_t(ray.o, ray.d, t_max)
+                .intersect_t(o, d, t_max)
                 .unwrap_or(f32::INFINITY),
             PrimKind::Triangle { .. } => f32::INFINITY,
         }
@@ -364,7 +359,7 @@ impl RayQuery for Geometry {
         let (id, t, b) = match &self.accel {
             // The wide BVH tests triangles itself; only quadrics come back here.
             Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                self.quadric_t(id, ray, t_max)
+                self.quadric_t(id, ray.o, ray.d, t_max)
             })?,
             _ => self.closest_by_callback(ray)?,
         };
@@ -376,7 +371,7 @@ impl RayQuery for Geometry {
         match &self.accel {
             Accel::None => false,
             Accel::Wide(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.quadric_t(id, ray, ray.t_max) < ray.t_max
+                self.quadric_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
             }),
             Accel::Own(bvh) => {
                 let shear = shear();
