@@ -176,6 +176,13 @@ macro_rules! dispatch {
 }
 
 impl Bsdf {
+    /// `(f(wo, wi), pdf(wo, wi))` in one dispatch: MIS light sampling needs both for the same
+    /// pair, and one call instead of two saves a call and a match per light sample.
+    #[inline]
+    pub fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        dispatch!(self, b => (b.f(wo, wi), b.pdf(wo, wi)))
+    }
+
     /// Choose how every non-delta lobe is sampled (the lab's I₁/I₂ comparison); delta BSDFs
     /// ignore it because a delta lobe can only be sampled one way.
     pub fn set_sampling(&mut self, s: LobeSampling) {

@@ -11,7 +11,7 @@ use crate::Rgb;
 use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::{Ray, RayQuery, SurfaceHit};
-use crate::light_selection::{LightSelector, ShadingPoint};
+use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode};
 use crate::sampling::{Frame, PixelSamples, SamplePattern, balance_heuristic, power_heuristic};
 use crate::scene::Scene;
@@ -85,15 +85,31 @@ impl Draws {
     }
 }
 
-/// The shading state at a camera-ray hit.
-struct Shading {
-    hit: SurfaceHit,
+/// The shading state at a camera-ray hit (the hit is borrowed, not copied: it is large and
+/// the samples read only a few of its fields).
+struct Shading<'h> {
+    hit: &'h SurfaceHit,
     bsdf: Bsdf,
     frame: Frame,
     wo_local: Vec3,
-    ng: Vec3,
+    /// World-space direction toward the viewer (for selectors that need a [`ShadingPoint`]).
+    wo: Vec3,
+    /// The hit point and the geometric normal flipped toward the viewer.
     ctx: LightSampleContext,
-    sp: ShadingPoint,
+    /// `Some(n)` when light selection is uniform over `n` lights (picked inline).
+    uniform: Option<u32>,
+}
+
+impl Shading<'_> {
+    /// The selector's view of this shading point, built only for selectors that read it.
+    #[inline]
+    fn shading_point(&self) -> ShadingPoint {
+        ShadingPoint {
+            p: self.ctx.p,
+            n: self.ctx.n,
+            wo: self.wo,
+        }
+    }
 }
 
 impl<'a> DirectLighting<'a> {
@@ -157,14 +173,14 @@ impl<'a> DirectLighting<'a> {
             bsdf,
             wo_local: frame.to_local(wo),
             frame,
-            ng,
+            wo,
             ctx: LightSampleContext { p: hit.p, n: ng },
-            sp: ShadingPoint {
-                p: hit.p,
-                n: ng,
-                wo,
+            uniform: if use_light {
+                self.selector.uniform_count()
+            } else {
+                None
             },
-            hit,
+            hit: &hit,
         };
         let mis = self.strategy == Strategy::Mis;
         let mut sum = Rgb::ZERO;
@@ -197,18 +213,30 @@ impl<'a> DirectLighting<'a> {
 
     /// One light-sampling estimate f·Li·cos / (pmf·pdf), MIS-weighted when `mis`.
     fn light_sample(&self, sh: &Shading, d: &Draws, mis: bool, rays: &mut u64) -> Rgb {
-        let Some(sel) = self.selector.sample(&sh.sp, d.light_select) else {
+        let sel = match sh.uniform {
+            Some(count) => UniformSelector::pick(count, d.light_select),
+            None => self.selector.sample(&sh.shading_point(), d.light_select),
+        };
+        let Some(SelectedLight { index, pmf }) = sel else {
             return Rgb::ZERO;
         };
-        let light = &self.scene.lights[sel.index as usize];
+        let light = &self.scene.lights[index as usize];
         let Some(ls) = light.sample_li(&sh.ctx, d.light, self.mode()) else {
             return Rgb::ZERO;
         };
-        if !(ls.pdf > 0.0) || sel.pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(sh.ng) <= 0.0 {
+        if !(ls.pdf > 0.0) || pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(sh.ctx.n) <= 0.0 {
             return Rgb::ZERO;
         }
         let wi_local = sh.frame.to_local(ls.wi);
-        let f = sh.bsdf.f(sh.wo_local, wi_local) * wi_local.z.abs();
+        // Under MIS the BSDF pdf is needed too: one dispatch evaluates both (for the few
+        // occluded samples it is wasted, cheaper than a second call for all the others).
+        let weigh = mis && !ls.delta;
+        let (f, bsdf_pdf) = if weigh {
+            sh.bsdf.f_pdf(sh.wo_local, wi_local)
+        } else {
+            (sh.bsdf.f(sh.wo_local, wi_local), 0.0)
+        };
+        let f = f * wi_local.z.abs();
         if f == Rgb::ZERO {
             return Rgb::ZERO;
         }
@@ -216,13 +244,13 @@ impl<'a> DirectLighting<'a> {
         if self
             .scene
             .geometry
-            .occluded(&shadow_ray(&sh.hit, ls.p_light))
+            .occluded(&shadow_ray(sh.hit, ls.p_light))
         {
             return Rgb::ZERO;
         }
-        let pdf = sel.pmf * ls.pdf;
-        let w = if mis && !ls.delta {
-            self.heuristic(pdf, sh.bsdf.pdf(sh.wo_local, wi_local))
+        let pdf = pmf * ls.pdf;
+        let w = if weigh {
+            self.heuristic(pdf, bsdf_pdf)
         } else {
             1.0
         };
@@ -240,7 +268,7 @@ impl<'a> DirectLighting<'a> {
         let wi = sh.frame.to_world(bs.wi).normalize();
         // Only specular transmission (smooth glass) may leave below the geometric surface;
         // every other sample there is rejected exactly as light sampling rejects it.
-        if wi.dot(sh.ng) <= 0.0 && !bs.delta {
+        if wi.dot(sh.ctx.n) <= 0.0 && !bs.delta {
             return Rgb::ZERO;
         }
         let weight = bs.f * (bs.wi.z.abs() / bs.pdf);
@@ -256,7 +284,7 @@ impl<'a> DirectLighting<'a> {
         if let Some(h) = self.scene.emitters.intersect(&ray) {
             let light = &self.scene.lights[h.light as usize];
             let le = light.radiance(h.p, h.ng, h.uv, -wi);
-            if le == Rgb::ZERO || self.scene.geometry.occluded(&shadow_ray(&sh.hit, h.p)) {
+            if le == Rgb::ZERO || self.scene.geometry.occluded(&shadow_ray(sh.hit, h.p)) {
                 return Rgb::ZERO;
             }
             return weight * le * self.bsdf_mis_weight(sh, &bs, mis, h.light, wi, h.p, h.ng);
@@ -291,7 +319,8 @@ impl<'a> DirectLighting<'a> {
         if !mis || bs.delta {
             return 1.0;
         }
-        let pdf_l = self.selector.pmf(&sh.sp, light)
+        // Rare (emitter hits only): the plain virtual call, whatever the selector.
+        let pdf_l = self.selector.pmf(&sh.shading_point(), light)
             * self.scene.lights[light as usize].pdf_li(&sh.ctx, wi, p, n, self.mode());
         self.heuristic(bs.pdf, pdf_l)
     }

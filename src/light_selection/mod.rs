@@ -63,6 +63,12 @@ pub trait LightSelector: Send + Sync {
     fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32;
     /// Name as accepted by `--light-selection`.
     fn name(&self) -> &'static str;
+    /// `Some(n)` if this is [`UniformSelector`] over `n` lights, whose picks ignore the shading
+    /// point: the integrator then picks inline (same numbers) without building a
+    /// [`ShadingPoint`] or making a virtual call per sample.
+    fn uniform_count(&self) -> Option<u32> {
+        None
+    }
 }
 
 /// A strategy over the finite lights `0..n` (indices into [`LightSet::finite`]).

@@ -9,16 +9,25 @@ pub struct UniformSelector {
     pub count: u32,
 }
 
-impl LightSelector for UniformSelector {
-    fn sample(&self, _ctx: &ShadingPoint, u: f32) -> Option<SelectedLight> {
-        if self.count == 0 {
+impl UniformSelector {
+    /// The pick of `u` among `count` lights (`None` without lights): the one definition both
+    /// [`LightSelector::sample`] and the integrator's inline fast path use.
+    #[inline]
+    pub fn pick(count: u32, u: f32) -> Option<SelectedLight> {
+        if count == 0 {
             return None;
         }
-        let index = ((u * self.count as f32) as u32).min(self.count - 1);
+        let index = ((u * count as f32) as u32).min(count - 1);
         Some(SelectedLight {
             index,
-            pmf: 1.0 / self.count as f32,
+            pmf: 1.0 / count as f32,
         })
+    }
+}
+
+impl LightSelector for UniformSelector {
+    fn sample(&self, _ctx: &ShadingPoint, u: f32) -> Option<SelectedLight> {
+        Self::pick(self.count, u)
     }
 
     fn pmf(&self, _ctx: &ShadingPoint, light: u32) -> f32 {
@@ -31,5 +40,9 @@ impl LightSelector for UniformSelector {
 
     fn name(&self) -> &'static str {
         "uniform"
+    }
+
+    fn uniform_count(&self) -> Option<u32> {
+        Some(self.count)
     }
 }
