@@ -85,17 +85,19 @@ impl Draws {
     }
 }
 
-/// The shading state at a camera-ray hit (the hit is borrowed, not copied: it is large and
-/// the samples read only a few of its fields).
+/// The shading state at a camera-ray hit. The parts whose address goes to out-of-line calls
+/// (hit, BSDF, light context) are borrowed from separate locals: a struct with one field
+/// passed by address is kept whole in memory, so owning them would force every other field
+/// (frame, wo) through the stack too.
 struct Shading<'h> {
     hit: &'h SurfaceHit,
-    bsdf: Bsdf,
+    bsdf: &'h Bsdf,
+    /// The hit point and the geometric normal flipped toward the viewer.
+    ctx: &'h LightSampleContext,
     frame: Frame,
     wo_local: Vec3,
     /// World-space direction toward the viewer (for selectors that need a [`ShadingPoint`]).
     wo: Vec3,
-    /// The hit point and the geometric normal flipped toward the viewer.
-    ctx: LightSampleContext,
     /// `Some(n)` when light selection is uniform over `n` lights (picked inline).
     uniform: Option<u32>,
 }
@@ -169,12 +171,13 @@ impl<'a> DirectLighting<'a> {
         if self.bsdf_sampling != LobeSampling::Importance {
             bsdf.set_sampling(self.bsdf_sampling);
         }
+        let ctx = LightSampleContext { p: hit.p, n: ng };
         let sh = Shading {
-            bsdf,
+            bsdf: &bsdf,
             wo_local: frame.to_local(wo),
             frame,
             wo,
-            ctx: LightSampleContext { p: hit.p, n: ng },
+            ctx: &ctx,
             uniform: if use_light {
                 self.selector.uniform_count()
             } else {
@@ -221,7 +224,7 @@ impl<'a> DirectLighting<'a> {
             return Rgb::ZERO;
         };
         let light = &self.scene.lights[index as usize];
-        let Some(ls) = light.sample_li(&sh.ctx, d.light, self.mode()) else {
+        let Some(ls) = light.sample_li(sh.ctx, d.light, self.mode()) else {
             return Rgb::ZERO;
         };
         if !(ls.pdf > 0.0) || pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(sh.ctx.n) <= 0.0 {
@@ -321,7 +324,7 @@ impl<'a> DirectLighting<'a> {
         }
         // Rare (emitter hits only): the plain virtual call, whatever the selector.
         let pdf_l = self.selector.pmf(&sh.shading_point(), light)
-            * self.scene.lights[light as usize].pdf_li(&sh.ctx, wi, p, n, self.mode());
+            * self.scene.lights[light as usize].pdf_li(sh.ctx, wi, p, n, self.mode());
         self.heuristic(bs.pdf, pdf_l)
     }
 }
