@@ -63,7 +63,21 @@ pub enum Material {
 impl Material {
     /// The BSDF at a hit. `front` is true when the ray arrives on the side of `hit.ng`
     /// (transmissive materials need it to orient their index of refraction).
+    #[inline]
     pub fn bsdf(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
+        // The diffuse case (most surfaces of most scenes) is built inline at the hit, without
+        // a call that returns the BSDF through memory; every other material goes out of line.
+        match self {
+            Material::Diffuse { reflectance } => Bsdf::Lambert(Lambert::new(
+                reflectance.eval(hit.uv).clamp(Rgb::ZERO, Rgb::ONE),
+            )),
+            _ => self.bsdf_general(hit, front),
+        }
+    }
+
+    /// [`Material::bsdf`] for every material (the out-of-line path).
+    #[inline(never)]
+    fn bsdf_general(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
         let unit = |c: Rgb| c.clamp(Rgb::ZERO, Rgb::ONE);
         match self {
             Material::Diffuse { reflectance } => {
