@@ -60,6 +60,15 @@ pub enum Material {
     Mirror,
 }
 
+/// The Lambertian BSDF of a `diffuse` material (reflectance clamped to [0, 1]); inlined into the
+/// hot path of [`Material::bsdf`] and shared with its general arm.
+#[inline(always)]
+fn diffuse(reflectance: &Texture, hit: &SurfaceHit) -> Bsdf {
+    Bsdf::Lambert(Lambert::new(
+        reflectance.eval(hit.uv).clamp(Rgb::ZERO, Rgb::ONE),
+    ))
+}
+
 impl Material {
     /// The BSDF at a hit. `front` is true when the ray arrives on the side of `hit.ng`
     /// (transmissive materials need it to orient their index of refraction).
@@ -68,9 +77,7 @@ impl Material {
         // The diffuse case (most surfaces of most scenes) is built inline at the hit, without
         // a call that returns the BSDF through memory; every other material goes out of line.
         match self {
-            Material::Diffuse { reflectance } => Bsdf::Lambert(Lambert::new(
-                reflectance.eval(hit.uv).clamp(Rgb::ZERO, Rgb::ONE),
-            )),
+            Material::Diffuse { reflectance } => diffuse(reflectance, hit),
             _ => self.bsdf_general(hit, front),
         }
     }
@@ -78,11 +85,8 @@ impl Material {
     /// [`Material::bsdf`] for every material (the out-of-line path).
     #[inline(never)]
     fn bsdf_general(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
-        let unit = |c: Rgb| c.clamp(Rgb::ZERO, Rgb::ONE);
         match self {
-            Material::Diffuse { reflectance } => {
-                Bsdf::Lambert(Lambert::new(unit(reflectance.eval(hit.uv))))
-            }
+            Material::Diffuse { reflectance } => diffuse(reflectance, hit),
             Material::Phong { kd, ks, n } => Bsdf::Phong(Phong::clamped(kd.eval(hit.uv), *ks, *n)),
             Material::Conductor {
                 eta,
