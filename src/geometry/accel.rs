@@ -77,6 +77,9 @@ enum Accel {
 /// All scene geometry and its BVH.
 pub struct Geometry {
     prims: Vec<Primitive>,
+    /// Unit geometric normal of each triangle (by `prims` index; zero for quadrics), computed
+    /// once here instead of per hit with the same expression, hence the same bits.
+    tri_ng: Vec<Vec3>,
     /// Per-mesh shading data.
     pub meshes: Vec<MeshShading>,
     /// Spheres and disks.
@@ -145,9 +148,17 @@ impl Geometry {
                 }
             }
         };
-        let prims = order.iter().map(|&i| prims[i as usize]).collect();
+        let prims: Vec<Primitive> = order.iter().map(|&i| prims[i as usize]).collect();
+        let tri_ng = prims
+            .iter()
+            .map(|p| match p.kind {
+                PrimKind::Triangle { .. } => triangle_normal(p.p),
+                PrimKind::Quadric(_) => Vec3::ZERO,
+            })
+            .collect();
         Self {
             prims,
+            tri_ng,
             meshes,
             quadrics,
             accel,
@@ -236,9 +247,7 @@ impl Geometry {
                 let verts = p.p;
                 let pos = verts[0] * b0 + verts[1] * b1 + verts[2] * b2;
                 let m = &self.meshes[mesh as usize];
-                let mut ng = (verts[1] - verts[0])
-                    .cross(verts[2] - verts[0])
-                    .normalize_or_zero();
+                let mut ng = self.tri_ng[id];
                 let ns = match &m.normals {
                     Some(n) => {
                         let ns =
@@ -296,6 +305,11 @@ impl Geometry {
             }
         }
     }
+}
+
+/// Unit geometric normal of triangle `p` (winding order), zero if degenerate.
+fn triangle_normal(p: [Vec3; 3]) -> Vec3 {
+    (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()
 }
 
 fn prim_bounds(p: &Primitive, quadrics: &[Quadric]) -> (Vec3, Vec3) {

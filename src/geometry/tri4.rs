@@ -55,7 +55,12 @@ impl TriPacket {
     /// Vertex `j` of the triangle in `lane`.
     #[inline]
     fn vertex(&self, lane: usize, j: usize) -> Vec3 {
-        Vec3::new(self.v[j][0][lane], self.v[j][1][lane], self.v[j][2][lane])
+        let v = &self.v[j];
+        Vec3::new(
+            v[0].to_array()[lane],
+            v[1].to_array()[lane],
+            v[2].to_array()[lane],
+        )
     }
 }
 
@@ -89,19 +94,20 @@ impl RayShear4 {
     #[inline(always)]
     pub fn new(o: Vec3, d: Vec3) -> Self {
         let k = shear_axes(d);
-        let dz = d[k[2]];
+        // Arrays, not `Vec3` indexing: glam's runtime `Index` is a `match` (a jump table).
+        let (oa, da) = (o.to_array(), d.to_array());
+        let dz = da[k[2]];
+        // One vector division instead of three scalar ones: IEEE quotients are the same, and
+        // −(a / b) = (−a) / b exactly under round-to-nearest.
+        let q = Vec4::new(-da[k[0]], -da[k[1]], 1.0, 1.0) / Vec4::splat(dz);
         Self {
             k,
             o: [
-                Vec4::splat(o[k[0]]),
-                Vec4::splat(o[k[1]]),
-                Vec4::splat(o[k[2]]),
+                Vec4::splat(oa[k[0]]),
+                Vec4::splat(oa[k[1]]),
+                Vec4::splat(oa[k[2]]),
             ],
-            s: [
-                Vec4::splat(-(d[k[0]] / dz)),
-                Vec4::splat(-(d[k[1]] / dz)),
-                Vec4::splat(1.0 / dz),
-            ],
+            s: [Vec4::splat(q.x), Vec4::splat(q.y), Vec4::splat(q.z)],
             ray: (o, d),
         }
     }
@@ -160,9 +166,12 @@ impl RayShear4 {
         if h.hit | h.redo == 0 {
             return None;
         }
+        // Arrays, not `Vec4` indexing by a runtime lane (glam's `Index` is a jump table).
         let t = h.t.to_array();
         let mut best_t = t_max;
-        let mut best: Option<LaneHit> = None;
+        // The best lane, with its barycentrics only if the scalar redo produced them: those
+        // of a vector lane are formed once below, not at every improvement.
+        let mut best: Option<(usize, Option<[f32; 3]>)> = None;
         // Lanes in increasing order, so that equal t keeps the lowest lane.
         let mut lanes = h.hit | h.redo;
         while lanes != 0 {
@@ -171,20 +180,24 @@ impl RayShear4 {
             if h.hit & (1 << lane) != 0 {
                 if t[lane] < best_t {
                     best_t = t[lane];
-                    let inv = h.inv[lane];
-                    let b = [h.e[0][lane] * inv, h.e[1][lane] * inv, h.e[2][lane] * inv];
-                    best = Some((lane, t[lane], b));
+                    best = Some((lane, None));
                 }
             } else {
                 let (p0, p1, p2) = (pk.vertex(lane, 0), pk.vertex(lane, 1), pk.vertex(lane, 2));
                 let scalar = RayShear::new(self.ray.0, self.ray.1);
                 if let Some((tl, b0, b1, b2)) = scalar.intersect(p0, p1, p2, best_t) {
                     best_t = tl;
-                    best = Some((lane, tl, [b0, b1, b2]));
+                    best = Some((lane, Some([b0, b1, b2])));
                 }
             }
         }
-        best
+        let (lane, b) = best?;
+        let b = b.unwrap_or_else(|| {
+            let inv = h.inv.to_array()[lane];
+            let e = [h.e[0].to_array(), h.e[1].to_array(), h.e[2].to_array()];
+            [e[0][lane] * inv, e[1][lane] * inv, e[2][lane] * inv]
+        });
+        Some((lane, best_t, b))
     }
 
     /// True if any triangle of `pk` is hit with t in (0, t_max).
