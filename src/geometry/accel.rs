@@ -381,6 +381,12 @@ impl RayQuery for Geometry {
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
+        // The default backend first, by a compare: the `match` below is a jump table.
+        if let Accel::Wide(bvh) = &self.accel {
+            return bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                self.quadric_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
+            });
+        }
         let shear = || RayShear::new(ray.o, ray.d);
         match &self.accel {
             Accel::None => false,

@@ -129,14 +129,21 @@ impl RayShear4 {
         let e2 = ax * by - ay * bx;
         let zero = Vec4::ZERO;
         let redo = (e0.cmpeq(zero) | e1.cmpeq(zero) | e2.cmpeq(zero)).bitmask() & pk.tri;
-        let neg = e0.cmplt(zero) | e1.cmplt(zero) | e2.cmplt(zero);
-        let pos = e0.cmpgt(zero) | e1.cmpgt(zero) | e2.cmpgt(zero);
+        // Lanes whose edge functions differ in sign. Zero lanes are redone and NaN lanes fail
+        // `in_range`, so for the remaining lanes comparing sign bits is the scalar test's
+        // `(e < 0 for some) && (e > 0 for some)`.
+        let n0 = e0.is_negative_bitmask();
+        let mixed = (n0 ^ e1.is_negative_bitmask()) | (n0 ^ e2.is_negative_bitmask());
         let det = e0 + e1 + e2;
         let t_scaled = e0 * az + e1 * bz + e2 * cz;
         let tmd = Vec4::splat(t_max) * det;
-        let in_range = (det.cmplt(zero) & t_scaled.cmplt(zero) & t_scaled.cmpge(tmd))
-            | (det.cmpgt(zero) & t_scaled.cmpgt(zero) & t_scaled.cmple(tmd));
-        let candidates = (!(neg & pos) & in_range).bitmask() & pk.tri & !redo;
+        // The scalar test's two sign cases in one: multiplying by ±1 is exact and turns
+        // `det < 0 && t_scaled < 0 && t_scaled >= tmd` into the `det > 0` case. A zero det
+        // fails (t_scaled·s > 0 and ≤ ±0 or NaN), as does NaN.
+        let sgn = Vec4::ONE.copysign(det);
+        let (ts, tm) = (t_scaled * sgn, tmd * sgn);
+        let in_range = ts.cmpgt(zero) & ts.cmple(tm);
+        let candidates = in_range.bitmask() & !mixed & pk.tri & !redo;
         if candidates == 0 {
             // The common miss: skip the division.
             return Lanes {
