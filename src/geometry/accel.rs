@@ -250,9 +250,9 @@ impl Geometry {
                 let mut ng = self.tri_ng[id];
                 let ns = match &m.normals {
                     Some(n) => {
-                        let ns =
-                            (n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2)
-                                .normalize_or_zero();
+                        let ns = unit_or_zero(
+                            n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2,
+                        );
                         if ns == Vec3::ZERO {
                             ng
                         } else {
@@ -304,6 +304,18 @@ impl Geometry {
                 }
             }
         }
+    }
+}
+
+/// `v.normalize_or_zero()`, bit for bit (same length, reciprocal and product), but with the
+/// validity test as 0 < 1/|v| < ∞ (two compares) instead of glam's `is_finite` bit test.
+#[inline(always)]
+fn unit_or_zero(v: Vec3) -> Vec3 {
+    let rcp = 1.0 / v.dot(v).sqrt();
+    if rcp > 0.0 && rcp < f32::INFINITY {
+        v * rcp
+    } else {
+        Vec3::ZERO
     }
 }
 

@@ -55,10 +55,7 @@ impl Node4 {
             .max(t(r.near[2], 2))
             .max(Vec4::ZERO)
             * NEAR_SLACK;
-        let far = t(r.far[0], 0)
-            .min(t(r.far[1], 1))
-            .min(t(r.far[2], 2))
-            * ROUNDING_SLACK;
+        let far = t(r.far[0], 0).min(t(r.far[1], 1)).min(t(r.far[2], 2)) * ROUNDING_SLACK;
         (near, near.cmple(far.min(Vec4::splat(t_max))).bitmask())
     }
 }
@@ -231,8 +228,7 @@ impl WideBvh {
                         // children have non-NaN entry distances, so `<=` is the exact
                         // complement of the `>` of a stable ascending sort.
                         unsafe {
-                            while j > base && stack.get_unchecked(j - 1).assume_init().1 <= item.1
-                            {
+                            while j > base && stack.get_unchecked(j - 1).assume_init().1 <= item.1 {
                                 *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
                                 j -= 1;
                             }
