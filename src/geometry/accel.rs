@@ -232,6 +232,14 @@ impl Geometry {
         }
     }
 
+    /// [`Self::quadric_t`] kept out of line for the wide traversal: inlined, the compiler
+    /// hoists its per-ray setup (splats of the ray) out of the traversal loop, which every ray
+    /// pays for although triangle-only scenes never run it.
+    #[inline(never)]
+    fn quadric_t_outlined(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        self.quadric_t(id, o, d, t_max)
+    }
+
     /// Hit distance of primitive `id` below `t_max`, or +∞ (any-hit queries).
     #[inline(always)]
     fn prim_t(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> f32 {
@@ -385,7 +393,7 @@ impl RayQuery for Geometry {
         let (id, t, b) = match &self.accel {
             // The wide BVH tests triangles itself; only quadrics come back here.
             Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                self.quadric_t(id, ray.o, ray.d, t_max)
+                self.quadric_t_outlined(id, ray.o, ray.d, t_max)
             })?,
             _ => self.closest_by_callback(ray)?,
         };
@@ -396,7 +404,7 @@ impl RayQuery for Geometry {
         // The default backend first, by a compare: the `match` below is a jump table.
         if let Accel::Wide(bvh) = &self.accel {
             return bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.quadric_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
+                self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
             });
         }
         let shear = || RayShear::new(ray.o, ray.d);
