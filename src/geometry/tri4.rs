@@ -189,7 +189,7 @@ impl RayShear4 {
                     best_t = t[lane];
                     best = Some((lane, None));
                 }
-            } else if let Some((tl, b0, b1, b2)) = self.redo_lane(pk, lane, best_t) {
+            } else if let Some((tl, b0, b1, b2)) = redo_lane(self.ray, pk, lane, best_t) {
                 best_t = tl;
                 best = Some((lane, Some([b0, b1, b2])));
             }
@@ -223,16 +223,22 @@ impl RayShear4 {
         }
         false
     }
+}
 
-    /// The scalar test of triangle `lane` (an exact-zero edge function in f32). Cold and not
-    /// inlined: otherwise the compiler hoists its per-ray setup (splats of the ray) out of the
-    /// traversal loop, paying for it on every ray although it almost never runs.
-    #[cold]
-    #[inline(never)]
-    fn redo_lane(&self, pk: &TriPacket, lane: usize, t_max: f32) -> Option<(f32, f32, f32, f32)> {
-        let (p0, p1, p2) = (pk.vertex(lane, 0), pk.vertex(lane, 1), pk.vertex(lane, 2));
-        RayShear::new(self.ray.0, self.ray.1).intersect(p0, p1, p2, t_max)
-    }
+/// The scalar test of triangle `lane` of `pk` against `ray` (an exact-zero edge function in
+/// f32). Cold and not inlined: otherwise the compiler hoists its per-ray setup (splats of the
+/// ray) out of the traversal loop, paying for it on every ray although it almost never runs.
+/// It takes the ray by value, not the `RayShear4`, which would then have to live in memory.
+#[cold]
+#[inline(never)]
+fn redo_lane(
+    ray: (Vec3, Vec3),
+    pk: &TriPacket,
+    lane: usize,
+    t_max: f32,
+) -> Option<(f32, f32, f32, f32)> {
+    let (p0, p1, p2) = (pk.vertex(lane, 0), pk.vertex(lane, 1), pk.vertex(lane, 2));
+    RayShear::new(ray.0, ray.1).intersect(p0, p1, p2, t_max)
 }
 
 #[cfg(test)]
