@@ -172,6 +172,11 @@ impl WideBvh {
             }
             self.packets.push(pk);
         }
+        if ids.is_empty() {
+            // Every leaf owns at least one packet, so a leaf reference is always in bounds
+            // (the traversal reads packets unchecked).
+            self.packets.push(TriPacket::EMPTY);
+        }
         if let Some(last) = self.packets.last_mut() {
             last.last = true;
         }
@@ -244,8 +249,9 @@ impl WideBvh {
             } else {
                 let mut pi = (cur & !LEAF) as usize;
                 loop {
-                    // SAFETY: a leaf reference is the first packet of a run inside `packets`
-                    // whose final packet has `last` set, so pi never leaves `packets`.
+                    // SAFETY: a leaf reference is the first packet of a non-empty run inside
+                    // `packets` (see `leaf`) whose final packet has `last` set, so pi never
+                    // leaves `packets`.
                     let pk = unsafe { self.packets.get_unchecked(pi) };
                     if pk.tri != 0
                         && let Some((lane, t, b)) = shear.closest(pk, best)
