@@ -96,7 +96,9 @@ pub fn shear_axes(d: Vec3) -> [usize; 3] {
     let x_gt_y = a.x > a.y;
     let x_max = x_gt_y & (a.x > a.z);
     let y_max = !x_gt_y & (a.y > a.z);
-    let kz = [2, 1, 0, 0][(x_max as usize) << 1 | y_max as usize];
+    // A `static` table is one load; a literal array is built on the stack at every call.
+    static KZ: [usize; 4] = [2, 1, 0, 0];
+    let kz = KZ[(x_max as usize) << 1 | y_max as usize];
     let neg = ([d.x, d.y, d.z, 0.0][kz & 3] < 0.0) as usize;
     // (kx, ky) = (kz + 1, kz + 2) mod 3, swapped when d[kz] < 0.
     const AXES: [[usize; 3]; 8] = [
