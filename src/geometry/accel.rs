@@ -77,6 +77,9 @@ enum Accel {
 /// All scene geometry and its BVH.
 pub struct Geometry {
     prims: Vec<Primitive>,
+    /// Unit geometric normal of each triangle (by `prims` index; zero for quadrics), computed
+    /// once here instead of per hit with the same expression, hence the same bits.
+    tri_ng: Vec<Vec3>,
     /// Per-mesh shading data.
     pub meshes: Vec<MeshShading>,
     /// Spheres and disks.
@@ -145,9 +148,17 @@ impl Geometry {
                 }
             }
         };
-        let prims = order.iter().map(|&i| prims[i as usize]).collect();
+        let prims: Vec<Primitive> = order.iter().map(|&i| prims[i as usize]).collect();
+        let tri_ng = prims
+            .iter()
+            .map(|p| match p.kind {
+                PrimKind::Triangle { .. } => triangle_normal(p.p),
+                PrimKind::Quadric(_) => Vec3::ZERO,
+            })
+            .collect();
         Self {
             prims,
+            tri_ng,
             meshes,
             quadrics,
             accel,
@@ -221,6 +232,14 @@ impl Geometry {
         }
     }
 
+    /// [`Self::quadric_t`] kept out of line for the wide traversal: inlined, the compiler
+    /// hoists its per-ray setup (splats of the ray) out of the traversal loop, which every ray
+    /// pays for although triangle-only scenes never run it.
+    #[inline(never)]
+    fn quadric_t_outlined(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        self.quadric_t(id, o, d, t_max)
+    }
+
     /// Hit distance of primitive `id` below `t_max`, or +∞ (any-hit queries).
     #[inline(always)]
     fn prim_t(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> f32 {
@@ -236,14 +255,12 @@ impl Geometry {
                 let verts = p.p;
                 let pos = verts[0] * b0 + verts[1] * b1 + verts[2] * b2;
                 let m = &self.meshes[mesh as usize];
-                let mut ng = (verts[1] - verts[0])
-                    .cross(verts[2] - verts[0])
-                    .normalize_or_zero();
+                let mut ng = self.tri_ng[id];
                 let ns = match &m.normals {
                     Some(n) => {
-                        let ns =
-                            (n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2)
-                                .normalize_or_zero();
+                        let ns = unit_or_zero(
+                            n[v[0] as usize] * b0 + n[v[1] as usize] * b1 + n[v[2] as usize] * b2,
+                        );
                         if ns == Vec3::ZERO {
                             ng
                         } else {
@@ -296,6 +313,23 @@ impl Geometry {
             }
         }
     }
+}
+
+/// `v.normalize_or_zero()`, bit for bit (same length, reciprocal and product), but with the
+/// validity test as 0 < 1/|v| < ∞ (two compares) instead of glam's `is_finite` bit test.
+#[inline(always)]
+fn unit_or_zero(v: Vec3) -> Vec3 {
+    let rcp = 1.0 / v.dot(v).sqrt();
+    if rcp > 0.0 && rcp < f32::INFINITY {
+        v * rcp
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// Unit geometric normal of triangle `p` (winding order), zero if degenerate.
+fn triangle_normal(p: [Vec3; 3]) -> Vec3 {
+    (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()
 }
 
 fn prim_bounds(p: &Primitive, quadrics: &[Quadric]) -> (Vec3, Vec3) {
@@ -359,7 +393,7 @@ impl RayQuery for Geometry {
         let (id, t, b) = match &self.accel {
             // The wide BVH tests triangles itself; only quadrics come back here.
             Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                self.quadric_t(id, ray.o, ray.d, t_max)
+                self.quadric_t_outlined(id, ray.o, ray.d, t_max)
             })?,
             _ => self.closest_by_callback(ray)?,
         };
@@ -367,6 +401,12 @@ impl RayQuery for Geometry {
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
+        // The default backend first, by a compare: the `match` below is a jump table.
+        if let Accel::Wide(bvh) = &self.accel {
+            return bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
+            });
+        }
         let shear = || RayShear::new(ray.o, ray.d);
         match &self.accel {
             Accel::None => false,

@@ -90,20 +90,28 @@ impl RayShear {
 /// Shared by [`RayShear`] and the 4-wide test so that both transform vertices identically.
 #[inline]
 pub fn shear_axes(d: Vec3) -> [usize; 3] {
+    // Branch-free: the dominant axis of a random direction is unpredictable. kz is 0 if
+    // |x| > |y| and |x| > |z|, else 1 if |y| > |z|, else 2 (ties go to the later axis).
     let a = d.abs();
-    let kz = if a.x > a.y {
-        if a.x > a.z { 0 } else { 2 }
-    } else if a.y > a.z {
-        1
-    } else {
-        2
-    };
-    let mut kx = (kz + 1) % 3;
-    let mut ky = (kx + 1) % 3;
-    if d[kz] < 0.0 {
-        std::mem::swap(&mut kx, &mut ky);
-    }
-    [kx, ky, kz]
+    let x_gt_y = a.x > a.y;
+    let x_max = x_gt_y & (a.x > a.z);
+    let y_max = !x_gt_y & (a.y > a.z);
+    // A `static` table is one load; a literal array is built on the stack at every call.
+    static KZ: [usize; 4] = [2, 1, 0, 0];
+    let kz = KZ[(x_max as usize) << 1 | y_max as usize];
+    let neg = ([d.x, d.y, d.z, 0.0][kz & 3] < 0.0) as usize;
+    // (kx, ky) = (kz + 1, kz + 2) mod 3, swapped when d[kz] < 0.
+    const AXES: [[usize; 3]; 8] = [
+        [1, 2, 0],
+        [2, 0, 1],
+        [0, 1, 2],
+        [0, 1, 2],
+        [2, 1, 0],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 0, 2],
+    ];
+    AXES[(kz | neg << 2) & 7]
 }
 
 /// Intersect the ray (o, d) with triangle (p0, p1, p2); returns (t, b0, b1, b2).

@@ -55,10 +55,7 @@ impl Node4 {
             .max(t(r.near[2], 2))
             .max(Vec4::ZERO)
             * NEAR_SLACK;
-        let far = t(r.near[0] ^ 1, 0)
-            .min(t(r.near[1] ^ 1, 1))
-            .min(t(r.near[2] ^ 1, 2))
-            * ROUNDING_SLACK;
+        let far = t(r.far[0], 0).min(t(r.far[1], 1)).min(t(r.far[2], 2)) * ROUNDING_SLACK;
         (near, near.cmple(far.min(Vec4::splat(t_max))).bitmask())
     }
 }
@@ -69,20 +66,24 @@ struct RayBox {
     inv: [Vec4; 3],
     /// Side (0 = lower, 1 = upper box plane) through which the ray enters, per axis.
     near: [usize; 3],
+    /// The other side per axis (stored, not `near ^ 1` per node: one instruction less each).
+    far: [usize; 3],
 }
 
 impl RayBox {
     #[inline(always)]
     fn new(o: Vec3, d: Vec3) -> Self {
         let inv = safe_inverse(d);
+        let near = [
+            (inv.x < 0.0) as usize,
+            (inv.y < 0.0) as usize,
+            (inv.z < 0.0) as usize,
+        ];
         Self {
             o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
             inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
-            near: [
-                (inv.x < 0.0) as usize,
-                (inv.y < 0.0) as usize,
-                (inv.z < 0.0) as usize,
-            ],
+            near,
+            far: [near[0] ^ 1, near[1] ^ 1, near[2] ^ 1],
         }
     }
 }
@@ -171,6 +172,11 @@ impl WideBvh {
             }
             self.packets.push(pk);
         }
+        if ids.is_empty() {
+            // Every leaf owns at least one packet, so a leaf reference is always in bounds
+            // (the traversal reads packets unchecked).
+            self.packets.push(TriPacket::EMPTY);
+        }
         if let Some(last) = self.packets.last_mut() {
             last.last = true;
         }
@@ -201,47 +207,57 @@ impl WideBvh {
         let mut cur = 0u32;
         loop {
             if cur & LEAF == 0 {
-                let node = &self.nodes[cur as usize];
-                let (near, mut mask) = node.hit(&r, best);
+                // SAFETY: interior references are indices of nodes pushed by `collapse`, and
+                // the root 0 exists (`nodes` is not empty).
+                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
+                let (near, mask) = node.hit(&r, best);
                 if mask != 0 {
-                    let first = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    if mask == 0 {
-                        cur = node.child[first];
+                    if mask & (mask - 1) == 0 {
+                        cur = node.child[mask.trailing_zeros() as usize & 3];
                         continue;
                     }
-                    // Two to four children: visit the nearest, push the others far to near.
+                    // Two to four children: insertion-sorted straight onto the stack, far
+                    // below near (of equal distances the lower lane ends up higher), and the
+                    // top one is visited. No separate array to sort and copy.
                     let near = near.to_array();
-                    let mut items = [(0u32, 0f32); 4];
-                    items[0] = (node.child[first], near[first]);
-                    let mut k = 1;
-                    while mask != 0 {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        let mut j = k;
-                        while j > 0 && items[j - 1].1 > near[i] {
-                            items[j] = items[j - 1];
-                            j -= 1;
+                    let base = sp;
+                    let mut bits = mask;
+                    while bits != 0 {
+                        let i = bits.trailing_zeros() as usize & 3;
+                        bits &= bits - 1;
+                        let item = (node.child[i], near[i]);
+                        let mut j = sp;
+                        // SAFETY: slots base..sp were written in this loop, and sp < STACK:
+                        // at wide depth d at most 3·(d − 1) entries are pending below `base`
+                        // (three per ancestor), so indices stay below 3·d ≤ STACK − 1. Hit
+                        // children have non-NaN entry distances, so `<=` is the exact
+                        // complement of the `>` of a stable ascending sort.
+                        unsafe {
+                            while j > base && stack.get_unchecked(j - 1).assume_init().1 <= item.1 {
+                                *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
+                                j -= 1;
+                            }
+                            stack.get_unchecked_mut(j).write(item);
                         }
-                        items[j] = (node.child[i], near[i]);
-                        k += 1;
-                    }
-                    for &item in items[1..k].iter().rev() {
-                        stack[sp].write(item);
                         sp += 1;
                     }
-                    cur = items[0].0;
+                    sp -= 1;
+                    // SAFETY: slot sp was written just above.
+                    cur = unsafe { stack.get_unchecked(sp).assume_init().0 };
                     continue;
                 }
             } else {
                 let mut pi = (cur & !LEAF) as usize;
                 loop {
-                    let pk = &self.packets[pi];
+                    // SAFETY: a leaf reference is the first packet of a non-empty run inside
+                    // `packets` (see `leaf`) whose final packet has `last` set, so pi never
+                    // leaves `packets`.
+                    let pk = unsafe { self.packets.get_unchecked(pi) };
                     if pk.tri != 0
                         && let Some((lane, t, b)) = shear.closest(pk, best)
                     {
                         best = t;
-                        hit = Some((pk.ids[lane] as usize, b));
+                        hit = Some((pk.ids[lane & 3] as usize, b));
                     }
                     let mut others = pk.other;
                     while others != 0 {
@@ -266,7 +282,7 @@ impl WideBvh {
                 }
                 sp -= 1;
                 // SAFETY: every slot below the stack pointer was written by a push above.
-                let (c, t) = unsafe { stack[sp].assume_init() };
+                let (c, t) = unsafe { stack.get_unchecked(sp).assume_init() };
                 if t < best {
                     cur = c;
                     break;
@@ -287,7 +303,8 @@ impl WideBvh {
     ) -> bool {
         let mut pi = (child & !LEAF) as usize;
         loop {
-            let pk = &self.packets[pi];
+            // SAFETY: as in `closest`, a leaf's packet run lies inside `packets`.
+            let pk = unsafe { self.packets.get_unchecked(pi) };
             if pk.tri != 0 && shear.any(pk, t_max) {
                 return true;
             }
@@ -321,14 +338,15 @@ impl WideBvh {
         let mut sp = 0usize;
         let mut cur = 0u32;
         loop {
-            let node = &self.nodes[cur as usize];
+            // SAFETY: as in `closest`, node references are valid indices.
+            let node = unsafe { self.nodes.get_unchecked(cur as usize) };
             let (_, mask) = node.hit(&r, t_max);
             // Leaves first: a leaf hit ends the query, while a subtree may be descended
             // without result (large occluders such as walls sit in leaves near the root).
             let mut inner = 0u32;
             let mut bits = mask;
             while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
+                let i = bits.trailing_zeros() as usize & 3;
                 bits &= bits - 1;
                 let c = node.child[i];
                 if c & LEAF == 0 {
@@ -338,10 +356,13 @@ impl WideBvh {
                 }
             }
             if inner != 0 {
-                let first = inner.trailing_zeros() as usize;
+                let first = inner.trailing_zeros() as usize & 3;
                 inner &= inner - 1;
                 while inner != 0 {
-                    stack[sp].write(node.child[inner.trailing_zeros() as usize]);
+                    // SAFETY: at most three pushes per level of a tree at most
+                    // MAX_TREE_DEPTH deep, so sp < STACK.
+                    unsafe { stack.get_unchecked_mut(sp) }
+                        .write(node.child[inner.trailing_zeros() as usize & 3]);
                     sp += 1;
                     inner &= inner - 1;
                 }
@@ -353,7 +374,7 @@ impl WideBvh {
             }
             sp -= 1;
             // SAFETY: every slot below the stack pointer was written by a push above.
-            cur = unsafe { stack[sp].assume_init() };
+            cur = unsafe { stack.get_unchecked(sp).assume_init() };
         }
     }
 }
