@@ -32,7 +32,7 @@ use std::str::FromStr;
 
 use super::ONE_MINUS_EPSILON;
 use super::error::SamplingError;
-use super::hash::{hash_keys, hash_step, uniform_pair};
+use super::hash::{HASH_INIT, hash_keys, hash_step, mix64, uniform_pair};
 use super::permutation::{PermDomain, Permutation};
 use std::cell::Cell;
 
@@ -157,7 +157,14 @@ impl Pattern {
     /// The keys of one (pixel, dim, 1D/2D) sample set, from the pixel's hash prefix.
     #[inline]
     fn set(&self, prefix: u64, dim: u32, tag: u64) -> SetKeys {
-        SetKeys::new(self.kind, hash_step(hash_step(prefix, dim as u64), tag))
+        self.set_of_dim(hash_step(prefix, dim as u64), tag)
+    }
+
+    /// [`Pattern::set`] from the hash state after (seed, pixel, dim), which the 1D and 2D sets
+    /// of one dimension share.
+    #[inline]
+    fn set_of_dim(&self, dim_hash: u64, tag: u64) -> SetKeys {
+        SetKeys::new(self.kind, hash_step(dim_hash, tag))
     }
 }
 
@@ -170,6 +177,8 @@ struct SetKeys {
     perm_y: Permutation,
     /// Jitter / random stream key.
     jitter: u64,
+    /// `jitter` + [`HASH_INIT`]: [`uniform_pair`]`(jitter, i)` hashes `jitter_fast + i · HASH_INIT`.
+    jitter_fast: u64,
     /// Set key, for Sobol sequences past the first 2^16 points.
     key: u64,
     /// Sobol seed of the first 2^16 points.
@@ -191,6 +200,7 @@ impl SetKeys {
             PatternKind::Stratified => {
                 s.perm = Permutation::new(key);
                 s.jitter = hash_step(key, TAG_JITTER);
+                s.jitter_fast = s.jitter.wrapping_add(HASH_INIT);
             }
             PatternKind::Lhs => {
                 s.perm = Permutation::new(key);
@@ -344,13 +354,98 @@ impl SamplePattern for Pattern {
 
     fn pixel(&self, pixel: UVec2) -> PixelSamples {
         let prefix = self.pixel_hash(pixel);
+        let dims: [u64; CACHED_DIMS] = std::array::from_fn(|d| hash_step(prefix, d as u64));
         PixelSamples {
             pattern: *self,
             pixel,
-            sets_1d: std::array::from_fn(|d| self.set(prefix, d as u32, TAG_1D)),
-            sets_2d: std::array::from_fn(|d| self.set(prefix, d as u32, TAG_2D)),
+            sets_1d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_1D)),
+            sets_2d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_2D)),
             strata: Cell::default(),
+            // Only `stratified` fills the fast slots (count 0 = one stratum needs no setup).
+            fast: [
+                Cell::new(if self.kind == PatternKind::Stratified {
+                    FastStrata::ONE
+                } else {
+                    FastStrata::NONE
+                }),
+                Cell::new(FastStrata::NONE),
+            ],
         }
+    }
+}
+
+/// The shape of a `stratified` sample set of `count` points in the integer form of the
+/// [`PixelSamples`] fast path; only made for counts whose grid has a power-of-two width and at
+/// most 2^24 strata (where the fixed-point arithmetic below is exact).
+#[derive(Clone, Copy, Debug)]
+struct FastStrata {
+    /// The `count` argument this was made for (0 and 1 both mean one stratum); `u64::MAX`
+    /// (no u32 count) marks an empty cache slot.
+    key: u64,
+    /// Permutation domain [0, count).
+    dom: PermDomain,
+    /// nx − 1 (nx a power of two).
+    nx_mask: u32,
+    /// log2(nx).
+    nx_log2: u32,
+    /// count · 2^24, nx · 2^24, ny · 2^24 (exact in f32): the divisors of a stratum index
+    /// with its 24-bit jitter appended as fraction bits.
+    div_1d: f32,
+    div_x: f32,
+    div_y: f32,
+}
+
+impl FastStrata {
+    /// An empty cache slot.
+    const NONE: Self = Self {
+        key: u64::MAX,
+        dom: PermDomain::ONE,
+        nx_mask: 0,
+        nx_log2: 0,
+        div_1d: FIX_ONE,
+        div_x: FIX_ONE,
+        div_y: FIX_ONE,
+    };
+
+    /// One stratum, for `count` = 0 (counts as 1).
+    const ONE: Self = Self {
+        key: 0,
+        ..Self::NONE
+    };
+
+    /// The fast form of `count`, if it has one.
+    fn new(count: u32) -> Option<Self> {
+        let st = Strata::new(count);
+        if st.nx_log2 == u32::MAX || st.count > 1 << 24 {
+            return None;
+        }
+        Some(Self {
+            key: count as u64,
+            dom: st.dom,
+            nx_mask: st.nx - 1,
+            nx_log2: st.nx_log2,
+            div_1d: st.count as f32 * FIX_ONE,
+            div_x: st.nx as f32 * FIX_ONE,
+            div_y: st.ny as f32 * FIX_ONE,
+        })
+    }
+}
+
+/// 2^24: one in the 24-bit fixed point of the jitter.
+const FIX_ONE: f32 = (1u32 << 24) as f32;
+
+/// (stratum + jitter) / n with the jitter's 24 bits `j` and `div = n · 2^24`: the same f32 as
+/// [`in_stratum`]`(stratum, j · 2^-24, n)` for stratum < 2^24. Both round the exact value
+/// stratum + j · 2^-24 once (scaled by 2^24, which commutes with rounding) and then divide
+/// by the exact n, so the results agree bit for bit; this form saves the conversions.
+#[inline(always)]
+fn in_stratum_fixed(stratum: u32, j: u32, div: f32) -> f32 {
+    let v = (((stratum as u64) << 24) | j as u64) as i64 as f32 / div;
+    // `v` is never NaN, so this is `v.min(ONE_MINUS_EPSILON)` in a single `minss`.
+    if v < ONE_MINUS_EPSILON {
+        v
+    } else {
+        ONE_MINUS_EPSILON
     }
 }
 
@@ -365,6 +460,9 @@ pub struct PixelSamples {
     /// The two most recently used sample counts' [`Strata`] (an integrator asks for two: N for
     /// the pixel filter, N·M for the shading dimensions).
     strata: Cell<[Strata; 2]>,
+    /// The same for the `stratified` fast path: two slots, most recent first. Slots stay
+    /// empty for other patterns, so their lookups always fall through to the general path.
+    fast: [Cell<FastStrata>; 2],
 }
 
 impl PixelSamples {
@@ -390,9 +488,57 @@ impl PixelSamples {
         c[0]
     }
 
+    /// The cached [`FastStrata`] of `count` (hot path: a hit costs one or two compares).
+    #[inline(always)]
+    fn fast(&self, count: u32) -> Option<FastStrata> {
+        let a = self.fast[0].get();
+        if a.key == count as u64 {
+            return Some(a);
+        }
+        let b = self.fast[1].get();
+        if b.key == count as u64 {
+            return Some(b);
+        }
+        None
+    }
+
+    /// Put `count` in the fast cache when the pattern is `stratified` and `count` has a fast
+    /// form (the most recent count goes first, the other slot keeps the previous one).
+    #[cold]
+    fn fill_fast(&self, count: u32) {
+        if self.pattern.kind != PatternKind::Stratified {
+            return;
+        }
+        if let Some(f) = FastStrata::new(count) {
+            self.fast[1].set(self.fast[0].get());
+            self.fast[0].set(f);
+        }
+    }
+
     /// The 1D sample `index` of `count` for `dim`.
-    #[inline]
+    #[inline(always)]
     pub fn sample_1d(&self, dim: u32, index: u32, count: u32) -> f32 {
+        if let (Some(s), Some(f)) = (self.sets_1d.get(dim as usize), self.fast(count)) {
+            // `stratified` (the only pattern with fast slots): jittered permuted strata.
+            let i = if index < f.dom.len() {
+                index
+            } else {
+                index % f.dom.len()
+            };
+            let stratum = s.perm.apply_wrapped(i, &f.dom);
+            let h = mix64(
+                s.jitter_fast
+                    .wrapping_add((i as u64).wrapping_mul(HASH_INIT)),
+            );
+            return in_stratum_fixed(stratum, h as u32 >> 8, f.div_1d);
+        }
+        self.sample_1d_general(dim, index, count)
+    }
+
+    /// [`PixelSamples::sample_1d`] for every pattern and count.
+    #[inline(never)]
+    fn sample_1d_general(&self, dim: u32, index: u32, count: u32) -> f32 {
+        self.fill_fast(count);
         match self.sets_1d.get(dim as usize) {
             Some(s) => s.sample_1d(self.pattern.kind, index, &self.strata(count)),
             None => self.pattern.sample_1d(self.pixel, dim, index, count),
@@ -400,8 +546,32 @@ impl PixelSamples {
     }
 
     /// The 2D sample `index` of `count` for `dim`.
-    #[inline]
+    #[inline(always)]
     pub fn sample_2d(&self, dim: u32, index: u32, count: u32) -> Vec2 {
+        if let (Some(s), Some(f)) = (self.sets_2d.get(dim as usize), self.fast(count)) {
+            let i = if index < f.dom.len() {
+                index
+            } else {
+                index % f.dom.len()
+            };
+            let stratum = s.perm.apply_wrapped(i, &f.dom);
+            let (sx, sy) = (stratum & f.nx_mask, stratum >> f.nx_log2);
+            let h = mix64(
+                s.jitter_fast
+                    .wrapping_add((i as u64).wrapping_mul(HASH_INIT)),
+            );
+            return Vec2::new(
+                in_stratum_fixed(sx, h as u32 >> 8, f.div_x),
+                in_stratum_fixed(sy, (h >> 40) as u32, f.div_y),
+            );
+        }
+        self.sample_2d_general(dim, index, count)
+    }
+
+    /// [`PixelSamples::sample_2d`] for every pattern and count.
+    #[inline(never)]
+    fn sample_2d_general(&self, dim: u32, index: u32, count: u32) -> Vec2 {
+        self.fill_fast(count);
         match self.sets_2d.get(dim as usize) {
             Some(s) => s.sample_2d(self.pattern.kind, index, &self.strata(count)),
             None => self.pattern.sample_2d(self.pixel, dim, index, count),
