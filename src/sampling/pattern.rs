@@ -361,27 +361,22 @@ impl SamplePattern for Pattern {
             sets_1d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_1D)),
             sets_2d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_2D)),
             strata: Cell::default(),
-            // Only `stratified` fills the fast slots (count 0 = one stratum needs no setup).
-            fast: [
-                Cell::new(if self.kind == PatternKind::Stratified {
-                    FastStrata::ONE
-                } else {
-                    FastStrata::NONE
-                }),
-                Cell::new(FastStrata::NONE),
-            ],
+            fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
+            chunks_1d: Default::default(),
+            chunks_2d: Default::default(),
         }
     }
 }
 
 /// The shape of a `stratified` sample set of `count` points in the integer form of the
-/// [`PixelSamples`] fast path; only made for counts whose grid has a power-of-two width and at
-/// most 2^24 strata (where the fixed-point arithmetic below is exact).
+/// [`PixelSamples`] fast path; only usable (`valid`) for counts whose grid has a power-of-two
+/// width and at most 2^24 strata (where the fixed-point arithmetic below is exact).
 #[derive(Clone, Copy, Debug)]
 struct FastStrata {
-    /// The `count` argument this was made for (0 and 1 both mean one stratum); `u64::MAX`
-    /// (no u32 count) marks an empty cache slot.
+    /// The `count` argument this was made for; `u64::MAX` (no u32 count) marks an empty slot.
     key: u64,
+    /// Whether `count` has a fast form (else the general path serves it).
+    valid: bool,
     /// Permutation domain [0, count).
     dom: PermDomain,
     /// nx − 1 (nx a power of two).
@@ -399,6 +394,7 @@ impl FastStrata {
     /// An empty cache slot.
     const NONE: Self = Self {
         key: u64::MAX,
+        valid: false,
         dom: PermDomain::ONE,
         nx_mask: 0,
         nx_log2: 0,
@@ -407,26 +403,53 @@ impl FastStrata {
         div_y: FIX_ONE,
     };
 
-    /// One stratum, for `count` = 0 (counts as 1).
-    const ONE: Self = Self {
-        key: 0,
-        ..Self::NONE
-    };
-
-    /// The fast form of `count`, if it has one.
-    fn new(count: u32) -> Option<Self> {
+    /// The fast form of `count` (`valid` if it has one).
+    fn new(count: u32) -> Self {
         let st = Strata::new(count);
         if st.nx_log2 == u32::MAX || st.count > 1 << 24 {
-            return None;
+            return Self {
+                key: count as u64,
+                ..Self::NONE
+            };
         }
-        Some(Self {
+        Self {
             key: count as u64,
+            valid: true,
             dom: st.dom,
             nx_mask: st.nx - 1,
             nx_log2: st.nx_log2,
             div_1d: st.count as f32 * FIX_ONE,
             div_x: st.nx as f32 * FIX_ONE,
             div_y: st.ny as f32 * FIX_ONE,
+        }
+    }
+
+    /// Stratified 1D samples `base..base + CHUNK` of `set` (those < count are the same f32s as
+    /// [`SetKeys::sample_1d`]; the rest are unspecified).
+    #[inline(always)]
+    fn chunk_1d(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+        let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
+        let (jit, div) = (set.jitter_fast, self.div_1d);
+        std::array::from_fn(|k| {
+            let i = base.wrapping_add(k as u32);
+            let h = mix64(jit.wrapping_add((i as u64).wrapping_mul(HASH_INIT)));
+            in_stratum_fixed(strata[k], h as u32 >> 8, div)
+        })
+    }
+
+    /// Stratified 2D samples `base..base + CHUNK` of `set` (see [`FastStrata::chunk_1d`]).
+    #[inline(always)]
+    fn chunk_2d(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+        let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
+        let (jit, f) = (set.jitter_fast, *self);
+        std::array::from_fn(|k| {
+            let i = base.wrapping_add(k as u32);
+            let (sx, sy) = (strata[k] & f.nx_mask, strata[k] >> f.nx_log2);
+            let h = mix64(jit.wrapping_add((i as u64).wrapping_mul(HASH_INIT)));
+            Vec2::new(
+                in_stratum_fixed(sx, h as u32 >> 8, f.div_x),
+                in_stratum_fixed(sy, (h >> 40) as u32, f.div_y),
+            )
         })
     }
 }
@@ -449,6 +472,61 @@ fn in_stratum_fixed(stratum: u32, j: u32, div: f32) -> f32 {
     }
 }
 
+/// Indices per [`Chunk`]: a sample set's values are computed this many at a time.
+const CHUNK: usize = 16;
+
+/// Precomputed values of consecutive indices [base, base + len) of one sample set for one
+/// count: integrators walk a pixel's indices in order, so a batch evaluated in one tight loop
+/// (keys in registers, no per-call lookups) serves the next `len` requests with one compare.
+#[derive(Clone, Debug)]
+struct Chunk<T: Copy> {
+    /// The count the values belong to.
+    count: Cell<u32>,
+    /// First index.
+    base: Cell<u32>,
+    /// Number of valid values (0 = empty).
+    len: Cell<u32>,
+    /// The values of indices base..base + len.
+    v: [Cell<T>; CHUNK],
+}
+
+impl<T: Copy + Default> Default for Chunk<T> {
+    fn default() -> Self {
+        Self {
+            count: Cell::new(0),
+            base: Cell::new(0),
+            len: Cell::new(0),
+            v: Default::default(),
+        }
+    }
+}
+
+impl<T: Copy> Chunk<T> {
+    /// The value of `index` of `count`, if this chunk holds it (hot path).
+    #[inline(always)]
+    fn get(&self, index: u32, count: u32) -> Option<T> {
+        let off = index.wrapping_sub(self.base.get());
+        if self.count.get() == count && off < self.len.get() {
+            return Some(self.v[off as usize % CHUNK].get());
+        }
+        None
+    }
+
+    /// Store the values `v` of the chunk of `index` (< count) and return `index`'s value.
+    #[inline(always)]
+    fn store(&self, index: u32, count: u32, v: &[T; CHUNK]) -> T {
+        let base = index & !(CHUNK as u32 - 1);
+        let len = (count - base).min(CHUNK as u32);
+        for (c, &x) in self.v.iter().zip(v) {
+            c.set(x);
+        }
+        self.count.set(count);
+        self.base.set(base);
+        self.len.set(len);
+        v[(index - base) as usize % CHUNK]
+    }
+}
+
 /// One pixel's sample sets with the keys of the first [`CACHED_DIMS`] dimensions precomputed;
 /// returns exactly what the pattern's `sample_1d` / `sample_2d` return for this pixel.
 #[derive(Clone, Debug)]
@@ -460,9 +538,11 @@ pub struct PixelSamples {
     /// The two most recently used sample counts' [`Strata`] (an integrator asks for two: N for
     /// the pixel filter, N·M for the shading dimensions).
     strata: Cell<[Strata; 2]>,
-    /// The same for the `stratified` fast path: two slots, most recent first. Slots stay
-    /// empty for other patterns, so their lookups always fall through to the general path.
+    /// The same in the `stratified` fast form: two slots, most recent first.
     fast: [Cell<FastStrata>; 2],
+    /// Batches of precomputed `stratified` values per cached 1D / 2D dimension.
+    chunks_1d: [Chunk<f32>; CACHED_DIMS],
+    chunks_2d: [Chunk<Vec2>; CACHED_DIMS],
 }
 
 impl PixelSamples {
@@ -488,94 +568,76 @@ impl PixelSamples {
         c[0]
     }
 
-    /// The cached [`FastStrata`] of `count` (hot path: a hit costs one or two compares).
-    #[inline(always)]
-    fn fast(&self, count: u32) -> Option<FastStrata> {
+    /// The [`FastStrata`] of `count`, from the two-slot cache (most recent first).
+    #[inline]
+    fn fast(&self, count: u32) -> FastStrata {
         let a = self.fast[0].get();
         if a.key == count as u64 {
-            return Some(a);
+            return a;
         }
         let b = self.fast[1].get();
         if b.key == count as u64 {
-            return Some(b);
+            return b;
         }
-        None
-    }
-
-    /// Put `count` in the fast cache when the pattern is `stratified` and `count` has a fast
-    /// form (the most recent count goes first, the other slot keeps the previous one).
-    #[cold]
-    fn fill_fast(&self, count: u32) {
-        if self.pattern.kind != PatternKind::Stratified {
-            return;
-        }
-        if let Some(f) = FastStrata::new(count) {
-            self.fast[1].set(self.fast[0].get());
-            self.fast[0].set(f);
-        }
+        let f = FastStrata::new(count);
+        self.fast[1].set(a);
+        self.fast[0].set(f);
+        f
     }
 
     /// The 1D sample `index` of `count` for `dim`.
     #[inline(always)]
     pub fn sample_1d(&self, dim: u32, index: u32, count: u32) -> f32 {
-        if let (Some(s), Some(f)) = (self.sets_1d.get(dim as usize), self.fast(count)) {
-            // `stratified` (the only pattern with fast slots): jittered permuted strata.
-            let i = if index < f.dom.len() {
-                index
-            } else {
-                index % f.dom.len()
-            };
-            let stratum = s.perm.apply_wrapped(i, &f.dom);
-            let h = mix64(
-                s.jitter_fast
-                    .wrapping_add((i as u64).wrapping_mul(HASH_INIT)),
-            );
-            return in_stratum_fixed(stratum, h as u32 >> 8, f.div_1d);
+        if let Some(c) = self.chunks_1d.get(dim as usize)
+            && let Some(v) = c.get(index, count)
+        {
+            return v;
         }
-        self.sample_1d_general(dim, index, count)
+        self.sample_1d_miss(dim, index, count)
     }
 
-    /// [`PixelSamples::sample_1d`] for every pattern and count.
+    /// [`PixelSamples::sample_1d`] when no chunk holds the value: refill one (`stratified`
+    /// with a fast count, index < count) or evaluate the general way.
     #[inline(never)]
-    fn sample_1d_general(&self, dim: u32, index: u32, count: u32) -> f32 {
-        self.fill_fast(count);
-        match self.sets_1d.get(dim as usize) {
-            Some(s) => s.sample_1d(self.pattern.kind, index, &self.strata(count)),
-            None => self.pattern.sample_1d(self.pixel, dim, index, count),
+    fn sample_1d_miss(&self, dim: u32, index: u32, count: u32) -> f32 {
+        let Some(set) = self.sets_1d.get(dim as usize) else {
+            return self.pattern.sample_1d(self.pixel, dim, index, count);
+        };
+        if self.pattern.kind == PatternKind::Stratified && index < count {
+            let f = self.fast(count);
+            if f.valid {
+                let v = f.chunk_1d(set, index & !(CHUNK as u32 - 1));
+                return self.chunks_1d[dim as usize].store(index, count, &v);
+            }
         }
+        set.sample_1d(self.pattern.kind, index, &self.strata(count))
     }
 
     /// The 2D sample `index` of `count` for `dim`.
     #[inline(always)]
     pub fn sample_2d(&self, dim: u32, index: u32, count: u32) -> Vec2 {
-        if let (Some(s), Some(f)) = (self.sets_2d.get(dim as usize), self.fast(count)) {
-            let i = if index < f.dom.len() {
-                index
-            } else {
-                index % f.dom.len()
-            };
-            let stratum = s.perm.apply_wrapped(i, &f.dom);
-            let (sx, sy) = (stratum & f.nx_mask, stratum >> f.nx_log2);
-            let h = mix64(
-                s.jitter_fast
-                    .wrapping_add((i as u64).wrapping_mul(HASH_INIT)),
-            );
-            return Vec2::new(
-                in_stratum_fixed(sx, h as u32 >> 8, f.div_x),
-                in_stratum_fixed(sy, (h >> 40) as u32, f.div_y),
-            );
+        if let Some(c) = self.chunks_2d.get(dim as usize)
+            && let Some(v) = c.get(index, count)
+        {
+            return v;
         }
-        self.sample_2d_general(dim, index, count)
+        self.sample_2d_miss(dim, index, count)
     }
 
-    /// [`PixelSamples::sample_2d`] for every pattern and count.
+    /// [`PixelSamples::sample_2d`] when no chunk holds the value (see `sample_1d_miss`).
     #[inline(never)]
-    fn sample_2d_general(&self, dim: u32, index: u32, count: u32) -> Vec2 {
-        self.fill_fast(count);
-        match self.sets_2d.get(dim as usize) {
-            Some(s) => s.sample_2d(self.pattern.kind, index, &self.strata(count)),
-            None => self.pattern.sample_2d(self.pixel, dim, index, count),
+    fn sample_2d_miss(&self, dim: u32, index: u32, count: u32) -> Vec2 {
+        let Some(set) = self.sets_2d.get(dim as usize) else {
+            return self.pattern.sample_2d(self.pixel, dim, index, count);
+        };
+        if self.pattern.kind == PatternKind::Stratified && index < count {
+            let f = self.fast(count);
+            if f.valid {
+                let v = f.chunk_2d(set, index & !(CHUNK as u32 - 1));
+                return self.chunks_2d[dim as usize].store(index, count, &v);
+            }
         }
+        set.sample_2d(self.pattern.kind, index, &self.strata(count))
     }
 }
 

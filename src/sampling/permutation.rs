@@ -99,6 +99,29 @@ impl Permutation {
     }
 }
 
+impl Permutation {
+    /// The images of the `N` consecutive indices `base..base + N` (each < n), computed in one
+    /// loop that the compiler can vectorise when n is a power of two (no cycle-walking).
+    /// Entries for indices ≥ n (when base + N > n) are unspecified.
+    #[inline(always)]
+    pub fn apply_many<const N: usize>(&self, base: u32, dom: &PermDomain) -> [u32; N] {
+        let (p, d) = (*self, *dom);
+        let mut out = [0u32; N];
+        if d.mask.wrapping_add(1) == d.n {
+            for (k, o) in out.iter_mut().enumerate() {
+                let i = base.wrapping_add(k as u32);
+                *o = round(round(round(i, &p.r[0], &d), &p.r[1], &d), &p.r[2], &d);
+            }
+        } else {
+            let len = d.n.saturating_sub(base).min(N as u32) as usize;
+            for (k, o) in out.iter_mut().enumerate().take(len) {
+                *o = p.apply_wrapped(base + k as u32, &d);
+            }
+        }
+        out
+    }
+}
+
 /// The length of a permuted range with the width of its enclosing power of two, which
 /// [`Permutation::apply_in`] would otherwise recompute for every index.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
