@@ -90,3 +90,25 @@ const GOLDEN: [u64; 6] = [
 ];
 /// Digest of `permute` before the rewrite.
 const GOLDEN_PERMUTE: u64 = 0x5c05_5541_1332_bbee;
+
+#[test]
+fn pixel_samples_match_the_general_path_for_large_counts() {
+    // Counts past the i32 fixed-point form (strata ≥ 2^7 per axis) and past the fast form
+    // (> 2^24 strata): the per-pixel path must still equal `SamplePattern::sample_*`.
+    for kind in PatternKind::ALL {
+        let pat = make_pattern(kind, 11);
+        let pixel = UVec2::new(5, 9);
+        let px = pat.pixel(pixel);
+        for count in [200u32, 256, 1 << 14, 1 << 15, 1 << 16, 1 << 25, u32::MAX] {
+            for index in [0u32, 1, 17, 255, 4097, 32767, 65535, 1 << 24, u32::MAX - 1] {
+                for dim in [1u32, 2] {
+                    let a = px.sample_1d(dim, index, count).to_bits();
+                    assert_eq!(a, pat.sample_1d(pixel, dim, index, count).to_bits());
+                    let a = px.sample_2d(dim, index, count).to_array().map(f32::to_bits);
+                    let b = pat.sample_2d(pixel, dim, index, count);
+                    assert_eq!(a, b.to_array().map(f32::to_bits), "{kind} {count} {index}");
+                }
+            }
+        }
+    }
+}

@@ -388,6 +388,10 @@ struct FastStrata {
     div_1d: f32,
     div_x: f32,
     div_y: f32,
+    /// Every 1D stratum index is < 2^7, so stratum · 2^24 + jitter fits an i32.
+    small_1d: bool,
+    /// The same for both 2D axes.
+    small_2d: bool,
 }
 
 impl FastStrata {
@@ -401,6 +405,8 @@ impl FastStrata {
         div_1d: FIX_ONE,
         div_x: FIX_ONE,
         div_y: FIX_ONE,
+        small_1d: false,
+        small_2d: false,
     };
 
     /// The fast form of `count` (`valid` if it has one).
@@ -421,7 +427,27 @@ impl FastStrata {
             div_1d: st.count as f32 * FIX_ONE,
             div_x: st.nx as f32 * FIX_ONE,
             div_y: st.ny as f32 * FIX_ONE,
+            // Bounds of every computed index, including the unspecified ones past `count`.
+            small_1d: st.dom.mask() < 1 << 7,
+            small_2d: st.nx - 1 < 1 << 7 && st.dom.mask() >> st.nx_log2 < 1 << 7,
         }
+    }
+
+    /// The 24-bit jitters (x: low, y: high half) of indices `base..base + CHUNK` of `set`.
+    #[inline(always)]
+    fn jitters(set: &SetKeys, base: u32) -> ([u32; CHUNK], [u32; CHUNK]) {
+        let mut jx = [0u32; CHUNK];
+        let mut jy = [0u32; CHUNK];
+        for (k, (x, y)) in jx.iter_mut().zip(&mut jy).enumerate() {
+            let i = base.wrapping_add(k as u32);
+            let h = mix64(
+                set.jitter_fast
+                    .wrapping_add((i as u64).wrapping_mul(HASH_INIT)),
+            );
+            *x = h as u32 >> 8;
+            *y = (h >> 40) as u32;
+        }
+        (jx, jy)
     }
 
     /// Stratified 1D samples `base..base + CHUNK` of `set` (those < count are the same f32s as
@@ -429,28 +455,38 @@ impl FastStrata {
     #[inline(always)]
     fn chunk_1d(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
         let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
-        let (jit, div) = (set.jitter_fast, self.div_1d);
-        std::array::from_fn(|k| {
-            let i = base.wrapping_add(k as u32);
-            let h = mix64(jit.wrapping_add((i as u64).wrapping_mul(HASH_INIT)));
-            in_stratum_fixed(strata[k], h as u32 >> 8, div)
-        })
+        let (jx, _) = Self::jitters(set, base);
+        fixed_chunk(&strata, &jx, self.div_1d, self.small_1d)
     }
 
     /// Stratified 2D samples `base..base + CHUNK` of `set` (see [`FastStrata::chunk_1d`]).
     #[inline(always)]
     fn chunk_2d(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
         let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
-        let (jit, f) = (set.jitter_fast, *self);
+        let (jx, jy) = Self::jitters(set, base);
+        let sx = strata.map(|s| s & self.nx_mask);
+        let sy = strata.map(|s| s >> self.nx_log2);
+        let x = fixed_chunk(&sx, &jx, self.div_x, self.small_2d);
+        let y = fixed_chunk(&sy, &jy, self.div_y, self.small_2d);
+        std::array::from_fn(|k| Vec2::new(x[k], y[k]))
+    }
+}
+
+/// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form that
+/// vectorises (the same values: the integer is the same and exact either way).
+#[inline(always)]
+fn fixed_chunk(strata: &[u32; CHUNK], j: &[u32; CHUNK], div: f32, small: bool) -> [f32; CHUNK] {
+    if small {
         std::array::from_fn(|k| {
-            let i = base.wrapping_add(k as u32);
-            let (sx, sy) = (strata[k] & f.nx_mask, strata[k] >> f.nx_log2);
-            let h = mix64(jit.wrapping_add((i as u64).wrapping_mul(HASH_INIT)));
-            Vec2::new(
-                in_stratum_fixed(sx, h as u32 >> 8, f.div_x),
-                in_stratum_fixed(sy, (h >> 40) as u32, f.div_y),
-            )
+            let v = ((strata[k] << 24) | j[k]) as i32 as f32 / div;
+            if v < ONE_MINUS_EPSILON {
+                v
+            } else {
+                ONE_MINUS_EPSILON
+            }
         })
+    } else {
+        std::array::from_fn(|k| in_stratum_fixed(strata[k], j[k], div))
     }
 }
 

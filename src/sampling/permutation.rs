@@ -176,6 +176,12 @@ impl PermDomain {
         self.n
     }
 
+    /// 2^bits − 1, with 2^bits the smallest power of two ≥ n.
+    #[inline]
+    pub fn mask(&self) -> u32 {
+        self.mask
+    }
+
     /// Never true: the domain holds at least one element.
     #[inline]
     pub fn is_empty(&self) -> bool {
