@@ -230,7 +230,7 @@ impl SetKeys {
         sobol_burley::sample(index & 0xffff, d, seed)
     }
 
-    #[inline]
+    #[inline(always)]
     fn sample_1d(&self, kind: PatternKind, index: u32, st: &Strata) -> f32 {
         let count = st.count;
         match kind {
@@ -245,7 +245,7 @@ impl SetKeys {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn sample_2d(&self, kind: PatternKind, index: u32, st: &Strata) -> Vec2 {
         let count = st.count;
         match kind {
@@ -632,21 +632,47 @@ impl PixelSamples {
         self.sample_1d_miss(dim, index, count)
     }
 
-    /// [`PixelSamples::sample_1d`] when no chunk holds the value: refill one (`stratified`
-    /// with a fast count, index < count) or evaluate the general way.
+    /// [`PixelSamples::sample_1d`] when no chunk holds the value: refill the chunk of `index`
+    /// (< count; the `stratified` fast form where it applies) or evaluate the general way.
     #[inline(never)]
     fn sample_1d_miss(&self, dim: u32, index: u32, count: u32) -> f32 {
         let Some(set) = self.sets_1d.get(dim as usize) else {
             return self.pattern.sample_1d(self.pixel, dim, index, count);
         };
-        if self.pattern.kind == PatternKind::Stratified && index < count {
-            let f = self.fast(count);
-            if f.valid {
-                let v = f.chunk_1d(set, index & !(CHUNK as u32 - 1));
-                return self.chunks_1d[dim as usize].store(index, count, &v);
-            }
+        let kind = self.pattern.kind;
+        if index < count {
+            let base = index & !(CHUNK as u32 - 1);
+            let f = if kind == PatternKind::Stratified {
+                self.fast(count)
+            } else {
+                FastStrata::NONE
+            };
+            let v = if f.valid {
+                f.chunk_1d(set, base)
+            } else {
+                // Every other pattern and count: the general evaluation, batched the same way.
+                let st = self.strata(count);
+                let len = (count - base).min(CHUNK as u32) as usize;
+                let batch = |kind| {
+                    let mut v = [Default::default(); CHUNK];
+                    for (k, o) in v.iter_mut().enumerate().take(len) {
+                        *o = set.sample_1d(kind, base + k as u32, &st);
+                    }
+                    v
+                };
+                // One loop per kind, so that each loop body is that kind's arithmetic only.
+                match kind {
+                    PatternKind::Fixed => batch(PatternKind::Fixed),
+                    PatternKind::Random => batch(PatternKind::Random),
+                    PatternKind::Grid => batch(PatternKind::Grid),
+                    PatternKind::Stratified => batch(PatternKind::Stratified),
+                    PatternKind::Lhs => batch(PatternKind::Lhs),
+                    PatternKind::Sobol => batch(PatternKind::Sobol),
+                }
+            };
+            return self.chunks_1d[dim as usize].store(index, count, &v);
         }
-        set.sample_1d(self.pattern.kind, index, &self.strata(count))
+        set.sample_1d(kind, index, &self.strata(count))
     }
 
     /// The 2D sample `index` of `count` for `dim`.
@@ -666,14 +692,40 @@ impl PixelSamples {
         let Some(set) = self.sets_2d.get(dim as usize) else {
             return self.pattern.sample_2d(self.pixel, dim, index, count);
         };
-        if self.pattern.kind == PatternKind::Stratified && index < count {
-            let f = self.fast(count);
-            if f.valid {
-                let v = f.chunk_2d(set, index & !(CHUNK as u32 - 1));
-                return self.chunks_2d[dim as usize].store(index, count, &v);
-            }
+        let kind = self.pattern.kind;
+        if index < count {
+            let base = index & !(CHUNK as u32 - 1);
+            let f = if kind == PatternKind::Stratified {
+                self.fast(count)
+            } else {
+                FastStrata::NONE
+            };
+            let v = if f.valid {
+                f.chunk_2d(set, base)
+            } else {
+                // Every other pattern and count: the general evaluation, batched the same way.
+                let st = self.strata(count);
+                let len = (count - base).min(CHUNK as u32) as usize;
+                let batch = |kind| {
+                    let mut v = [Default::default(); CHUNK];
+                    for (k, o) in v.iter_mut().enumerate().take(len) {
+                        *o = set.sample_2d(kind, base + k as u32, &st);
+                    }
+                    v
+                };
+                // One loop per kind, so that each loop body is that kind's arithmetic only.
+                match kind {
+                    PatternKind::Fixed => batch(PatternKind::Fixed),
+                    PatternKind::Random => batch(PatternKind::Random),
+                    PatternKind::Grid => batch(PatternKind::Grid),
+                    PatternKind::Stratified => batch(PatternKind::Stratified),
+                    PatternKind::Lhs => batch(PatternKind::Lhs),
+                    PatternKind::Sobol => batch(PatternKind::Sobol),
+                }
+            };
+            return self.chunks_2d[dim as usize].store(index, count, &v);
         }
-        set.sample_2d(self.pattern.kind, index, &self.strata(count))
+        set.sample_2d(kind, index, &self.strata(count))
     }
 }
 
