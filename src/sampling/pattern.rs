@@ -23,8 +23,11 @@
 //! 1D versions are analogous (`grid`: stratum centres, `stratified`/`lhs`: jittered strata).
 //!
 //! Hot path: [`SamplePattern::pixel`] hashes the keys of one pixel's first [`CACHED_DIMS`]
-//! dimensions once ([`PixelSamples`]); per sample only the permutation rounds and one jitter
-//! hash remain. The values are identical to those of `sample_1d` / `sample_2d`.
+//! dimensions once ([`PixelSamples`]), which then evaluates each of those sample sets 16
+//! consecutive indices at a time (integrators walk a pixel's indices in order), so most
+//! samples cost one compare and a load. `stratified` batches run in an integer form
+//! (vectorisable permutation rounds; stratum and jitter as one fixed-point number). The values
+//! are bit-identical to those of `sample_1d` / `sample_2d` (tests/pat_golden.rs).
 
 use glam::{UVec2, Vec2};
 use std::fmt;
