@@ -23,8 +23,11 @@
 //! 1D versions are analogous (`grid`: stratum centres, `stratified`/`lhs`: jittered strata).
 //!
 //! Hot path: [`SamplePattern::pixel`] hashes the keys of one pixel's first [`CACHED_DIMS`]
-//! dimensions once ([`PixelSamples`]); per sample only the permutation rounds and one jitter
-//! hash remain. The values are identical to those of `sample_1d` / `sample_2d`.
+//! dimensions once ([`PixelSamples`]), which then evaluates each of those sample sets 16
+//! consecutive indices at a time (integrators walk a pixel's indices in order), so most
+//! samples cost one compare and a load. `stratified` batches run in an integer form
+//! (vectorisable permutation rounds; stratum and jitter as one fixed-point number). The values
+//! are bit-identical to those of `sample_1d` / `sample_2d` (tests/pat_golden.rs).
 
 use glam::{UVec2, Vec2};
 use std::fmt;
@@ -32,7 +35,7 @@ use std::str::FromStr;
 
 use super::ONE_MINUS_EPSILON;
 use super::error::SamplingError;
-use super::hash::{hash_keys, hash_step, uniform_pair};
+use super::hash::{HASH_INIT, hash_keys, hash_step, mix64, uniform_pair};
 use super::permutation::{PermDomain, Permutation};
 use std::cell::Cell;
 
@@ -157,7 +160,14 @@ impl Pattern {
     /// The keys of one (pixel, dim, 1D/2D) sample set, from the pixel's hash prefix.
     #[inline]
     fn set(&self, prefix: u64, dim: u32, tag: u64) -> SetKeys {
-        SetKeys::new(self.kind, hash_step(hash_step(prefix, dim as u64), tag))
+        self.set_of_dim(hash_step(prefix, dim as u64), tag)
+    }
+
+    /// [`Pattern::set`] from the hash state after (seed, pixel, dim), which the 1D and 2D sets
+    /// of one dimension share.
+    #[inline]
+    fn set_of_dim(&self, dim_hash: u64, tag: u64) -> SetKeys {
+        SetKeys::new(self.kind, hash_step(dim_hash, tag))
     }
 }
 
@@ -170,6 +180,8 @@ struct SetKeys {
     perm_y: Permutation,
     /// Jitter / random stream key.
     jitter: u64,
+    /// `jitter` + [`HASH_INIT`]: [`uniform_pair`]`(jitter, i)` hashes `jitter_fast + i · HASH_INIT`.
+    jitter_fast: u64,
     /// Set key, for Sobol sequences past the first 2^16 points.
     key: u64,
     /// Sobol seed of the first 2^16 points.
@@ -191,6 +203,7 @@ impl SetKeys {
             PatternKind::Stratified => {
                 s.perm = Permutation::new(key);
                 s.jitter = hash_step(key, TAG_JITTER);
+                s.jitter_fast = s.jitter.wrapping_add(HASH_INIT);
             }
             PatternKind::Lhs => {
                 s.perm = Permutation::new(key);
@@ -220,7 +233,7 @@ impl SetKeys {
         sobol_burley::sample(index & 0xffff, d, seed)
     }
 
-    #[inline]
+    #[inline(always)]
     fn sample_1d(&self, kind: PatternKind, index: u32, st: &Strata) -> f32 {
         let count = st.count;
         match kind {
@@ -235,7 +248,7 @@ impl SetKeys {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn sample_2d(&self, kind: PatternKind, index: u32, st: &Strata) -> Vec2 {
         let count = st.count;
         match kind {
@@ -344,13 +357,212 @@ impl SamplePattern for Pattern {
 
     fn pixel(&self, pixel: UVec2) -> PixelSamples {
         let prefix = self.pixel_hash(pixel);
+        let dims: [u64; CACHED_DIMS] = std::array::from_fn(|d| hash_step(prefix, d as u64));
         PixelSamples {
             pattern: *self,
             pixel,
-            sets_1d: std::array::from_fn(|d| self.set(prefix, d as u32, TAG_1D)),
-            sets_2d: std::array::from_fn(|d| self.set(prefix, d as u32, TAG_2D)),
+            sets_1d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_1D)),
+            sets_2d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_2D)),
             strata: Cell::default(),
+            fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
+            chunks_1d: Default::default(),
+            chunks_2d: Default::default(),
         }
+    }
+}
+
+/// The shape of a `stratified` sample set of `count` points in the integer form of the
+/// [`PixelSamples`] fast path; only usable (`valid`) for counts whose grid has a power-of-two
+/// width and at most 2^24 strata (where the fixed-point arithmetic below is exact).
+#[derive(Clone, Copy, Debug)]
+struct FastStrata {
+    /// The `count` argument this was made for; `u64::MAX` (no u32 count) marks an empty slot.
+    key: u64,
+    /// Whether `count` has a fast form (else the general path serves it).
+    valid: bool,
+    /// Permutation domain [0, count).
+    dom: PermDomain,
+    /// nx − 1 (nx a power of two).
+    nx_mask: u32,
+    /// log2(nx).
+    nx_log2: u32,
+    /// count · 2^24, nx · 2^24, ny · 2^24 (exact in f32): the divisors of a stratum index
+    /// with its 24-bit jitter appended as fraction bits.
+    div_1d: f32,
+    div_x: f32,
+    div_y: f32,
+    /// Every 1D stratum index is < 2^7, so stratum · 2^24 + jitter fits an i32.
+    small_1d: bool,
+    /// The same for both 2D axes.
+    small_2d: bool,
+}
+
+impl FastStrata {
+    /// An empty cache slot.
+    const NONE: Self = Self {
+        key: u64::MAX,
+        valid: false,
+        dom: PermDomain::ONE,
+        nx_mask: 0,
+        nx_log2: 0,
+        div_1d: FIX_ONE,
+        div_x: FIX_ONE,
+        div_y: FIX_ONE,
+        small_1d: false,
+        small_2d: false,
+    };
+
+    /// The fast form of `count` (`valid` if it has one).
+    fn new(count: u32) -> Self {
+        let st = Strata::new(count);
+        if st.nx_log2 == u32::MAX || st.count > 1 << 24 {
+            return Self {
+                key: count as u64,
+                ..Self::NONE
+            };
+        }
+        Self {
+            key: count as u64,
+            valid: true,
+            dom: st.dom,
+            nx_mask: st.nx - 1,
+            nx_log2: st.nx_log2,
+            div_1d: st.count as f32 * FIX_ONE,
+            div_x: st.nx as f32 * FIX_ONE,
+            div_y: st.ny as f32 * FIX_ONE,
+            // Bounds of every computed index, including the unspecified ones past `count`.
+            small_1d: st.dom.mask() < 1 << 7,
+            small_2d: st.nx - 1 < 1 << 7 && st.dom.mask() >> st.nx_log2 < 1 << 7,
+        }
+    }
+
+    /// The 24-bit jitters (x: low, y: high half) of indices `base..base + CHUNK` of `set`.
+    #[inline(always)]
+    fn jitters(set: &SetKeys, base: u32) -> ([u32; CHUNK], [u32; CHUNK]) {
+        let mut jx = [0u32; CHUNK];
+        let mut jy = [0u32; CHUNK];
+        for (k, (x, y)) in jx.iter_mut().zip(&mut jy).enumerate() {
+            let i = base.wrapping_add(k as u32);
+            let h = mix64(
+                set.jitter_fast
+                    .wrapping_add((i as u64).wrapping_mul(HASH_INIT)),
+            );
+            *x = h as u32 >> 8;
+            *y = (h >> 40) as u32;
+        }
+        (jx, jy)
+    }
+
+    /// Stratified 1D samples `base..base + CHUNK` of `set` (those < count are the same f32s as
+    /// [`SetKeys::sample_1d`]; the rest are unspecified).
+    #[inline(always)]
+    fn chunk_1d(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+        let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
+        let (jx, _) = Self::jitters(set, base);
+        fixed_chunk(&strata, &jx, self.div_1d, self.small_1d)
+    }
+
+    /// Stratified 2D samples `base..base + CHUNK` of `set` (see [`FastStrata::chunk_1d`]).
+    #[inline(always)]
+    fn chunk_2d(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+        let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
+        let (jx, jy) = Self::jitters(set, base);
+        let sx = strata.map(|s| s & self.nx_mask);
+        let sy = strata.map(|s| s >> self.nx_log2);
+        let x = fixed_chunk(&sx, &jx, self.div_x, self.small_2d);
+        let y = fixed_chunk(&sy, &jy, self.div_y, self.small_2d);
+        std::array::from_fn(|k| Vec2::new(x[k], y[k]))
+    }
+}
+
+/// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form that
+/// vectorises (the same values: the integer is the same and exact either way).
+#[inline(always)]
+fn fixed_chunk(strata: &[u32; CHUNK], j: &[u32; CHUNK], div: f32, small: bool) -> [f32; CHUNK] {
+    if small {
+        std::array::from_fn(|k| {
+            let v = ((strata[k] << 24) | j[k]) as i32 as f32 / div;
+            if v < ONE_MINUS_EPSILON {
+                v
+            } else {
+                ONE_MINUS_EPSILON
+            }
+        })
+    } else {
+        std::array::from_fn(|k| in_stratum_fixed(strata[k], j[k], div))
+    }
+}
+
+/// 2^24: one in the 24-bit fixed point of the jitter.
+const FIX_ONE: f32 = (1u32 << 24) as f32;
+
+/// (stratum + jitter) / n with the jitter's 24 bits `j` and `div = n · 2^24`: the same f32 as
+/// [`in_stratum`]`(stratum, j · 2^-24, n)` for stratum < 2^24. Both round the exact value
+/// stratum + j · 2^-24 once (scaled by 2^24, which commutes with rounding) and then divide
+/// by the exact n, so the results agree bit for bit; this form saves the conversions.
+#[inline(always)]
+fn in_stratum_fixed(stratum: u32, j: u32, div: f32) -> f32 {
+    let v = (((stratum as u64) << 24) | j as u64) as i64 as f32 / div;
+    // `v` is never NaN, so this is `v.min(ONE_MINUS_EPSILON)` in a single `minss`.
+    if v < ONE_MINUS_EPSILON {
+        v
+    } else {
+        ONE_MINUS_EPSILON
+    }
+}
+
+/// Indices per [`Chunk`]: a sample set's values are computed this many at a time.
+const CHUNK: usize = 16;
+
+/// Precomputed values of consecutive indices [base, base + len) of one sample set for one
+/// count: integrators walk a pixel's indices in order, so a batch evaluated in one tight loop
+/// (keys in registers, no per-call lookups) serves the next `len` requests with one compare.
+#[derive(Clone, Debug)]
+struct Chunk<T: Copy> {
+    /// The count the values belong to.
+    count: Cell<u32>,
+    /// First index.
+    base: Cell<u32>,
+    /// Number of valid values (0 = empty).
+    len: Cell<u32>,
+    /// The values of indices base..base + len.
+    v: [Cell<T>; CHUNK],
+}
+
+impl<T: Copy + Default> Default for Chunk<T> {
+    fn default() -> Self {
+        Self {
+            count: Cell::new(0),
+            base: Cell::new(0),
+            len: Cell::new(0),
+            v: Default::default(),
+        }
+    }
+}
+
+impl<T: Copy> Chunk<T> {
+    /// The value of `index` of `count`, if this chunk holds it (hot path).
+    #[inline(always)]
+    fn get(&self, index: u32, count: u32) -> Option<T> {
+        let off = index.wrapping_sub(self.base.get());
+        if self.count.get() == count && off < self.len.get() {
+            return Some(self.v[off as usize % CHUNK].get());
+        }
+        None
+    }
+
+    /// Store the values `v` of the chunk of `index` (< count) and return `index`'s value.
+    #[inline(always)]
+    fn store(&self, index: u32, count: u32, v: &[T; CHUNK]) -> T {
+        let base = index & !(CHUNK as u32 - 1);
+        let len = (count - base).min(CHUNK as u32);
+        for (c, &x) in self.v.iter().zip(v) {
+            c.set(x);
+        }
+        self.count.set(count);
+        self.base.set(base);
+        self.len.set(len);
+        v[(index - base) as usize % CHUNK]
     }
 }
 
@@ -365,6 +577,11 @@ pub struct PixelSamples {
     /// The two most recently used sample counts' [`Strata`] (an integrator asks for two: N for
     /// the pixel filter, N·M for the shading dimensions).
     strata: Cell<[Strata; 2]>,
+    /// The same in the `stratified` fast form: two slots, most recent first.
+    fast: [Cell<FastStrata>; 2],
+    /// Batches of precomputed `stratified` values per cached 1D / 2D dimension.
+    chunks_1d: [Chunk<f32>; CACHED_DIMS],
+    chunks_2d: [Chunk<Vec2>; CACHED_DIMS],
 }
 
 impl PixelSamples {
@@ -390,22 +607,128 @@ impl PixelSamples {
         c[0]
     }
 
-    /// The 1D sample `index` of `count` for `dim`.
+    /// The [`FastStrata`] of `count`, from the two-slot cache (most recent first).
     #[inline]
-    pub fn sample_1d(&self, dim: u32, index: u32, count: u32) -> f32 {
-        match self.sets_1d.get(dim as usize) {
-            Some(s) => s.sample_1d(self.pattern.kind, index, &self.strata(count)),
-            None => self.pattern.sample_1d(self.pixel, dim, index, count),
+    fn fast(&self, count: u32) -> FastStrata {
+        let a = self.fast[0].get();
+        if a.key == count as u64 {
+            return a;
         }
+        let b = self.fast[1].get();
+        if b.key == count as u64 {
+            return b;
+        }
+        let f = FastStrata::new(count);
+        self.fast[1].set(a);
+        self.fast[0].set(f);
+        f
+    }
+
+    /// The 1D sample `index` of `count` for `dim`.
+    #[inline(always)]
+    pub fn sample_1d(&self, dim: u32, index: u32, count: u32) -> f32 {
+        if let Some(c) = self.chunks_1d.get(dim as usize)
+            && let Some(v) = c.get(index, count)
+        {
+            return v;
+        }
+        self.sample_1d_miss(dim, index, count)
+    }
+
+    /// [`PixelSamples::sample_1d`] when no chunk holds the value: refill the chunk of `index`
+    /// (< count; the `stratified` fast form where it applies) or evaluate the general way.
+    #[inline(never)]
+    fn sample_1d_miss(&self, dim: u32, index: u32, count: u32) -> f32 {
+        let Some(set) = self.sets_1d.get(dim as usize) else {
+            return self.pattern.sample_1d(self.pixel, dim, index, count);
+        };
+        let kind = self.pattern.kind;
+        if index < count {
+            let base = index & !(CHUNK as u32 - 1);
+            let f = if kind == PatternKind::Stratified {
+                self.fast(count)
+            } else {
+                FastStrata::NONE
+            };
+            let v = if f.valid {
+                f.chunk_1d(set, base)
+            } else {
+                // Every other pattern and count: the general evaluation, batched the same way.
+                let st = self.strata(count);
+                let len = (count - base).min(CHUNK as u32) as usize;
+                let batch = |kind| {
+                    let mut v = [Default::default(); CHUNK];
+                    for (k, o) in v.iter_mut().enumerate().take(len) {
+                        *o = set.sample_1d(kind, base + k as u32, &st);
+                    }
+                    v
+                };
+                // One loop per kind, so that each loop body is that kind's arithmetic only.
+                match kind {
+                    PatternKind::Fixed => batch(PatternKind::Fixed),
+                    PatternKind::Random => batch(PatternKind::Random),
+                    PatternKind::Grid => batch(PatternKind::Grid),
+                    PatternKind::Stratified => batch(PatternKind::Stratified),
+                    PatternKind::Lhs => batch(PatternKind::Lhs),
+                    PatternKind::Sobol => batch(PatternKind::Sobol),
+                }
+            };
+            return self.chunks_1d[dim as usize].store(index, count, &v);
+        }
+        set.sample_1d(kind, index, &self.strata(count))
     }
 
     /// The 2D sample `index` of `count` for `dim`.
-    #[inline]
+    #[inline(always)]
     pub fn sample_2d(&self, dim: u32, index: u32, count: u32) -> Vec2 {
-        match self.sets_2d.get(dim as usize) {
-            Some(s) => s.sample_2d(self.pattern.kind, index, &self.strata(count)),
-            None => self.pattern.sample_2d(self.pixel, dim, index, count),
+        if let Some(c) = self.chunks_2d.get(dim as usize)
+            && let Some(v) = c.get(index, count)
+        {
+            return v;
         }
+        self.sample_2d_miss(dim, index, count)
+    }
+
+    /// [`PixelSamples::sample_2d`] when no chunk holds the value (see `sample_1d_miss`).
+    #[inline(never)]
+    fn sample_2d_miss(&self, dim: u32, index: u32, count: u32) -> Vec2 {
+        let Some(set) = self.sets_2d.get(dim as usize) else {
+            return self.pattern.sample_2d(self.pixel, dim, index, count);
+        };
+        let kind = self.pattern.kind;
+        if index < count {
+            let base = index & !(CHUNK as u32 - 1);
+            let f = if kind == PatternKind::Stratified {
+                self.fast(count)
+            } else {
+                FastStrata::NONE
+            };
+            let v = if f.valid {
+                f.chunk_2d(set, base)
+            } else {
+                // Every other pattern and count: the general evaluation, batched the same way.
+                let st = self.strata(count);
+                let len = (count - base).min(CHUNK as u32) as usize;
+                let batch = |kind| {
+                    let mut v = [Default::default(); CHUNK];
+                    for (k, o) in v.iter_mut().enumerate().take(len) {
+                        *o = set.sample_2d(kind, base + k as u32, &st);
+                    }
+                    v
+                };
+                // One loop per kind, so that each loop body is that kind's arithmetic only.
+                match kind {
+                    PatternKind::Fixed => batch(PatternKind::Fixed),
+                    PatternKind::Random => batch(PatternKind::Random),
+                    PatternKind::Grid => batch(PatternKind::Grid),
+                    PatternKind::Stratified => batch(PatternKind::Stratified),
+                    PatternKind::Lhs => batch(PatternKind::Lhs),
+                    PatternKind::Sobol => batch(PatternKind::Sobol),
+                }
+            };
+            return self.chunks_2d[dim as usize].store(index, count, &v);
+        }
+        set.sample_2d(kind, index, &self.strata(count))
     }
 }
 

@@ -2,18 +2,41 @@
 //! assigned to sample indices without storing a shuffled table (idea after Kensler 2013,
 //! "Correlated Multi-Jittered Sampling"; this construction is our own).
 
-/// One keyed round of invertible operations on `bits`-bit integers (`mask = 2^bits − 1`).
-#[inline]
-fn round(mut i: u32, mask: u32, bits: u32, k: u32, m: u32) -> u32 {
+/// The keys of one round, pre-derived from the permutation key (see [`round`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct RoundKeys {
+    /// Xored in first.
+    x: u32,
+    /// Odd multiplier.
+    m: u32,
+    /// Added before the fixed multiplier.
+    a: u32,
+}
+
+impl RoundKeys {
+    /// The round of xor key `k` and multiplier `m` (made odd).
+    #[inline]
+    fn new(k: u32, m: u32) -> Self {
+        Self {
+            x: k,
+            m: m | 1,
+            a: k >> 16,
+        }
+    }
+}
+
+/// One keyed round of invertible operations on `bits`-bit integers (`mask = 2^bits − 1`,
+/// `s1 = bits/2 + 1`, `s2 = bits/3 + 1`).
+#[inline(always)]
+fn round(i: u32, r: &RoundKeys, dom: &PermDomain) -> u32 {
     // Each step is a bijection of [0, 2^bits): xor/add a constant, multiply by an odd number,
-    // and xor with a right shift of itself (the result stays inside the mask).
-    i ^= k & mask;
-    i = i.wrapping_mul(m | 1) & mask;
-    i ^= i >> (bits / 2 + 1);
-    i = i.wrapping_add(k >> 16) & mask;
-    i = i.wrapping_mul(0x2c1b_3c6d) & mask;
-    i ^= i >> (bits / 3 + 1);
-    i
+    // and xor with a right shift of itself (the result stays inside the mask). The low `bits`
+    // bits of a sum or product depend only on the operands' low bits, so masking once after
+    // each multiply gives the same value as masking every operand.
+    let mut i = (i ^ r.x).wrapping_mul(r.m) & dom.mask;
+    i ^= i >> dom.s1;
+    i = i.wrapping_add(r.a).wrapping_mul(0x2c1b_3c6d) & dom.mask;
+    i ^ (i >> dom.s2)
 }
 
 /// The image of `index` under a pseudo-random permutation of [0, n) selected by `key`.
@@ -28,7 +51,7 @@ pub fn permute(index: u32, n: u32, key: u64) -> u32 {
 /// indices under the same key (one pixel's strata) pays the two key hashes only once.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Permutation {
-    k: [u32; 4],
+    r: [RoundKeys; 3],
 }
 
 impl Permutation {
@@ -37,8 +60,13 @@ impl Permutation {
     pub fn new(key: u64) -> Self {
         let k = super::hash::mix64(key);
         let k2 = super::hash::mix64(k);
+        let [k0, k1, k2, k3] = [k as u32, (k >> 32) as u32, k2 as u32, (k2 >> 32) as u32];
         Self {
-            k: [k as u32, (k >> 32) as u32, k2 as u32, (k2 >> 32) as u32],
+            r: [
+                RoundKeys::new(k0, k1),
+                RoundKeys::new(k2, k3),
+                RoundKeys::new(k1 ^ k2, k0 ^ k3),
+            ],
         }
     }
 
@@ -51,43 +79,113 @@ impl Permutation {
     /// [`Permutation::apply`] with the domain's bit width precomputed (hot path).
     #[inline]
     pub fn apply_in(&self, index: u32, dom: &PermDomain) -> u32 {
-        let PermDomain { n, bits, mask } = *dom;
-        if n <= 1 {
-            return 0;
-        }
-        let [k0, k1, k2, k3] = self.k;
-        let mut i = if index < n { index } else { index % n };
+        let n = dom.n;
+        self.apply_wrapped(if index < n { index } else { index % n }, dom)
+    }
+
+    /// [`Permutation::apply_in`] of an index already in [0, n) (hot path: the caller wrapped it).
+    #[inline(always)]
+    pub fn apply_wrapped(&self, index: u32, dom: &PermDomain) -> u32 {
+        // n = 1 needs no special case: its mask is 0, so every round maps to 0.
+        let mut i = index;
         loop {
-            i = round(i, mask, bits, k0, k1);
-            i = round(i, mask, bits, k2, k3);
-            i = round(i, mask, bits, k1 ^ k2, k0 ^ k3);
-            if i < n {
+            i = round(i, &self.r[0], dom);
+            i = round(i, &self.r[1], dom);
+            i = round(i, &self.r[2], dom);
+            if i < dom.n {
                 return i;
             }
         }
     }
 }
 
+impl Permutation {
+    /// The images of the `N` consecutive indices `base..base + N` (each < n), computed in one
+    /// loop that the compiler can vectorise when n is a power of two (no cycle-walking).
+    /// Entries for indices ≥ n (when base + N > n) are unspecified.
+    #[inline(always)]
+    pub fn apply_many<const N: usize>(&self, base: u32, dom: &PermDomain) -> [u32; N] {
+        let (p, d) = (*self, *dom);
+        let mut out = [0u32; N];
+        if d.mask.wrapping_add(1) == d.n {
+            for (k, o) in out.iter_mut().enumerate() {
+                let i = base.wrapping_add(k as u32);
+                *o = round(round(round(i, &p.r[0], &d), &p.r[1], &d), &p.r[2], &d);
+            }
+        } else {
+            let len = d.n.saturating_sub(base).min(N as u32) as usize;
+            for (k, o) in out.iter_mut().enumerate().take(len) {
+                *o = p.apply_wrapped(base + k as u32, &d);
+            }
+        }
+        out
+    }
+}
+
 /// The length of a permuted range with the width of its enclosing power of two, which
 /// [`Permutation::apply_in`] would otherwise recompute for every index.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PermDomain {
+    /// Length (≥ 1).
     n: u32,
-    bits: u32,
+    /// 2^bits − 1 with 2^bits the smallest power of two ≥ n.
     mask: u32,
+    /// First shift of a round, bits/2 + 1.
+    s1: u32,
+    /// Second shift of a round, bits/3 + 1.
+    s2: u32,
+}
+
+impl Default for PermDomain {
+    /// The domain [0, 1).
+    fn default() -> Self {
+        Self::new(1)
+    }
 }
 
 impl PermDomain {
-    /// The domain [0, n).
+    /// The domain [0, 1).
+    pub const ONE: Self = Self {
+        n: 1,
+        mask: 0,
+        s1: 1,
+        s2: 1,
+    };
+
+    /// The domain [0, n) (n = 0 counts as 1).
     #[inline]
     pub fn new(n: u32) -> Self {
-        let bits = 32 - n.saturating_sub(1).leading_zeros();
+        let n = n.max(1);
+        let bits = 32 - (n - 1).leading_zeros();
         let mask = if bits == 32 {
             u32::MAX
         } else {
             (1 << bits) - 1
         };
-        Self { n, bits, mask }
+        Self {
+            n,
+            mask,
+            s1: bits / 2 + 1,
+            s2: bits / 3 + 1,
+        }
+    }
+
+    /// The length n.
+    #[inline]
+    pub fn len(&self) -> u32 {
+        self.n
+    }
+
+    /// 2^bits − 1, with 2^bits the smallest power of two ≥ n.
+    #[inline]
+    pub fn mask(&self) -> u32 {
+        self.mask
+    }
+
+    /// Never true: the domain holds at least one element.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        false
     }
 }
 
