@@ -198,7 +198,9 @@ impl WideBvh {
             return None;
         }
         let r = RayBox::new(o, d);
-        let shear = RayShear4::new(o, d);
+        // Built at the first leaf: a ray that misses every leaf box (most rays against the
+        // small emitter-only geometry) never pays for the shear setup.
+        let mut shear: Option<RayShear4> = None;
         let mut best = t_max;
         let mut hit: Option<(usize, Bary)> = None;
         // Not cleared per ray: only entries below `sp` are ever read, and those were written.
@@ -247,6 +249,7 @@ impl WideBvh {
                     continue;
                 }
             } else {
+                let shear = shear.get_or_insert_with(|| RayShear4::new(o, d));
                 let mut pi = (cur & !LEAF) as usize;
                 loop {
                     // SAFETY: a leaf reference is the first packet of a non-empty run inside
