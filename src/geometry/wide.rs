@@ -93,6 +93,50 @@ impl RayBox {
 pub struct WideBvh {
     nodes: Vec<Node4>,
     packets: Vec<TriPacket>,
+    /// Set when the whole tree is one leaf (the emitter-only geometry of most scenes): its
+    /// box (the root's lane 0) and leaf reference, for [`WideBvh::closest`]'s fast path.
+    single_leaf: Option<SingleLeaf>,
+}
+
+/// The box and leaf reference of a tree that is a single leaf.
+#[derive(Clone, Copy, Debug)]
+struct SingleLeaf {
+    lo: Vec3,
+    hi: Vec3,
+    child: u32,
+}
+
+/// `Vec4::max` on one lane (SSE `maxps` semantics, NaN and zero sign included), so that the
+/// single-box test reduces the axes exactly like [`Node4::hit`] does per lane.
+#[inline(always)]
+fn lane_max(a: f32, b: f32) -> f32 {
+    Vec4::splat(a).max(Vec4::splat(b)).x
+}
+
+/// `Vec4::min` on one lane (see [`lane_max`]).
+#[inline(always)]
+fn lane_min(a: f32, b: f32) -> f32 {
+    Vec4::splat(a).min(Vec4::splat(b)).x
+}
+
+impl SingleLeaf {
+    /// The slab test of [`Node4::hit`] for this one box: the same operations on the same
+    /// values as its lane 0, hence the same verdict, without the splatted per-ray setup.
+    #[inline(always)]
+    fn hit(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
+        let inv = safe_inverse(d);
+        let t = |lo: f32, hi: f32, o: f32, inv: f32| {
+            let (n, f) = if inv < 0.0 { (hi, lo) } else { (lo, hi) };
+            ((n - o) * inv, (f - o) * inv)
+        };
+        let (nx, fx) = t(self.lo.x, self.hi.x, o.x, inv.x);
+        let (ny, fy) = t(self.lo.y, self.hi.y, o.y, inv.y);
+        let (nz, fz) = t(self.lo.z, self.hi.z, o.z, inv.z);
+        let near = lane_max(lane_max(lane_max(nx, ny), nz), 0.0) * NEAR_SLACK;
+        let far = lane_min(fx, fy);
+        let far = lane_min(far, fz) * ROUNDING_SLACK;
+        near <= lane_min(far, t_max)
+    }
 }
 
 impl WideBvh {
@@ -105,6 +149,24 @@ impl WideBvh {
                 return None;
             }
             w.collapse(tree, prims, 0);
+        }
+        // One node whose lanes 1..3 are unused (inverted boxes, which every ray misses) and
+        // whose lane 0 is therefore a leaf.
+        if let [root] = w.nodes.as_slice() {
+            let unused = (1..4).all(|lane| {
+                (0..3).all(|a| root.b[0][a][lane] == f32::INFINITY)
+                    && (0..3).all(|a| root.b[1][a][lane] == f32::NEG_INFINITY)
+            });
+            if unused && root.child[0] & LEAF != 0 {
+                let lane0 = |side: usize| {
+                    Vec3::new(root.b[side][0].x, root.b[side][1].x, root.b[side][2].x)
+                };
+                w.single_leaf = Some(SingleLeaf {
+                    lo: lane0(0),
+                    hi: lane0(1),
+                    child: root.child[0],
+                });
+            }
         }
         Some(w)
     }
@@ -194,6 +256,16 @@ impl WideBvh {
         t_max: f32,
         mut other: impl FnMut(usize, f32) -> f32,
     ) -> Option<(usize, f32, Bary)> {
+        if let Some(leaf) = &self.single_leaf {
+            // The traversal would test the root's one box and then this leaf with
+            // best = t_max: the same here, minus its per-ray setup (most rays miss).
+            if !leaf.hit(o, d, t_max) {
+                return None;
+            }
+            let mut best = t_max;
+            let hit = self.leaf_closest(leaf.child, &RayShear4::new(o, d), &mut best, &mut other);
+            return hit.map(|(id, b)| (id, best, b));
+        }
         if self.nodes.is_empty() {
             return None;
         }
@@ -250,32 +322,8 @@ impl WideBvh {
                 }
             } else {
                 let shear = shear.get_or_insert_with(|| RayShear4::new(o, d));
-                let mut pi = (cur & !LEAF) as usize;
-                loop {
-                    // SAFETY: a leaf reference is the first packet of a non-empty run inside
-                    // `packets` (see `leaf`) whose final packet has `last` set, so pi never
-                    // leaves `packets`.
-                    let pk = unsafe { self.packets.get_unchecked(pi) };
-                    if pk.tri != 0
-                        && let Some((lane, t, b)) = shear.closest(pk, best)
-                    {
-                        best = t;
-                        hit = Some((pk.ids[lane & 3] as usize, b));
-                    }
-                    let mut others = pk.other;
-                    while others != 0 {
-                        let id = pk.ids[others.trailing_zeros() as usize] as usize;
-                        others &= others - 1;
-                        let t = other(id, best);
-                        if t < best {
-                            best = t;
-                            hit = Some((id, [1.0 / 3.0; 3]));
-                        }
-                    }
-                    if pk.last {
-                        break;
-                    }
-                    pi += 1;
+                if let Some(h) = self.leaf_closest(cur, shear, &mut best, &mut other) {
+                    hit = Some(h);
                 }
             }
             // Pop the nearest pending subtree that can still hold a closer hit.
@@ -291,6 +339,46 @@ impl WideBvh {
                     break;
                 }
             }
+        }
+    }
+
+    /// The closest hit below `*best` among the primitives of leaf `child` (a `LEAF`
+    /// reference): lowers `*best` to its t and returns (leaf-order id, barycentrics).
+    #[inline(always)]
+    fn leaf_closest(
+        &self,
+        child: u32,
+        shear: &RayShear4,
+        best: &mut f32,
+        other: &mut impl FnMut(usize, f32) -> f32,
+    ) -> Option<(usize, Bary)> {
+        let mut hit = None;
+        let mut pi = (child & !LEAF) as usize;
+        loop {
+            // SAFETY: a leaf reference is the first packet of a non-empty run inside
+            // `packets` (see `leaf`) whose final packet has `last` set, so pi never leaves
+            // `packets`.
+            let pk = unsafe { self.packets.get_unchecked(pi) };
+            if pk.tri != 0
+                && let Some((lane, t, b)) = shear.closest(pk, *best)
+            {
+                *best = t;
+                hit = Some((pk.ids[lane & 3] as usize, b));
+            }
+            let mut others = pk.other;
+            while others != 0 {
+                let id = pk.ids[others.trailing_zeros() as usize] as usize;
+                others &= others - 1;
+                let t = other(id, *best);
+                if t < *best {
+                    *best = t;
+                    hit = Some((id, [1.0 / 3.0; 3]));
+                }
+            }
+            if pk.last {
+                return hit;
+            }
+            pi += 1;
         }
     }
 
@@ -389,6 +477,59 @@ mod tests {
     use crate::geometry::triangle::intersect_triangle;
     use crate::sampling::hash::{next_f32, pcg_from_keys};
     use rand_pcg::Pcg32;
+
+    #[test]
+    fn single_leaf_fast_path_matches_the_traversal() {
+        let mut s = pcg_from_keys(&[5]);
+        let rnd3 = |s: &mut Pcg32| Vec3::new(next_f32(s), next_f32(s), next_f32(s)) * 2.0 - 1.0;
+        let mut fast_hits = 0;
+        for n in 1..=4u32 {
+            let prims: Vec<Primitive> = (0..n)
+                .map(|i| Primitive {
+                    p: [rnd3(&mut s), rnd3(&mut s), rnd3(&mut s)],
+                    kind: PrimKind::Triangle { mesh: 0, v: [i; 3] },
+                    material: 0,
+                    light: u32::MAX,
+                })
+                .collect();
+            let boxes: Vec<(Vec3, Vec3)> = prims
+                .iter()
+                .map(|p| {
+                    (
+                        p.p[0].min(p.p[1]).min(p.p[2]),
+                        p.p[0].max(p.p[1]).max(p.p[2]),
+                    )
+                })
+                .collect();
+            let Some(fast) = WideBvh::build(&Tree2::ploc(&boxes), &prims) else {
+                panic!("{n} triangles gave a too deep tree");
+            };
+            assert!(fast.single_leaf.is_some(), "{n} triangles are not one leaf");
+            let slow = WideBvh {
+                single_leaf: None,
+                ..fast.clone()
+            };
+            for _ in 0..5000 {
+                let o = rnd3(&mut s) * 3.0;
+                // Half the rays aim at a vertex, so hits and box-edge cases are common.
+                let d = if next_f32(&mut s) < 0.5 {
+                    prims[0].p[0] - o
+                } else {
+                    rnd3(&mut s)
+                };
+                let t_max = if next_f32(&mut s) < 0.5 {
+                    f32::INFINITY
+                } else {
+                    2.0
+                };
+                let want = slow.closest(o, d, t_max, |_, _| f32::INFINITY);
+                let got = fast.closest(o, d, t_max, |_, _| f32::INFINITY);
+                assert_eq!(want, got);
+                fast_hits += got.is_some() as u32;
+            }
+        }
+        assert!(fast_hits > 1000, "{fast_hits} hits");
+    }
 
     #[test]
     fn both_binary_trees_collapse_to_correct_wide_trees() {
