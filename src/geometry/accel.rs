@@ -388,8 +388,11 @@ impl Geometry {
     }
 }
 
-impl RayQuery for Geometry {
-    fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+impl Geometry {
+    /// [`RayQuery::intersect`] after the cheap pre-test, out of line: its frame (traversal
+    /// stack, six saved registers) is not set up for rays that the pre-test rejects.
+    #[inline(never)]
+    fn intersect_full(&self, ray: &Ray) -> Option<SurfaceHit> {
         let (id, t, b) = match &self.accel {
             // The wide BVH tests triangles itself; only quadrics come back here.
             Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
@@ -398,6 +401,18 @@ impl RayQuery for Geometry {
             _ => self.closest_by_callback(ray)?,
         };
         Some(self.surface_hit(id, ray, t, b))
+    }
+}
+
+impl RayQuery for Geometry {
+    fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        // Most rays against the emitter-only geometry (one leaf on most scenes) miss it.
+        if let Accel::Wide(bvh) = &self.accel
+            && bvh.single_leaf_missed(ray.o, ray.d, ray.t_max)
+        {
+            return None;
+        }
+        self.intersect_full(ray)
     }
 
     fn occluded(&self, ray: &Ray) -> bool {

@@ -245,6 +245,17 @@ impl WideBvh {
         first as u32
     }
 
+    /// True if the tree is a single leaf whose box the ray (o, d) misses in (0, t_max), so
+    /// that [`Self::closest`] would return `None`: a cheap pre-test for callers whose own
+    /// per-query work (a large stack frame) is worth skipping.
+    #[inline(always)]
+    pub fn single_leaf_missed(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
+        match &self.single_leaf {
+            Some(leaf) => !leaf.hit(o, d, t_max),
+            None => false,
+        }
+    }
+
     /// Closest hit of the ray (o, d) in (0, t_max): (leaf-order id, t, barycentrics).
     /// Triangles are tested here; `other(id, t_best)` returns the hit distance of a
     /// non-triangle primitive if below `t_best`, else +∞.
