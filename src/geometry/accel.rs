@@ -391,6 +391,30 @@ impl Geometry {
 }
 
 impl Geometry {
+    /// [`RayQuery::occluded`] for the backends other than the default one.
+    #[inline(never)]
+    fn occluded_other(&self, ray: &Ray) -> bool {
+        let shear = || RayShear::new(ray.o, ray.d);
+        match &self.accel {
+            Accel::None => false,
+            Accel::Wide(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                self.quadric_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
+            }),
+            Accel::Own(bvh) => {
+                let shear = shear();
+                bvh.any(ray.o, ray.d, ray.t_max, |id| {
+                    self.prim_t(id, &shear, ray.o, ray.d, ray.t_max) < ray.t_max
+                })
+            }
+            Accel::Obvhs(bvh) => {
+                let shear = shear();
+                !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
+                    self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
+                })
+            }
+        }
+    }
+
     /// [`RayQuery::intersect`] after the cheap pre-test, out of line: its frame (traversal
     /// stack, six saved registers) is not set up for rays that the pre-test rejects.
     #[inline(never)]
@@ -418,30 +442,13 @@ impl RayQuery for Geometry {
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
-        // The default backend first, by a compare: the `match` below is a jump table.
+        // The default backend by a compare; the others out of line (inline, LLVM folds all
+        // four into a jump table that every shadow ray pays for).
         if let Accel::Wide(bvh) = &self.accel {
             return bvh.any(ray.o, ray.d, ray.t_max, |id| {
                 self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
             });
         }
-        let shear = || RayShear::new(ray.o, ray.d);
-        match &self.accel {
-            Accel::None => false,
-            Accel::Wide(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.quadric_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
-            }),
-            Accel::Own(bvh) => {
-                let shear = shear();
-                bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                    self.prim_t(id, &shear, ray.o, ray.d, ray.t_max) < ray.t_max
-                })
-            }
-            Accel::Obvhs(bvh) => {
-                let shear = shear();
-                !bvh.ray_traverse_miss(to_obvhs(ray), |r, id| {
-                    self.prim_t(id, &shear, ray.o, ray.d, r.tmax)
-                })
-            }
-        }
+        self.occluded_other(ray)
     }
 }
