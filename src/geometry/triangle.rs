@@ -4,7 +4,7 @@
 //! ray-sheared space.
 
 use super::float::gamma;
-use glam::{DVec2, Vec3};
+use glam::{DVec2, Vec3, Vec3A};
 
 /// Per-ray constants of the shear that maps the ray to +z through the origin, stored as the
 /// rows of the shear matrix so that each vertex is transformed by three dot products instead of
@@ -99,7 +99,8 @@ pub fn shear_axes(d: Vec3) -> [usize; 3] {
     // A `static` table is one load; a literal array is built on the stack at every call.
     static KZ: [usize; 4] = [2, 1, 0, 0];
     let kz = KZ[(x_max as usize) << 1 | y_max as usize];
-    let neg = ([d.x, d.y, d.z, 0.0][kz & 3] < 0.0) as usize;
+    // `d[kz] < 0` from one vector compare (an indexed array would go through the stack).
+    let neg = (Vec3A::from(d).cmplt(Vec3A::ZERO).bitmask() as usize >> kz) & 1;
     // (kx, ky) = (kz + 1, kz + 2) mod 3, swapped when d[kz] < 0.
     const AXES: [[usize; 3]; 8] = [
         [1, 2, 0],
