@@ -248,14 +248,18 @@ impl Geometry {
 
     /// The hit record of primitive `id` hit at `t` with triangle barycentrics `b`.
     fn surface_hit(&self, id: usize, ray: &Ray, t: f32, b: Bary) -> SurfaceHit {
-        let p = &self.prims[id];
+        // SAFETY: `id` comes from a traversal, which reports only ids it has tested: leaf-order
+        // ids < prims.len() stored by the wide BVH's build, or ids the callback backends passed
+        // to `prim_hit`, which indexes `prims` with a bounds check. `tri_ng` has one entry per
+        // primitive.
+        let (p, tri_ng) = unsafe { (self.prims.get_unchecked(id), *self.tri_ng.get_unchecked(id)) };
         match p.kind {
             PrimKind::Triangle { mesh, v } => {
                 let [b0, b1, b2] = b;
                 let verts = p.p;
                 let pos = verts[0] * b0 + verts[1] * b1 + verts[2] * b2;
                 let m = &self.meshes[mesh as usize];
-                let mut ng = self.tri_ng[id];
+                let mut ng = tri_ng;
                 let ns = match &m.normals {
                     Some(n) => {
                         let ns = unit_or_zero(
