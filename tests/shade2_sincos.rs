@@ -18,8 +18,13 @@ fn sin_cos_turn_max_abs_error_below_2e7() {
     for &t in ts.iter().filter(|t| (0.0..=1.0).contains(*t)) {
         let (s, c) = sin_cos_turn(t);
         let (se, ce) = (std::f64::consts::TAU * t as f64).sin_cos();
-        max_err = max_err.max((s as f64 - se).abs()).max((c as f64 - ce).abs());
-        assert!(s.abs() <= 1.0 && c.abs() <= 1.0, "t = {t}: ({s}, {c}) outside [-1, 1]");
+        max_err = max_err
+            .max((s as f64 - se).abs())
+            .max((c as f64 - ce).abs());
+        assert!(
+            s.abs() <= 1.0 && c.abs() <= 1.0,
+            "t = {t}: ({s}, {c}) outside [-1, 1]"
+        );
     }
     println!("max abs error {max_err:e}");
     assert!(max_err <= 2e-7, "max abs error {max_err:e} > 2e-7");

@@ -43,7 +43,11 @@ pub fn sin_cos_turn(t: f32) -> (f32, f32) {
     let cos_r = 1.0 + r2 * (-1.233_698 + r2 * (0.253_606_36 + r2 * -0.020_426_25));
     // Quadrant q rotates by qπ/2: odd q swaps sin and cos; sin is negated in quadrants 2, 3
     // and cos in quadrants 1, 2 — sign bits set by integer xor instead of branches.
-    let (a, b) = if q & 1 == 0 { (sin_r, cos_r) } else { (cos_r, sin_r) };
+    let (a, b) = if q & 1 == 0 {
+        (sin_r, cos_r)
+    } else {
+        (cos_r, sin_r)
+    };
     let sin_sign = ((q & 2) as u32) << 30;
     let cos_sign = (((q + 1) & 2) as u32) << 30;
     (
