@@ -262,7 +262,13 @@ impl<'a> DirectLighting<'a> {
 
     /// One BSDF-sampling estimate f·cos·Le / pdf, MIS-weighted when `mis`.
     fn bsdf_sample(&self, sh: &Shading, d: &Draws, mis: bool, rays: &mut u64) -> Rgb {
-        let Some(bs) = sh.bsdf.sample(sh.wo_local, d.lobe, d.bsdf) else {
+        // Lambert inline: `Bsdf::sample` carries every BSDF and stays out of line, so the
+        // common diffuse hit paid a call and a `BsdfSample` returned through memory.
+        let sample = match sh.bsdf {
+            Bsdf::Lambert(b) => b.sample(sh.wo_local, d.lobe, d.bsdf),
+            other => other.sample(sh.wo_local, d.lobe, d.bsdf),
+        };
+        let Some(bs) = sample else {
             return Rgb::ZERO;
         };
         if !(bs.pdf > 0.0) {
