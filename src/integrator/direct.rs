@@ -70,7 +70,8 @@ struct Draws {
 
 impl Draws {
     /// The draws of sample `index` of `count`; only the dimensions the strategy reads.
-    #[inline]
+    /// Forced inline: out of line, the draws came back through memory after a call.
+    #[inline(always)]
     fn new(px: &PixelSamples, index: u32, count: u32, light: bool, bsdf: bool) -> Self {
         let mut d = Draws::default();
         if light {
