@@ -56,6 +56,54 @@ pub fn sin_cos_turn(t: f32) -> (f32, f32) {
     )
 }
 
+/// `(sin x, cos x)` in f64 for 0 ≤ x ≤ 8 (solid angles: at most 4π), without the libm
+/// `sincos` call (≈ 85 instructions per spherical-triangle sample); other x go to libm.
+///
+/// Cody–Waite reduction by π/2 in two parts (the high part has 8 trailing zero bits, so
+/// q·hi is exact for the q ≤ 5 that occur), then Taylor series on |r| ≤ π/4 up to r¹⁵ / r¹⁶,
+/// whose truncation error (< 5e-17) is below f64 rounding. Max abs. error vs libm is tested.
+#[inline]
+pub fn sin_cos_small_f64(x: f64) -> (f64, f64) {
+    if !(0.0..=8.0).contains(&x) {
+        return x.sin_cos();
+    }
+    const PIO2_HI: f64 = f64::from_bits(std::f64::consts::FRAC_PI_2.to_bits() & !0xff);
+    // The zeroed bits, plus π/2 − FRAC_PI_2 (the part of π/2 that f64 cannot hold).
+    const PIO2_LO: f64 = (std::f64::consts::FRAC_PI_2 - PIO2_HI) + 6.123_233_995_736_766e-17;
+    let q = (x * std::f64::consts::FRAC_2_PI + 0.5) as i64;
+    let qf = q as f64;
+    let r = (x - qf * PIO2_HI) - qf * PIO2_LO;
+    let r2 = r * r;
+    // 1/n! for the Taylor terms (exact to f64 rounding as constant expressions).
+    const F3: f64 = 1.0 / 6.0;
+    const F5: f64 = F3 / 20.0;
+    const F7: f64 = F5 / 42.0;
+    const F9: f64 = F7 / 72.0;
+    const F11: f64 = F9 / 110.0;
+    const F13: f64 = F11 / 156.0;
+    const F15: f64 = F13 / 210.0;
+    const F2: f64 = 0.5;
+    const F4: f64 = F2 / 12.0;
+    const F6: f64 = F4 / 30.0;
+    const F8: f64 = F6 / 56.0;
+    const F10: f64 = F8 / 90.0;
+    const F12: f64 = F10 / 132.0;
+    const F14: f64 = F12 / 182.0;
+    const F16: f64 = F14 / 240.0;
+    let ps = -F3 + r2 * (F5 + r2 * (-F7 + r2 * (F9 + r2 * (-F11 + r2 * (F13 - r2 * F15)))));
+    let sin_r = r + r * r2 * ps;
+    let pc = F4 + r2 * (-F6 + r2 * (F8 + r2 * (-F10 + r2 * (F12 + r2 * (-F14 + r2 * F16)))));
+    let cos_r = 1.0 - r2 * F2 + r2 * r2 * pc;
+    // Rotate by qπ/2 as in `sin_cos_turn`.
+    let (a, b) = if q & 1 == 0 { (sin_r, cos_r) } else { (cos_r, sin_r) };
+    let sin_sign = ((q & 2) as u64) << 62;
+    let cos_sign = (((q + 1) & 2) as u64) << 62;
+    (
+        f64::from_bits(a.to_bits() ^ sin_sign),
+        f64::from_bits(b.to_bits() ^ cos_sign),
+    )
+}
+
 /// [`spherical_direction`] with the azimuth given in turns (φ = 2πt, t ∈ [0, 1]), via
 /// [`sin_cos_turn`]: what every warp with φ = 2πξ calls.
 #[inline]
