@@ -62,7 +62,9 @@ pub fn sin_cos_turn(t: f32) -> (f32, f32) {
 /// Cody–Waite reduction by π/2 in two parts (the high part has 8 trailing zero bits, so
 /// q·hi is exact for the q ≤ 5 that occur), then Taylor series on |r| ≤ π/4 up to r¹⁵ / r¹⁶,
 /// whose truncation error (< 5e-17) is below f64 rounding. Max abs. error vs libm is tested.
-#[inline]
+/// Out of line on purpose: inlined into the light sampler it cost the area-sampling path of
+/// the same function more (register pressure) than the call it saves.
+#[inline(never)]
 pub fn sin_cos_small_f64(x: f64) -> (f64, f64) {
     if !(0.0..=8.0).contains(&x) {
         return x.sin_cos();
@@ -95,7 +97,11 @@ pub fn sin_cos_small_f64(x: f64) -> (f64, f64) {
     let pc = F4 + r2 * (-F6 + r2 * (F8 + r2 * (-F10 + r2 * (F12 + r2 * (-F14 + r2 * F16)))));
     let cos_r = 1.0 - r2 * F2 + r2 * r2 * pc;
     // Rotate by qπ/2 as in `sin_cos_turn`.
-    let (a, b) = if q & 1 == 0 { (sin_r, cos_r) } else { (cos_r, sin_r) };
+    let (a, b) = if q & 1 == 0 {
+        (sin_r, cos_r)
+    } else {
+        (cos_r, sin_r)
+    };
     let sin_sign = ((q & 2) as u64) << 62;
     let cos_sign = (((q + 1) & 2) as u64) << 62;
     (
