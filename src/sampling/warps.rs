@@ -27,8 +27,8 @@ pub fn spherical_direction(cos_theta: f32, phi: f32) -> Vec3 {
 ///
 /// Reduction is exact: s = 4t, q = nearest quadrant, r = s − q ∈ [−½, ½] (Sterbenz), so the
 /// polynomials only ever see |2πt − qπ/2| ≤ π/4; their minimax fits (Lawson iteration) are off by
-/// ≤ 1.3e-9 (sin) and 3.3e-8 (cos) before their coefficients are rounded to f32 (the leading
-/// one is then FRAC_PI_2). Abs. error vs f64 ≤ 2e-7 is tested (measured 1.1e-7).
+/// ≤ 1.3e-9 (sin) and 3.3e-8 (cos) before their coefficients are rounded to f32. Abs. error
+/// vs f64 ≤ 2e-7 is tested (measured 1.1e-7).
 /// Being a polynomial in the exact r, it is also *more* accurate than `(TAU * t).sin_cos()`,
 /// which first rounds the angle.
 #[inline]
@@ -38,8 +38,11 @@ pub fn sin_cos_turn(t: f32) -> (f32, f32) {
     let q = (s + 0.5) as i32;
     let r = s - q as f32;
     let r2 = r * r;
-    // sin(π/2·r) and cos(π/2·r) on r ∈ [−½, ½].
-    let sin_r = r * (FRAC_PI_2 + r2 * (-0.645_962_94 + r2 * (0.079_675_9 + r2 * -0.004_592_288_8)));
+    // sin(π/2·r) and cos(π/2·r) on r ∈ [−½, ½]. The leading sin coefficient is the fit's,
+    // not π/2: both round to neighbouring f32 values and the fit's is the more accurate.
+    #[allow(clippy::approx_constant)]
+    let sin_r =
+        r * (1.570_796_2 + r2 * (-0.645_962_94 + r2 * (0.079_675_9 + r2 * -0.004_592_288_8)));
     let cos_r = 1.0 + r2 * (-1.233_698 + r2 * (0.253_606_36 + r2 * -0.020_426_25));
     // Quadrant q rotates by qπ/2: odd q swaps sin and cos; sin is negated in quadrants 2, 3
     // and cos in quadrants 1, 2 — sign bits set by integer xor instead of branches.
