@@ -70,7 +70,8 @@ struct Draws {
 
 impl Draws {
     /// The draws of sample `index` of `count`; only the dimensions the strategy reads.
-    #[inline]
+    /// Forced inline: out of line, the draws came back through memory after a call.
+    #[inline(always)]
     fn new(px: &PixelSamples, index: u32, count: u32, light: bool, bsdf: bool) -> Self {
         let mut d = Draws::default();
         if light {
@@ -262,7 +263,13 @@ impl<'a> DirectLighting<'a> {
 
     /// One BSDF-sampling estimate f·cos·Le / pdf, MIS-weighted when `mis`.
     fn bsdf_sample(&self, sh: &Shading, d: &Draws, mis: bool, rays: &mut u64) -> Rgb {
-        let Some(bs) = sh.bsdf.sample(sh.wo_local, d.lobe, d.bsdf) else {
+        // Lambert inline: `Bsdf::sample` carries every BSDF and stays out of line, so the
+        // common diffuse hit paid a call and a `BsdfSample` returned through memory.
+        let sample = match sh.bsdf {
+            Bsdf::Lambert(b) => b.sample(sh.wo_local, d.lobe, d.bsdf),
+            other => other.sample(sh.wo_local, d.lobe, d.bsdf),
+        };
+        let Some(bs) = sample else {
             return Rgb::ZERO;
         };
         if !(bs.pdf > 0.0) {

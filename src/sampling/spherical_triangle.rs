@@ -149,7 +149,7 @@ impl Arvo {
         let sub_area = u.x as f64 * self.area64;
         let (sin_alpha, cos_alpha) = (self.sin_alpha, self.cos_alpha);
         // (s, t) = (sin, cos) of (ξ₁Ω − α).
-        let (sin_sub, cos_sub) = sub_area.sin_cos();
+        let (sin_sub, cos_sub) = super::warps::sin_cos_small_f64(sub_area);
         let s = sin_sub * cos_alpha - cos_sub * sin_alpha;
         let t = cos_sub * cos_alpha + sin_sub * sin_alpha;
         let uu = t - cos_alpha;
