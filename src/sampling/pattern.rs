@@ -635,47 +635,21 @@ impl PixelSamples {
         self.sample_1d_miss(dim, index, count)
     }
 
-    /// [`PixelSamples::sample_1d`] when no chunk holds the value: refill the chunk of `index`
-    /// (< count; the `stratified` fast form where it applies) or evaluate the general way.
+    /// [`PixelSamples::sample_1d`] when no chunk holds the value (see [`PixelSamples::miss`]).
     #[inline(never)]
     fn sample_1d_miss(&self, dim: u32, index: u32, count: u32) -> f32 {
-        let Some(set) = self.sets_1d.get(dim as usize) else {
-            return self.pattern.sample_1d(self.pixel, dim, index, count);
-        };
-        let kind = self.pattern.kind;
-        if index < count {
-            let base = index & !(CHUNK as u32 - 1);
-            let f = if kind == PatternKind::Stratified {
-                self.fast(count)
-            } else {
-                FastStrata::NONE
-            };
-            let v = if f.valid {
-                f.chunk_1d(set, base)
-            } else {
-                // Every other pattern and count: the general evaluation, batched the same way.
-                let st = self.strata(count);
-                let len = (count - base).min(CHUNK as u32) as usize;
-                let batch = |kind| {
-                    let mut v = [Default::default(); CHUNK];
-                    for (k, o) in v.iter_mut().enumerate().take(len) {
-                        *o = set.sample_1d(kind, base + k as u32, &st);
-                    }
-                    v
-                };
-                // One loop per kind, so that each loop body is that kind's arithmetic only.
-                match kind {
-                    PatternKind::Fixed => batch(PatternKind::Fixed),
-                    PatternKind::Random => batch(PatternKind::Random),
-                    PatternKind::Grid => batch(PatternKind::Grid),
-                    PatternKind::Stratified => batch(PatternKind::Stratified),
-                    PatternKind::Lhs => batch(PatternKind::Lhs),
-                    PatternKind::Sobol => batch(PatternKind::Sobol),
-                }
-            };
-            return self.chunks_1d[dim as usize].store(index, count, &v);
-        }
-        set.sample_1d(kind, index, &self.strata(count))
+        self.miss(
+            self.sets_1d.get(dim as usize),
+            &self.chunks_1d,
+            Arity {
+                dim,
+                index,
+                count,
+                general: |p: &Pattern| p.sample_1d(self.pixel, dim, index, count),
+                eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_1d(kind, i, st),
+                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_1d(set, base),
+            },
+        )
     }
 
     /// The 2D sample `index` of `count` for `dim`.
@@ -689,47 +663,96 @@ impl PixelSamples {
         self.sample_2d_miss(dim, index, count)
     }
 
-    /// [`PixelSamples::sample_2d`] when no chunk holds the value (see `sample_1d_miss`).
+    /// [`PixelSamples::sample_2d`] when no chunk holds the value (see [`PixelSamples::miss`]).
     #[inline(never)]
     fn sample_2d_miss(&self, dim: u32, index: u32, count: u32) -> Vec2 {
-        let Some(set) = self.sets_2d.get(dim as usize) else {
-            return self.pattern.sample_2d(self.pixel, dim, index, count);
+        self.miss(
+            self.sets_2d.get(dim as usize),
+            &self.chunks_2d,
+            Arity {
+                dim,
+                index,
+                count,
+                general: |p: &Pattern| p.sample_2d(self.pixel, dim, index, count),
+                eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_2d(kind, i, st),
+                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_2d(set, base),
+            },
+        )
+    }
+
+    /// A value no chunk holds: refill the chunk of `index` (< count; the `stratified` fast form
+    /// where it applies) or evaluate the general way (uncached dimension, wrapped index).
+    /// Written once for 1D and 2D; inlined into each so that every loop is specialised.
+    #[inline(always)]
+    fn miss<T, G, E, F>(
+        &self,
+        set: Option<&SetKeys>,
+        chunks: &[Chunk<T>; CACHED_DIMS],
+        a: Arity<G, E, F>,
+    ) -> T
+    where
+        T: Copy + Default,
+        G: Fn(&Pattern) -> T,
+        E: Fn(&SetKeys, PatternKind, u32, &Strata) -> T,
+        F: Fn(&FastStrata, &SetKeys, u32) -> [T; CHUNK],
+    {
+        let Arity {
+            dim,
+            index,
+            count,
+            general,
+            eval,
+            fast,
+        } = a;
+        let Some(set) = set else {
+            return general(&self.pattern);
         };
         let kind = self.pattern.kind;
-        if index < count {
-            let base = index & !(CHUNK as u32 - 1);
-            let f = if kind == PatternKind::Stratified {
-                self.fast(count)
-            } else {
-                FastStrata::NONE
-            };
-            let v = if f.valid {
-                f.chunk_2d(set, base)
-            } else {
-                // Every other pattern and count: the general evaluation, batched the same way.
-                let st = self.strata(count);
-                let len = (count - base).min(CHUNK as u32) as usize;
-                let batch = |kind| {
-                    let mut v = [Default::default(); CHUNK];
-                    for (k, o) in v.iter_mut().enumerate().take(len) {
-                        *o = set.sample_2d(kind, base + k as u32, &st);
-                    }
-                    v
-                };
-                // One loop per kind, so that each loop body is that kind's arithmetic only.
-                match kind {
-                    PatternKind::Fixed => batch(PatternKind::Fixed),
-                    PatternKind::Random => batch(PatternKind::Random),
-                    PatternKind::Grid => batch(PatternKind::Grid),
-                    PatternKind::Stratified => batch(PatternKind::Stratified),
-                    PatternKind::Lhs => batch(PatternKind::Lhs),
-                    PatternKind::Sobol => batch(PatternKind::Sobol),
-                }
-            };
-            return self.chunks_2d[dim as usize].store(index, count, &v);
+        if index >= count {
+            return eval(set, kind, index, &self.strata(count));
         }
-        set.sample_2d(kind, index, &self.strata(count))
+        let base = index & !(CHUNK as u32 - 1);
+        let f = if kind == PatternKind::Stratified {
+            self.fast(count)
+        } else {
+            FastStrata::NONE
+        };
+        let v = if f.valid {
+            fast(&f, set, base)
+        } else {
+            // Every other pattern and count: the general evaluation, batched the same way.
+            let st = self.strata(count);
+            let len = (count - base).min(CHUNK as u32) as usize;
+            let batch = |kind| {
+                let mut v = [T::default(); CHUNK];
+                for (k, o) in v.iter_mut().enumerate().take(len) {
+                    *o = eval(set, kind, base + k as u32, &st);
+                }
+                v
+            };
+            // One loop per kind, so that each loop body is that kind's arithmetic only.
+            match kind {
+                PatternKind::Fixed => batch(PatternKind::Fixed),
+                PatternKind::Random => batch(PatternKind::Random),
+                PatternKind::Grid => batch(PatternKind::Grid),
+                PatternKind::Stratified => batch(PatternKind::Stratified),
+                PatternKind::Lhs => batch(PatternKind::Lhs),
+                PatternKind::Sobol => batch(PatternKind::Sobol),
+            }
+        };
+        chunks[dim as usize].store(index, count, &v)
     }
+}
+
+/// What [`PixelSamples::miss`] needs of one request and of its dimension count (1D or 2D):
+/// the request, the uncached evaluation, the per-index evaluation and the fast chunk.
+struct Arity<G, E, F> {
+    dim: u32,
+    index: u32,
+    count: u32,
+    general: G,
+    eval: E,
+    fast: F,
 }
 
 #[cfg(test)]
