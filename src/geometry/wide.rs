@@ -489,6 +489,19 @@ mod tests {
     use crate::sampling::hash::{next_f32, pcg_from_keys};
     use rand_pcg::Pcg32;
 
+    /// The bounding box of each triangle.
+    fn boxes(prims: &[Primitive]) -> Vec<(Vec3, Vec3)> {
+        prims
+            .iter()
+            .map(|p| {
+                (
+                    p.p[0].min(p.p[1]).min(p.p[2]),
+                    p.p[0].max(p.p[1]).max(p.p[2]),
+                )
+            })
+            .collect()
+    }
+
     #[test]
     fn single_leaf_fast_path_matches_the_traversal() {
         let mut s = pcg_from_keys(&[5]);
@@ -503,16 +516,7 @@ mod tests {
                     light: u32::MAX,
                 })
                 .collect();
-            let boxes: Vec<(Vec3, Vec3)> = prims
-                .iter()
-                .map(|p| {
-                    (
-                        p.p[0].min(p.p[1]).min(p.p[2]),
-                        p.p[0].max(p.p[1]).max(p.p[2]),
-                    )
-                })
-                .collect();
-            let Some(fast) = WideBvh::build(&Tree2::ploc(&boxes), &prims) else {
+            let Some(fast) = WideBvh::build(&Tree2::ploc(&boxes(&prims)), &prims) else {
                 panic!("{n} triangles gave a too deep tree");
             };
             assert!(fast.single_leaf.is_some(), "{n} triangles are not one leaf");
@@ -558,15 +562,7 @@ mod tests {
                 }
             })
             .collect();
-        let boxes: Vec<(Vec3, Vec3)> = prims
-            .iter()
-            .map(|p| {
-                (
-                    p.p[0].min(p.p[1]).min(p.p[2]),
-                    p.p[0].max(p.p[1]).max(p.p[2]),
-                )
-            })
-            .collect();
+        let boxes = boxes(&prims);
         for tree in [Tree2::ploc(&boxes), Tree2::from_bvh(Bvh::build(&boxes))] {
             // Every primitive appears once in the leaf order; parents span their children.
             let mut seen = vec![0; prims.len()];
