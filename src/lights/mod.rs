@@ -306,6 +306,29 @@ pub(crate) fn planar_radiance(n: Vec3, l: Rgb, two_sided: bool, w: Vec3) -> Rgb 
     }
 }
 
+/// Solid-angle pdf of a planar emitter (area `area`, unit normal `n`) sampling `p_light` from
+/// a receiver at `p`: 1/Ω where the shape's rule chose solid-angle sampling (`omega`), else
+/// the area pdf 1/A converted. Zero when the receiver does not `face` the emitting side, where
+/// `sample_li` never samples. The caller guarantees that the direction hits the emitter, so
+/// no inside test is needed.
+#[inline]
+pub(crate) fn planar_pdf_li(
+    faces: bool,
+    omega: impl FnOnce() -> Option<f32>,
+    area: f32,
+    p: Vec3,
+    p_light: Vec3,
+    n: Vec3,
+) -> f32 {
+    if !faces {
+        return 0.0;
+    }
+    match omega() {
+        Some(omega) => 1.0 / omega,
+        None => area_to_solid_angle(1.0 / area, p, p_light, n),
+    }
+}
+
 /// Power Φ of a diffuse emitter of radiance `l` and area `area`: π·L·A per emitting side.
 #[inline]
 pub(crate) fn diffuse_power(l: Rgb, area: f32, two_sided: bool) -> f32 {

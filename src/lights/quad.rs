@@ -4,7 +4,7 @@
 
 use super::{
     LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
-    area_to_solid_angle, diffuse_power, is_positive, planar_radiance, sees_emitting_side,
+    diffuse_power, is_positive, planar_pdf_li, planar_radiance, sees_emitting_side,
     solid_angle_sample, spherical_ok, triangle_solid_angle,
 };
 use crate::Rgb;
@@ -130,14 +130,14 @@ impl LightSource for QuadLight {
         _n_light: Vec3,
         mode: SamplingMode,
     ) -> f32 {
-        if !self.faces(ctx.p) {
-            return 0.0;
-        }
-        // The caller guarantees that wi hits the quad, so no inside test is needed.
-        match self.spherical_omega(ctx.p, mode) {
-            Some(omega) => 1.0 / omega,
-            None => area_to_solid_angle(1.0 / self.area, ctx.p, p_light, self.n),
-        }
+        planar_pdf_li(
+            self.faces(ctx.p),
+            || self.spherical_omega(ctx.p, mode),
+            self.area,
+            ctx.p,
+            p_light,
+            self.n,
+        )
     }
 
     fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
