@@ -5,10 +5,8 @@
 
 mod geometry_support;
 
-use geometry_support::{brute_force_t, random_rays};
-use glam::{UVec2, Vec3};
-use penumbra::geometry::{Backend, Geometry, MeshShading, PrimKind, Primitive, RayQuery};
-use penumbra::sampling::{PatternKind, make_pattern};
+use geometry_support::{brute_force_t, random_rays, triangle_soup};
+use penumbra::geometry::{Backend, Geometry, MeshShading, PrimKind, RayQuery};
 
 /// A backend-independent name of a primitive: (mesh, vertex indices) or the quadric index.
 fn identity(g: &Geometry, id: u32) -> (u32, [u32; 3]) {
@@ -70,28 +68,7 @@ fn backends_agree_on_cornell() {
 
 #[test]
 fn backends_agree_on_a_triangle_soup() {
-    let pat = make_pattern(PatternKind::Random, 5);
-    let prims: Vec<Primitive> = (0..2000u32)
-        .map(|i| {
-            let px = UVec2::new(i, 1);
-            let p = |d| {
-                let a = pat.sample_2d(px, d, 0, 1);
-                let b = pat.sample_2d(px, d + 1, 0, 1);
-                Vec3::new(a.x, a.y, b.x) * 10.0
-            };
-            let p0 = p(0);
-            let (p1, p2) = (p0 + (p(2) - p0) * 0.2, p0 + (p(4) - p0) * 0.2);
-            Primitive {
-                p: [p0, p1, p2],
-                kind: PrimKind::Triangle {
-                    mesh: 0,
-                    v: [i, i, i],
-                },
-                material: 0,
-                light: u32::MAX,
-            }
-        })
-        .collect();
+    let prims = triangle_soup(2000);
     let g = Geometry::new(prims, vec![MeshShading::default()], Vec::new());
     check_agreement(&g, 100_000);
 }

@@ -5,7 +5,7 @@
 
 mod geometry_support;
 
-use geometry_support::{brute_force_t, random_rays};
+use geometry_support::{brute_force_t, random_rays, triangle, triangle_soup};
 use glam::{UVec2, Vec3};
 use penumbra::geometry::{
     Backend, Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Ray, RayQuery,
@@ -72,27 +72,7 @@ fn wide_matches_brute_force_on_cornell() {
 #[test]
 fn wide_matches_brute_force_on_triangles_spheres_and_disks() {
     let pat = make_pattern(PatternKind::Random, 5);
-    let mut prims: Vec<Primitive> = (0..3000u32)
-        .map(|i| {
-            let px = UVec2::new(i, 1);
-            let p = |d| {
-                let a = pat.sample_2d(px, d, 0, 1);
-                let b = pat.sample_2d(px, d + 1, 0, 1);
-                Vec3::new(a.x, a.y, b.x) * 10.0
-            };
-            let p0 = p(0);
-            let (p1, p2) = (p0 + (p(2) - p0) * 0.2, p0 + (p(4) - p0) * 0.2);
-            Primitive {
-                p: [p0, p1, p2],
-                kind: PrimKind::Triangle {
-                    mesh: 0,
-                    v: [i, i, i],
-                },
-                material: 0,
-                light: u32::MAX,
-            }
-        })
-        .collect();
+    let mut prims = triangle_soup(3000);
     let mut quadrics = Vec::new();
     for i in 0..40u32 {
         let c = pat.sample_2d(UVec2::new(i, 2), 0, 0, 1);
@@ -172,32 +152,17 @@ fn wide_handles_coincident_and_degenerate_triangles() {
         Vec3::new(1.0, 0.0, 0.0),
         Vec3::new(0.0, 1.0, 0.0),
     ];
-    let mut prims: Vec<Primitive> = (0..5000u32)
-        .map(|i| Primitive {
-            p: tri,
-            kind: PrimKind::Triangle {
-                mesh: 0,
-                v: [i, i, i],
-            },
-            material: 0,
-            light: u32::MAX,
-        })
-        .collect();
+    let mut prims: Vec<Primitive> = (0..5000u32).map(|i| triangle(i, tri)).collect();
     for i in 0..100u32 {
         let x = i as f32 * 0.01;
-        prims.push(Primitive {
-            p: [
+        prims.push(triangle(
+            i,
+            [
                 Vec3::new(x, 0.0, 0.5),
                 Vec3::new(x, 1.0, 0.5),
                 Vec3::new(x, 0.5, 0.5),
             ],
-            kind: PrimKind::Triangle {
-                mesh: 0,
-                v: [i, i, i],
-            },
-            material: 0,
-            light: u32::MAX,
-        });
+        ));
     }
     let g = Geometry::new(prims, vec![MeshShading::default()], Vec::new());
     let rays = random_rays(g.bounds(), 5_000, 13);

@@ -2,7 +2,7 @@
 
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::triangle::intersect_triangle;
-use penumbra::geometry::{Geometry, PrimKind, Ray};
+use penumbra::geometry::{Geometry, PrimKind, Primitive, Ray};
 use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere};
 
 /// Uniform random rays from points in the (enlarged) scene box, a third of them finite.
@@ -39,4 +39,35 @@ pub fn brute_force_t(g: &Geometry, ray: &Ray) -> Option<f32> {
             PrimKind::Quadric(q) => g.quadrics[q as usize].intersect_t(ray.o, ray.d, ray.t_max),
         })
         .min_by(f32::total_cmp)
+}
+
+/// Triangle `i` of mesh 0 with vertices `p` (material 0, no light).
+pub fn triangle(i: u32, p: [Vec3; 3]) -> Primitive {
+    Primitive {
+        p,
+        kind: PrimKind::Triangle {
+            mesh: 0,
+            v: [i, i, i],
+        },
+        material: 0,
+        light: u32::MAX,
+    }
+}
+
+/// `n` small random triangles in the box [0, 10]³ (seed 5 of the random pattern).
+pub fn triangle_soup(n: u32) -> Vec<Primitive> {
+    let pat = make_pattern(PatternKind::Random, 5);
+    (0..n)
+        .map(|i| {
+            let px = UVec2::new(i, 1);
+            let p = |d| {
+                let a = pat.sample_2d(px, d, 0, 1);
+                let b = pat.sample_2d(px, d + 1, 0, 1);
+                Vec3::new(a.x, a.y, b.x) * 10.0
+            };
+            let p0 = p(0);
+            let (p1, p2) = (p0 + (p(2) - p0) * 0.2, p0 + (p(4) - p0) * 0.2);
+            triangle(i, [p0, p1, p2])
+        })
+        .collect()
 }
