@@ -2,9 +2,7 @@
 //! `cargo run --release --example trace_rays -- SCENE BACKEND [closest|any|render] [RAYS|SPP]`.
 //! `render` renders 512² with MIS (area light sampling) and prints the time.
 
-use glam::{UVec2, Vec3};
-use penumbra::geometry::{Backend, Ray, RayQuery};
-use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere};
+use penumbra::geometry::{Backend, RayQuery, random_query_rays};
 use penumbra::scene::load::{LoadOptions, load};
 use std::time::Instant;
 
@@ -37,17 +35,8 @@ fn main() -> anyhow::Result<()> {
         .scene
         .geometry
         .rebuild(backend);
-    let (lo, hi) = g.bounds();
     println!("prims {}", g.len());
-    let pat = make_pattern(PatternKind::Random, 1);
-    let rays: Vec<Ray> = (0..n)
-        .map(|i| {
-            let px = UVec2::new(i, 0);
-            let (a, b) = (pat.sample_2d(px, 0, 0, 1), pat.sample_2d(px, 1, 0, 1));
-            let o = lo + (hi - lo) * Vec3::new(a.x, a.y, pat.sample_1d(px, 2, 0, 1));
-            Ray::new(o, uniform_sphere(b))
-        })
-        .collect();
+    let rays = random_query_rays(g.bounds(), n);
     if std::env::var("CHECKSUM").is_ok() {
         let sum = rays.iter().fold(0u64, |acc, r| {
             let id = g.intersect(r).map_or(u32::MAX, |h| h.prim);

@@ -100,24 +100,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// BVH section: build time and closest-/any-hit Mrays/s of both backends on random rays
 /// (origins in the scene box, uniform directions; one thread).
 fn bvh_section(names: &[String]) -> anyhow::Result<()> {
-    use glam::Vec3;
-    use penumbra::geometry::{Backend, Ray, RayQuery};
-    use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere};
+    use penumbra::geometry::{Backend, RayQuery, random_query_rays};
     println!("| scene | backend | prims | build (s) | closest Mrays/s | any-hit Mrays/s |");
     println!("|---|---|---|---|---|---|");
     const N: u32 = 1_000_000;
     for name in names {
         let scene = load(name, &LoadOptions::default())?.scene;
-        let (lo, hi) = scene.geometry.bounds();
-        let pat = make_pattern(PatternKind::Random, 1);
-        let rays: Vec<Ray> = (0..N)
-            .map(|i| {
-                let px = UVec2::new(i, 0);
-                let (a, b) = (pat.sample_2d(px, 0, 0, 1), pat.sample_2d(px, 1, 0, 1));
-                let o = lo + (hi - lo) * Vec3::new(a.x, a.y, pat.sample_1d(px, 2, 0, 1));
-                Ray::new(o, uniform_sphere(b))
-            })
-            .collect();
+        let rays = random_query_rays(scene.geometry.bounds(), N);
         for backend in [Backend::Own, Backend::Obvhs, Backend::Wide] {
             let g = scene.geometry.rebuild(backend);
             let t = Instant::now();

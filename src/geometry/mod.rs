@@ -16,7 +16,7 @@ pub mod wide;
 pub use accel::{Backend, Geometry, MeshShading, PrimKind, Primitive};
 pub use interaction::SurfaceHit;
 pub use quadric::{Quadric, QuadricKind};
-pub use ray::Ray;
+pub use ray::{Ray, random_query_rays};
 pub use transform::Transform;
 
 /// Closest-hit and any-hit ray queries: what integrators and lights need from geometry.
