@@ -10,7 +10,7 @@ use super::{MisHeuristic, Strategy};
 use crate::Rgb;
 use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
-use crate::geometry::{Ray, RayQuery, SurfaceHit};
+use crate::geometry::{Geometry, PACKET, Ray, RayQuery, SurfaceHit};
 use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode};
 use crate::sampling::{Frame, PixelSamples, SamplePattern, balance_heuristic, power_heuristic};
@@ -86,6 +86,134 @@ impl Draws {
     }
 }
 
+/// A packet of camera samples for [`DirectLighting::li_packet`]: lane k < `n` is eye sample
+/// `eye[k]` of pixel `pixel[k]` (an index into the caller's [`PixelSamples`]) along `ray[k]`.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraPacket {
+    /// Lanes in use.
+    pub n: usize,
+    /// Per lane: index of its pixel's samples.
+    pub pixel: [u8; PACKET],
+    /// Per lane: eye sample index within the pixel.
+    pub eye: [u32; PACKET],
+    /// Per lane: the camera ray.
+    pub ray: [Ray; PACKET],
+}
+
+impl Default for CameraPacket {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl CameraPacket {
+    /// An empty packet.
+    pub fn new() -> Self {
+        Self {
+            n: 0,
+            pixel: [0; PACKET],
+            eye: [0; PACKET],
+            ray: [Ray::new(Vec3::ZERO, Vec3::Z); PACKET],
+        }
+    }
+
+    /// True when every lane is in use.
+    pub fn is_full(&self) -> bool {
+        self.n == PACKET
+    }
+
+    /// Append a lane (ignored when full).
+    pub fn push(&mut self, pixel: u8, eye: u32, ray: Ray) {
+        if self.n < PACKET {
+            self.pixel[self.n] = pixel;
+            self.eye[self.n] = eye;
+            self.ray[self.n] = ray;
+            self.n += 1;
+        }
+    }
+
+    /// Mask of the lanes in use.
+    fn active(&self) -> u32 {
+        ((1u64 << self.n) - 1) as u32
+    }
+}
+
+/// What a BSDF sample contributes before its visibility is known.
+enum Estimate {
+    /// Nothing, and no ray was traced.
+    Zero,
+    /// Nothing, found by tracing a ray.
+    Traced,
+    /// The value, unless the ray is blocked.
+    Unless(Ray, Rgb),
+}
+
+/// One value per lane that counts unless its ray is blocked: the rays go to the geometry as
+/// one packet query.
+struct Pending {
+    active: u32,
+    ray: [Ray; PACKET],
+    value: [Rgb; PACKET],
+}
+
+impl Pending {
+    fn new(idle: Ray) -> Self {
+        Self {
+            active: 0,
+            ray: [idle; PACKET],
+            value: [Rgb::ZERO; PACKET],
+        }
+    }
+
+    #[inline]
+    fn set(&mut self, k: usize, ray: Ray, value: Rgb) {
+        self.active |= 1 << k;
+        self.ray[k] = ray;
+        self.value[k] = value;
+    }
+
+    /// The values whose rays are clear (zero elsewhere).
+    fn resolve(mut self, geometry: &Geometry) -> [Rgb; PACKET] {
+        if self.active != 0 {
+            let blocked = geometry.occluded_packet(&self.ray, self.active);
+            for (k, v) in self.value.iter_mut().enumerate() {
+                if (self.active & !blocked) >> k & 1 == 0 {
+                    *v = Rgb::ZERO;
+                }
+            }
+        }
+        self.value
+    }
+}
+
+/// The shading state of a camera-ray hit, owned per lane of a packet.
+struct LaneShading {
+    hit: SurfaceHit,
+    bsdf: Bsdf,
+    /// The hit point and the geometric normal flipped toward the viewer.
+    ctx: LightSampleContext,
+    frame: Frame,
+    wo_local: Vec3,
+    /// World-space direction toward the viewer.
+    wo: Vec3,
+}
+
+impl LaneShading {
+    /// The borrowed view the per-sample estimators take.
+    #[inline]
+    fn view(&self, uniform: Option<u32>) -> Shading<'_> {
+        Shading {
+            hit: &self.hit,
+            bsdf: &self.bsdf,
+            ctx: &self.ctx,
+            frame: self.frame,
+            wo_local: self.wo_local,
+            wo: self.wo,
+            uniform,
+        }
+    }
+}
+
 /// The shading state at a camera-ray hit. The parts whose address goes to out-of-line calls
 /// (hit, BSDF, light context) are borrowed from separate locals: a struct with one field
 /// passed by address is kept whole in memory, so owning them would force every other field
@@ -134,9 +262,28 @@ impl<'a> DirectLighting<'a> {
     }
 
     /// Radiance along camera ray `ray` for eye sample `eye` of the pixel whose samples are `px`
-    /// (from [`SamplePattern::pixel`]); also returns the number of rays traced.
+    /// (from [`SamplePattern::pixel`]); also returns the number of rays traced. A packet of one
+    /// lane: the same numbers as that lane of any [`Self::li_packet`].
     pub fn li(&self, px: &PixelSamples, eye: u32, ray: &Ray) -> (Rgb, u64) {
+        let mut cam = CameraPacket::new();
+        cam.push(0, eye, *ray);
+        let mut out = [Rgb::ZERO; PACKET];
+        let rays = self.li_packet(std::slice::from_ref(px), &cam, &mut out);
+        (out[0], rays)
+    }
+
+    /// Radiance of each lane of `cam` (lane k: eye sample `cam.eye[k]` of the pixel whose
+    /// samples are `pxs[cam.pixel[k]]`, along `cam.ray[k]`) into `out[k]`; returns the number of
+    /// rays traced. Each ray kind goes to the geometry as one packet query, so the coherent
+    /// camera and shadow rays of neighbouring samples share their traversal.
+    pub fn li_packet(
+        &self,
+        pxs: &[PixelSamples],
+        cam: &CameraPacket,
+        out: &mut [Rgb; PACKET],
+    ) -> u64 {
         let scene = self.scene;
+        let n = cam.n;
         let m = self.shadow_rays.max(1);
         let count = self.eye_rays.max(1) * m;
         let (use_light, use_bsdf) = match self.strategy {
@@ -144,14 +291,94 @@ impl<'a> DirectLighting<'a> {
             Strategy::Bsdf => (false, true),
             Strategy::Mis => (true, true),
         };
-        // The first sample's draws are pure arithmetic that does not depend on the hit: issued
-        // before the camera ray's traversal, they overlap with its memory-bound work (wasted
-        // only for camera rays that escape).
-        let first = Draws::new(px, eye * m, count, use_light, use_bsdf);
-        let Some(hit) = scene.geometry.intersect(ray) else {
-            return (self.escaped(ray.d), 1);
+        let draws = |k: usize, j: u32| {
+            Draws::new(
+                &pxs[cam.pixel[k] as usize],
+                cam.eye[k] * m + j,
+                count,
+                use_light,
+                use_bsdf,
+            )
         };
-        let mut rays = 1u64;
+        // The first sample's draws are pure arithmetic that does not depend on the hits:
+        // issued before the camera rays' traversal, they overlap with its memory-bound work.
+        let mut first = [Draws::default(); PACKET];
+        for (k, d) in first.iter_mut().enumerate().take(n) {
+            *d = draws(k, 0);
+        }
+        let mut hits = [None; PACKET];
+        scene
+            .geometry
+            .intersect_packet(&cam.ray, cam.active(), &mut hits);
+        let mut rays = n as u64;
+        let mut lanes: [Option<LaneShading>; PACKET] = [const { None }; PACKET];
+        for k in 0..n {
+            let ray = &cam.ray[k];
+            out[k] = match &hits[k] {
+                None => self.escaped(ray.d),
+                Some(hit) => {
+                    let (le, lane) = self.shade(hit, ray);
+                    lanes[k] = lane;
+                    le
+                }
+            };
+        }
+        let uniform = if use_light {
+            self.selector.uniform_count()
+        } else {
+            None
+        };
+        let mis = self.strategy == Strategy::Mis;
+        let mut sums = [Rgb::ZERO; PACKET];
+        let idle = Ray::new(Vec3::ZERO, Vec3::Z);
+        for j in 0..m {
+            let mut light = Pending::new(idle);
+            let mut bsdf = Pending::new(idle);
+            for k in 0..n {
+                let Some(lane) = &lanes[k] else { continue };
+                let sh = lane.view(uniform);
+                let d = if j == 0 { first[k] } else { draws(k, j) };
+                if use_light && let Some((r, v)) = self.light_sample(&sh, &d, mis) {
+                    light.set(k, r, v);
+                    rays += 1;
+                }
+                if use_bsdf {
+                    match self.bsdf_sample(&sh, &d, mis) {
+                        Estimate::Zero => {}
+                        Estimate::Traced => rays += 1,
+                        Estimate::Unless(r, v) => {
+                            bsdf.set(k, r, v);
+                            rays += 1;
+                        }
+                    }
+                }
+            }
+            let light = light.resolve(&scene.geometry);
+            let bsdf = bsdf.resolve(&scene.geometry);
+            for k in 0..n {
+                if lanes[k].is_some() {
+                    if use_light {
+                        sums[k] += light[k];
+                    }
+                    if use_bsdf {
+                        sums[k] += bsdf[k];
+                    }
+                }
+            }
+        }
+        for k in 0..n {
+            if lanes[k].is_some() {
+                out[k] += sums[k] / m as f32;
+            }
+        }
+        rays
+    }
+
+    /// Emitted radiance at camera hit `hit` of `ray` and, if it has a material, its shading
+    /// state.
+    #[inline]
+    fn shade(&self, hit: &SurfaceHit, ray: &Ray) -> (Rgb, Option<LaneShading>) {
+        let scene = self.scene;
         let wo = -ray.d.normalize();
         let mut l = Rgb::ZERO;
         if hit.light != NO_LIGHT {
@@ -166,43 +393,21 @@ impl<'a> DirectLighting<'a> {
         };
         let frame = Frame::from_normal(ns);
         let Some(material) = scene.materials.get(hit.material as usize) else {
-            return (l, rays);
+            return (l, None);
         };
-        let mut bsdf = material.bsdf(&hit, front);
+        let mut bsdf = material.bsdf(hit, front);
         if self.bsdf_sampling != LobeSampling::Importance {
             bsdf.set_sampling(self.bsdf_sampling);
         }
-        let ctx = LightSampleContext { p: hit.p, n: ng };
-        let sh = Shading {
-            bsdf: &bsdf,
+        let lane = LaneShading {
+            hit: *hit,
+            bsdf,
+            ctx: LightSampleContext { p: hit.p, n: ng },
             wo_local: frame.to_local(wo),
             frame,
             wo,
-            ctx: &ctx,
-            uniform: if use_light {
-                self.selector.uniform_count()
-            } else {
-                None
-            },
-            hit: &hit,
         };
-        let mis = self.strategy == Strategy::Mis;
-        let mut sum = Rgb::ZERO;
-        for j in 0..m {
-            let d = if j == 0 {
-                first
-            } else {
-                Draws::new(px, eye * m + j, count, use_light, use_bsdf)
-            };
-            if use_light {
-                sum += self.light_sample(&sh, &d, mis, &mut rays);
-            }
-            if use_bsdf {
-                sum += self.bsdf_sample(&sh, &d, mis, &mut rays);
-            }
-        }
-        l += sum / m as f32;
-        (l, rays)
+        (l, Some(lane))
     }
 
     /// Radiance of the infinite lights seen along an escaping ray.
@@ -215,21 +420,18 @@ impl<'a> DirectLighting<'a> {
             .sum()
     }
 
-    /// One light-sampling estimate f·Li·cos / (pmf·pdf), MIS-weighted when `mis`.
-    fn light_sample(&self, sh: &Shading, d: &Draws, mis: bool, rays: &mut u64) -> Rgb {
+    /// One light-sampling estimate f·Li·cos / (pmf·pdf), MIS-weighted when `mis`: the shadow
+    /// ray it needs and its value if that ray is clear (`None` when it is zero anyway).
+    fn light_sample(&self, sh: &Shading, d: &Draws, mis: bool) -> Option<(Ray, Rgb)> {
         let sel = match sh.uniform {
             Some(count) => UniformSelector::pick(count, d.light_select),
             None => self.selector.sample(&sh.shading_point(), d.light_select),
         };
-        let Some(SelectedLight { index, pmf }) = sel else {
-            return Rgb::ZERO;
-        };
+        let SelectedLight { index, pmf } = sel?;
         let light = &self.scene.lights[index as usize];
-        let Some(ls) = light.sample_li(sh.ctx, d.light, self.mode()) else {
-            return Rgb::ZERO;
-        };
+        let ls = light.sample_li(sh.ctx, d.light, self.mode())?;
         if !(ls.pdf > 0.0) || pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(sh.ctx.n) <= 0.0 {
-            return Rgb::ZERO;
+            return None;
         }
         let wi_local = sh.frame.to_local(ls.wi);
         // Under MIS the BSDF pdf is needed too: one dispatch evaluates both (for the few
@@ -242,15 +444,7 @@ impl<'a> DirectLighting<'a> {
         };
         let f = f * wi_local.z.abs();
         if f == Rgb::ZERO {
-            return Rgb::ZERO;
-        }
-        *rays += 1;
-        if self
-            .scene
-            .geometry
-            .occluded(&shadow_ray(sh.hit, ls.p_light))
-        {
-            return Rgb::ZERO;
+            return None;
         }
         let pdf = pmf * ls.pdf;
         let w = if weigh {
@@ -258,11 +452,11 @@ impl<'a> DirectLighting<'a> {
         } else {
             1.0
         };
-        f * ls.li * (w / pdf)
+        Some((shadow_ray(sh.hit, ls.p_light), f * ls.li * (w / pdf)))
     }
 
     /// One BSDF-sampling estimate f·cos·Le / pdf, MIS-weighted when `mis`.
-    fn bsdf_sample(&self, sh: &Shading, d: &Draws, mis: bool, rays: &mut u64) -> Rgb {
+    fn bsdf_sample(&self, sh: &Shading, d: &Draws, mis: bool) -> Estimate {
         // Lambert inline: `Bsdf::sample` carries every BSDF and stays out of line, so the
         // common diffuse hit paid a call and a `BsdfSample` returned through memory.
         let sample = match sh.bsdf {
@@ -270,37 +464,38 @@ impl<'a> DirectLighting<'a> {
             other => other.sample(sh.wo_local, d.lobe, d.bsdf),
         };
         let Some(bs) = sample else {
-            return Rgb::ZERO;
+            return Estimate::Zero;
         };
         if !(bs.pdf > 0.0) {
-            return Rgb::ZERO;
+            return Estimate::Zero;
         }
         let wi = sh.frame.to_world(bs.wi).normalize();
         // Only specular transmission (smooth glass) may leave below the geometric surface;
         // every other sample there is rejected exactly as light sampling rejects it.
         if wi.dot(sh.ctx.n) <= 0.0 && !bs.delta {
-            return Rgb::ZERO;
+            return Estimate::Zero;
         }
         let weight = bs.f * (bs.wi.z.abs() / bs.pdf);
         if weight == Rgb::ZERO || !weight.is_finite() {
-            return Rgb::ZERO;
+            return Estimate::Zero;
         }
         // One logical ray, resolved in two cheaper queries: the nearest emitter along it (a BVH
         // of emitters only), then whether the scene blocks the way to it. The first hit of the
         // ray is an emitter exactly when that emitter is visible, so this is the closest-hit
-        // estimator without a closest-hit query for the many rays that miss every light.
-        *rays += 1;
+        // estimator without a closest-hit query for the many rays that miss every light. (The
+        // caller counts this logical ray once whatever its outcome.)
         let ray = Ray::new(sh.hit.spawn_origin(wi), wi);
         if let Some(h) = self.scene.emitters.intersect(&ray) {
             let light = &self.scene.lights[h.light as usize];
             let le = light.radiance(h.p, h.ng, h.uv, -wi);
-            if le == Rgb::ZERO || self.scene.geometry.occluded(&shadow_ray(sh.hit, h.p)) {
-                return Rgb::ZERO;
+            if le == Rgb::ZERO {
+                return Estimate::Traced;
             }
-            return weight * le * self.bsdf_mis_weight(sh, &bs, mis, h.light, wi, h.p, h.ng);
+            let w = self.bsdf_mis_weight(sh, &bs, mis, h.light, wi, h.p, h.ng);
+            return Estimate::Unless(shadow_ray(sh.hit, h.p), weight * le * w);
         }
-        if self.scene.infinite_lights.is_empty() || self.scene.geometry.occluded(&ray) {
-            return Rgb::ZERO;
+        if self.scene.infinite_lights.is_empty() {
+            return Estimate::Traced;
         }
         let mut sum = Rgb::ZERO;
         for &i in &self.scene.infinite_lights {
@@ -311,7 +506,7 @@ impl<'a> DirectLighting<'a> {
             }
             sum += le * self.bsdf_mis_weight(sh, &bs, mis, i, wi, Vec3::ZERO, Vec3::ZERO);
         }
-        weight * sum
+        Estimate::Unless(ray, weight * sum)
     }
     /// MIS weight of BSDF sample `bs` that reached light `light` at (p, n) along `wi`
     /// (1 without MIS and for delta lobes, which light sampling cannot produce).

@@ -3,12 +3,13 @@
 //! image is bit-identical for any thread count and schedule.
 
 use super::RenderOptions;
-use super::direct::{DIM_FILTER, DirectLighting};
+use super::direct::{CameraPacket, DIM_FILTER, DirectLighting};
 use super::film::filter_sample;
 use crate::Rgb;
+use crate::geometry::PACKET;
 use crate::image::Image;
 use crate::light_selection::make_selector;
-use crate::sampling::make_pattern;
+use crate::sampling::{PixelSamples, make_pattern};
 use crate::scene::Scene;
 use glam::UVec2;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -89,28 +90,59 @@ pub fn render(
             let y0 = ty * TILE;
             let x1 = (x0 + TILE).min(res.x);
             let y1 = (y0 + TILE).min(res.y);
-            let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+            let (w, h) = (x1 - x0, y1 - y0);
+            // Samples in pixel-major order, PACKET at a time: a pixel's sum adds its samples in
+            // index order, exactly as one loop per pixel would.
+            let mut sums = vec![Rgb::ZERO; (w * h) as usize];
+            let mut pxs: Vec<PixelSamples> = Vec::with_capacity(PACKET + 1);
+            let mut owner: Vec<usize> = Vec::with_capacity(PACKET + 1);
+            let mut cam = CameraPacket::new();
+            let mut radiance = [Rgb::ZERO; PACKET];
             let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let pixel = UVec2::new(x, y);
-                    let px = pattern.pixel(pixel);
-                    let mut sum = Rgb::ZERO;
-                    for i in 0..opts.spp {
-                        let u = px.sample_2d(DIM_FILTER, i, opts.spp);
-                        let p = filter_sample(&scene.film.filter, pixel, u);
-                        let ray = camera.generate(p);
-                        let (l, r) = est.li(&px, i, &ray);
-                        tile_rays += r;
+            let mut flush =
+                |cam: &mut CameraPacket, pxs: &mut Vec<PixelSamples>, owner: &mut Vec<usize>| {
+                    tile_rays += est.li_packet(pxs, cam, &mut radiance);
+                    for k in 0..cam.n {
+                        let l = radiance[k];
                         if l.is_finite() {
-                            sum += l;
+                            sums[owner[cam.pixel[k] as usize]] += l;
                         } else {
                             tile_bad += 1;
                         }
                     }
-                    out.push(sum / opts.spp as f32);
+                    // A pixel whose samples go on into the next packet keeps its (cached) samples.
+                    let last = cam.n - 1;
+                    let keep = cam.eye[last] + 1 < opts.spp;
+                    let slot = cam.pixel[last] as usize;
+                    if keep {
+                        pxs.swap(0, slot);
+                        owner.swap(0, slot);
+                    }
+                    pxs.truncate(keep as usize);
+                    owner.truncate(keep as usize);
+                    *cam = CameraPacket::new();
+                };
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let pixel = UVec2::new(x, y);
+                    pxs.push(pattern.pixel(pixel));
+                    owner.push(((y - y0) * w + (x - x0)) as usize);
+                    for i in 0..opts.spp {
+                        let slot = pxs.len() - 1;
+                        let u = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
+                        let p = filter_sample(&scene.film.filter, pixel, u);
+                        cam.push(slot as u8, i, camera.generate(p));
+                        // Flushed as soon as full, so its last lane is of the newest pixel.
+                        if cam.is_full() {
+                            flush(&mut cam, &mut pxs, &mut owner);
+                        }
+                    }
                 }
             }
+            if cam.n > 0 {
+                flush(&mut cam, &mut pxs, &mut owner);
+            }
+            let out: Vec<Rgb> = sums.iter().map(|&s| s / opts.spp as f32).collect();
             rays.fetch_add(tile_rays, Ordering::Relaxed);
             bad.fetch_add(tile_bad, Ordering::Relaxed);
             bar.inc(1);
