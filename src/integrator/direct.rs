@@ -8,9 +8,9 @@
 
 use super::{MisHeuristic, Strategy};
 use crate::Rgb;
-use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
+use crate::bsdf::{Bsdf, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
-use crate::geometry::{Geometry, PACKET, Ray, RayQuery, SurfaceHit};
+use crate::geometry::{Geometry, PACKET, Ray, SurfaceHit};
 use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode};
 use crate::sampling::{Frame, PixelSamples, SamplePattern, balance_heuristic, power_heuristic};
@@ -138,14 +138,44 @@ impl CameraPacket {
     }
 }
 
-/// What a BSDF sample contributes before its visibility is known.
-enum Estimate {
-    /// Nothing, and no ray was traced.
-    Zero,
-    /// Nothing, found by tracing a ray.
-    Traced,
-    /// The value, unless the ray is blocked.
-    Unless(Ray, Rgb),
+/// A sampled BSDF direction as a ray, before what it reaches is known.
+#[derive(Clone, Copy)]
+struct BsdfRay {
+    ray: Ray,
+    /// f·cos / pdf.
+    weight: Rgb,
+    pdf: f32,
+    delta: bool,
+}
+
+/// The BSDF rays of a packet's lanes (bit k of `active`: lane k has one).
+struct Sampled {
+    active: u32,
+    ray: [Ray; PACKET],
+    lanes: [BsdfRay; PACKET],
+}
+
+impl Sampled {
+    fn new(idle: Ray) -> Self {
+        let none = BsdfRay {
+            ray: idle,
+            weight: Rgb::ZERO,
+            pdf: 0.0,
+            delta: false,
+        };
+        Self {
+            active: 0,
+            ray: [idle; PACKET],
+            lanes: [none; PACKET],
+        }
+    }
+
+    #[inline]
+    fn set(&mut self, k: usize, b: BsdfRay) {
+        self.active |= 1 << k;
+        self.ray[k] = b.ray;
+        self.lanes[k] = b;
+    }
 }
 
 /// One value per lane that counts unless its ray is blocked: the rays go to the geometry as
@@ -331,9 +361,11 @@ impl<'a> DirectLighting<'a> {
         let mis = self.strategy == Strategy::Mis;
         let mut sums = [Rgb::ZERO; PACKET];
         let idle = Ray::new(Vec3::ZERO, Vec3::Z);
+        let mut emitter_hits = [None; PACKET];
         for j in 0..m {
             let mut light = Pending::new(idle);
             let mut bsdf = Pending::new(idle);
+            let mut sampled = Sampled::new(idle);
             for k in 0..n {
                 let Some(lane) = &lanes[k] else { continue };
                 let sh = lane.view(uniform);
@@ -342,14 +374,26 @@ impl<'a> DirectLighting<'a> {
                     light.set(k, r, v);
                     rays += 1;
                 }
-                if use_bsdf {
-                    match self.bsdf_sample(&sh, &d, mis) {
-                        Estimate::Zero => {}
-                        Estimate::Traced => rays += 1,
-                        Estimate::Unless(r, v) => {
-                            bsdf.set(k, r, v);
-                            rays += 1;
-                        }
+                if use_bsdf && let Some(b) = self.bsdf_ray(&sh, &d) {
+                    // One logical ray whatever comes of it: an emitter query, then maybe a
+                    // visibility test.
+                    rays += 1;
+                    sampled.set(k, b);
+                }
+            }
+            if sampled.active != 0 {
+                scene
+                    .emitters
+                    .intersect_packet(&sampled.ray, sampled.active, &mut emitter_hits);
+                for k in 0..n {
+                    if sampled.active >> k & 1 == 0 {
+                        continue;
+                    }
+                    let Some(lane) = &lanes[k] else { continue };
+                    let b = &sampled.lanes[k];
+                    let hit = emitter_hits[k].as_ref();
+                    if let Some((r, v)) = self.bsdf_gather(&lane.view(uniform), b, hit, mis) {
+                        bsdf.set(k, r, v);
                     }
                 }
             }
@@ -455,47 +499,60 @@ impl<'a> DirectLighting<'a> {
         Some((shadow_ray(sh.hit, ls.p_light), f * ls.li * (w / pdf)))
     }
 
-    /// One BSDF-sampling estimate f·cos·Le / pdf, MIS-weighted when `mis`.
-    fn bsdf_sample(&self, sh: &Shading, d: &Draws, mis: bool) -> Estimate {
+    /// The first half of one BSDF-sampling estimate f·cos·Le / pdf: the sampled ray and its
+    /// weight f·cos / pdf (`None` when the estimate is zero without tracing it).
+    fn bsdf_ray(&self, sh: &Shading, d: &Draws) -> Option<BsdfRay> {
         // Lambert inline: `Bsdf::sample` carries every BSDF and stays out of line, so the
         // common diffuse hit paid a call and a `BsdfSample` returned through memory.
-        let sample = match sh.bsdf {
+        let bs = match sh.bsdf {
             Bsdf::Lambert(b) => b.sample(sh.wo_local, d.lobe, d.bsdf),
             other => other.sample(sh.wo_local, d.lobe, d.bsdf),
-        };
-        let Some(bs) = sample else {
-            return Estimate::Zero;
-        };
+        }?;
         if !(bs.pdf > 0.0) {
-            return Estimate::Zero;
+            return None;
         }
         let wi = sh.frame.to_world(bs.wi).normalize();
         // Only specular transmission (smooth glass) may leave below the geometric surface;
         // every other sample there is rejected exactly as light sampling rejects it.
         if wi.dot(sh.ctx.n) <= 0.0 && !bs.delta {
-            return Estimate::Zero;
+            return None;
         }
         let weight = bs.f * (bs.wi.z.abs() / bs.pdf);
         if weight == Rgb::ZERO || !weight.is_finite() {
-            return Estimate::Zero;
+            return None;
         }
-        // One logical ray, resolved in two cheaper queries: the nearest emitter along it (a BVH
-        // of emitters only), then whether the scene blocks the way to it. The first hit of the
-        // ray is an emitter exactly when that emitter is visible, so this is the closest-hit
-        // estimator without a closest-hit query for the many rays that miss every light. (The
-        // caller counts this logical ray once whatever its outcome.)
-        let ray = Ray::new(sh.hit.spawn_origin(wi), wi);
-        if let Some(h) = self.scene.emitters.intersect(&ray) {
+        Some(BsdfRay {
+            ray: Ray::new(sh.hit.spawn_origin(wi), wi),
+            weight,
+            pdf: bs.pdf,
+            delta: bs.delta,
+        })
+    }
+
+    /// The second half: given the nearest emitter `hit` along the sampled ray (a BVH of
+    /// emitters only), the ray whose blocking would void the estimate and its value, MIS-
+    /// weighted when `mis`. The first hit of the ray is an emitter exactly when that emitter
+    /// is visible, so this is the closest-hit estimator without a closest-hit query for the
+    /// many rays that miss every light.
+    fn bsdf_gather(
+        &self,
+        sh: &Shading,
+        b: &BsdfRay,
+        hit: Option<&SurfaceHit>,
+        mis: bool,
+    ) -> Option<(Ray, Rgb)> {
+        let wi = b.ray.d;
+        if let Some(h) = hit {
             let light = &self.scene.lights[h.light as usize];
             let le = light.radiance(h.p, h.ng, h.uv, -wi);
             if le == Rgb::ZERO {
-                return Estimate::Traced;
+                return None;
             }
-            let w = self.bsdf_mis_weight(sh, &bs, mis, h.light, wi, h.p, h.ng);
-            return Estimate::Unless(shadow_ray(sh.hit, h.p), weight * le * w);
+            let w = self.bsdf_mis_weight(sh, b, mis, h.light, h.p, h.ng);
+            return Some((shadow_ray(sh.hit, h.p), b.weight * le * w));
         }
         if self.scene.infinite_lights.is_empty() {
-            return Estimate::Traced;
+            return None;
         }
         let mut sum = Rgb::ZERO;
         for &i in &self.scene.infinite_lights {
@@ -504,30 +561,29 @@ impl<'a> DirectLighting<'a> {
             if le == Rgb::ZERO {
                 continue;
             }
-            sum += le * self.bsdf_mis_weight(sh, &bs, mis, i, wi, Vec3::ZERO, Vec3::ZERO);
+            sum += le * self.bsdf_mis_weight(sh, b, mis, i, Vec3::ZERO, Vec3::ZERO);
         }
-        Estimate::Unless(ray, weight * sum)
+        Some((b.ray, b.weight * sum))
     }
-    /// MIS weight of BSDF sample `bs` that reached light `light` at (p, n) along `wi`
-    /// (1 without MIS and for delta lobes, which light sampling cannot produce).
-    #[allow(clippy::too_many_arguments)]
+
+    /// MIS weight of BSDF sample `b` that reached light `light` at (p, n) (1 without MIS and
+    /// for delta lobes, which light sampling cannot produce).
     fn bsdf_mis_weight(
         &self,
         sh: &Shading,
-        bs: &BsdfSample,
+        b: &BsdfRay,
         mis: bool,
         light: u32,
-        wi: Vec3,
         p: Vec3,
         n: Vec3,
     ) -> f32 {
-        if !mis || bs.delta {
+        if !mis || b.delta {
             return 1.0;
         }
         // Rare (emitter hits only): the plain virtual call, whatever the selector.
         let pdf_l = self.selector.pmf(&sh.shading_point(), light)
-            * self.scene.lights[light as usize].pdf_li(sh.ctx, wi, p, n, self.mode());
-        self.heuristic(bs.pdf, pdf_l)
+            * self.scene.lights[light as usize].pdf_li(sh.ctx, b.ray.d, p, n, self.mode());
+        self.heuristic(b.pdf, pdf_l)
     }
 }
 
