@@ -5,7 +5,7 @@
 use glam::UVec2;
 use penumbra::Rgb;
 use penumbra::geometry::PACKET;
-use penumbra::integrator::direct::{CameraPacket, DIM_FILTER, DirectLighting};
+use penumbra::integrator::direct::{CameraPacket, DIM_FILTER, DirectLighting, PacketScratch};
 use penumbra::integrator::film::filter_sample;
 use penumbra::integrator::{MisHeuristic, Strategy};
 use penumbra::light_selection::make_selector;
@@ -35,6 +35,8 @@ fn check(scene: &Scene, strategy: Strategy, selection: &str, spp: u32, m: u32) -
     // packet when spp < PACKET.
     let mut pxs: Vec<PixelSamples> = Vec::new();
     let mut cam = CameraPacket::new();
+    // One scratch for every packet, as a render reuses it.
+    let mut scratch = PacketScratch::new();
     let (mut lanes_checked, mut lit) = (0, 0);
     for p in 0..48u32 {
         let pixel = UVec2::new(p % 24, (p * 7) % 24);
@@ -49,7 +51,7 @@ fn check(scene: &Scene, strategy: Strategy, selection: &str, spp: u32, m: u32) -
             cam.push(slot as u8, i, ray);
             if cam.is_full() || (i + 1 == spp && pxs.len() == PACKET) {
                 let mut out = [Rgb::ZERO; PACKET];
-                let rays = est.li_packet(&pxs, &cam, &mut out);
+                let rays = est.li_packet(&pxs, &cam, &mut out, &mut scratch);
                 let mut rays_single = 0;
                 for k in 0..cam.n {
                     let (l, r) = est.li(&pxs[cam.pixel[k] as usize], cam.eye[k], &cam.ray[k]);

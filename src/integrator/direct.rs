@@ -122,6 +122,11 @@ impl CameraPacket {
         self.n == PACKET
     }
 
+    /// Empty the packet (its arrays are overwritten lane by lane as it fills again).
+    pub fn clear(&mut self) {
+        self.n = 0;
+    }
+
     /// Append a lane (ignored when full).
     pub fn push(&mut self, pixel: u8, eye: u32, ray: Ray) {
         if self.n < PACKET {
@@ -202,17 +207,52 @@ impl Pending {
         self.value[k] = value;
     }
 
-    /// The values whose rays are clear (zero elsewhere).
-    fn resolve(mut self, geometry: &Geometry) -> [Rgb; PACKET] {
-        if self.active != 0 {
-            let blocked = geometry.occluded_packet(&self.ray, self.active);
-            for (k, v) in self.value.iter_mut().enumerate() {
-                if (self.active & !blocked) >> k & 1 == 0 {
-                    *v = Rgb::ZERO;
-                }
+    /// Keep the values whose rays are clear (zero elsewhere, inactive lanes included).
+    fn resolve(&mut self, geometry: &Geometry) {
+        let blocked = if self.active != 0 {
+            geometry.occluded_packet(&self.ray, self.active)
+        } else {
+            0
+        };
+        for (k, v) in self.value.iter_mut().enumerate() {
+            if (self.active & !blocked) >> k & 1 == 0 {
+                *v = Rgb::ZERO;
             }
         }
-        self.value
+    }
+}
+
+/// The working arrays of [`DirectLighting::li_packet`], made once per render thread's tile
+/// instead of per packet (every lane a packet reads is written first by that packet).
+pub struct PacketScratch {
+    first: [Draws; PACKET],
+    hits: [Option<SurfaceHit>; PACKET],
+    lanes: [Option<LaneShading>; PACKET],
+    emitter_hits: [Option<SurfaceHit>; PACKET],
+    light: Pending,
+    bsdf: Pending,
+    sampled: Sampled,
+}
+
+impl Default for PacketScratch {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl PacketScratch {
+    /// Fresh working arrays.
+    pub fn new() -> Self {
+        let idle = Ray::new(Vec3::ZERO, Vec3::Z);
+        Self {
+            first: [Draws::default(); PACKET],
+            hits: [None; PACKET],
+            lanes: [const { None }; PACKET],
+            emitter_hits: [None; PACKET],
+            light: Pending::new(idle),
+            bsdf: Pending::new(idle),
+            sampled: Sampled::new(idle),
+        }
     }
 }
 
@@ -298,7 +338,8 @@ impl<'a> DirectLighting<'a> {
         let mut cam = CameraPacket::new();
         cam.push(0, eye, *ray);
         let mut out = [Rgb::ZERO; PACKET];
-        let rays = self.li_packet(std::slice::from_ref(px), &cam, &mut out);
+        let mut scratch = PacketScratch::new();
+        let rays = self.li_packet(std::slice::from_ref(px), &cam, &mut out, &mut scratch);
         (out[0], rays)
     }
 
@@ -311,8 +352,18 @@ impl<'a> DirectLighting<'a> {
         pxs: &[PixelSamples],
         cam: &CameraPacket,
         out: &mut [Rgb; PACKET],
+        scratch: &mut PacketScratch,
     ) -> u64 {
         let scene = self.scene;
+        let PacketScratch {
+            first,
+            hits,
+            lanes,
+            emitter_hits,
+            light,
+            bsdf,
+            sampled,
+        } = scratch;
         let n = cam.n;
         let m = self.shadow_rays.max(1);
         let count = self.eye_rays.max(1) * m;
@@ -332,25 +383,18 @@ impl<'a> DirectLighting<'a> {
         };
         // The first sample's draws are pure arithmetic that does not depend on the hits:
         // issued before the camera rays' traversal, they overlap with its memory-bound work.
-        let mut first = [Draws::default(); PACKET];
         for (k, d) in first.iter_mut().enumerate().take(n) {
             *d = draws(k, 0);
         }
-        let mut hits = [None; PACKET];
         scene
             .geometry
-            .intersect_packet(&cam.ray, cam.active(), &mut hits);
+            .intersect_packet(&cam.ray, cam.active(), hits);
         let mut rays = n as u64;
-        let mut lanes: [Option<LaneShading>; PACKET] = [const { None }; PACKET];
         for k in 0..n {
             let ray = &cam.ray[k];
-            out[k] = match &hits[k] {
-                None => self.escaped(ray.d),
-                Some(hit) => {
-                    let (le, lane) = self.shade(hit, ray);
-                    lanes[k] = lane;
-                    le
-                }
+            (out[k], lanes[k]) = match &hits[k] {
+                None => (self.escaped(ray.d), None),
+                Some(hit) => self.shade(hit, ray),
             };
         }
         let uniform = if use_light {
@@ -360,12 +404,10 @@ impl<'a> DirectLighting<'a> {
         };
         let mis = self.strategy == Strategy::Mis;
         let mut sums = [Rgb::ZERO; PACKET];
-        let idle = Ray::new(Vec3::ZERO, Vec3::Z);
-        let mut emitter_hits = [None; PACKET];
         for j in 0..m {
-            let mut light = Pending::new(idle);
-            let mut bsdf = Pending::new(idle);
-            let mut sampled = Sampled::new(idle);
+            light.active = 0;
+            bsdf.active = 0;
+            sampled.active = 0;
             for k in 0..n {
                 let Some(lane) = &lanes[k] else { continue };
                 let sh = lane.view(uniform);
@@ -384,7 +426,7 @@ impl<'a> DirectLighting<'a> {
             if sampled.active != 0 {
                 scene
                     .emitters
-                    .intersect_packet(&sampled.ray, sampled.active, &mut emitter_hits);
+                    .intersect_packet(&sampled.ray, sampled.active, emitter_hits);
                 for k in 0..n {
                     if sampled.active >> k & 1 == 0 {
                         continue;
@@ -397,15 +439,15 @@ impl<'a> DirectLighting<'a> {
                     }
                 }
             }
-            let light = light.resolve(&scene.geometry);
-            let bsdf = bsdf.resolve(&scene.geometry);
+            light.resolve(&scene.geometry);
+            bsdf.resolve(&scene.geometry);
             for k in 0..n {
                 if lanes[k].is_some() {
                     if use_light {
-                        sums[k] += light[k];
+                        sums[k] += light.value[k];
                     }
                     if use_bsdf {
-                        sums[k] += bsdf[k];
+                        sums[k] += bsdf.value[k];
                     }
                 }
             }

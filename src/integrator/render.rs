@@ -3,7 +3,7 @@
 //! image is bit-identical for any thread count and schedule.
 
 use super::RenderOptions;
-use super::direct::{CameraPacket, DIM_FILTER, DirectLighting};
+use super::direct::{CameraPacket, DIM_FILTER, DirectLighting, PacketScratch};
 use super::film::filter_sample;
 use crate::Rgb;
 use crate::geometry::PACKET;
@@ -98,10 +98,11 @@ pub fn render(
             let mut owner: Vec<usize> = Vec::with_capacity(PACKET + 1);
             let mut cam = CameraPacket::new();
             let mut radiance = [Rgb::ZERO; PACKET];
+            let mut scratch = PacketScratch::new();
             let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
             let mut flush =
                 |cam: &mut CameraPacket, pxs: &mut Vec<PixelSamples>, owner: &mut Vec<usize>| {
-                    tile_rays += est.li_packet(pxs, cam, &mut radiance);
+                    tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut scratch);
                     for k in 0..cam.n {
                         let l = radiance[k];
                         if l.is_finite() {
@@ -120,7 +121,7 @@ pub fn render(
                     }
                     pxs.truncate(keep as usize);
                     owner.truncate(keep as usize);
-                    *cam = CameraPacket::new();
+                    cam.clear();
                 };
             for y in y0..y1 {
                 for x in x0..x1 {
