@@ -5,6 +5,7 @@ pub mod accel;
 pub mod bvh;
 pub mod float;
 pub mod interaction;
+pub mod packet;
 pub mod quadric;
 pub mod ray;
 pub mod transform;
@@ -15,6 +16,7 @@ pub mod wide;
 
 pub use accel::{Backend, Geometry, MeshShading, PrimKind, Primitive};
 pub use interaction::SurfaceHit;
+pub use packet::PACKET;
 pub use quadric::{Quadric, QuadricKind};
 pub use ray::{Ray, random_query_rays};
 pub use transform::Transform;
