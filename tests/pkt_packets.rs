@@ -223,3 +223,28 @@ fn packets_on_an_empty_scene_miss() {
     let rays = random_rays((Vec3::ZERO, Vec3::ONE), 16 * 4, 1);
     assert_eq!(check(&g, &rays), 0);
 }
+
+#[test]
+fn packets_match_scalar_queries_on_duplicated_triangles() {
+    // Every triangle twice: each hit ties on exactly equal t, which the packet traversal must
+    // resolve like the scalar one (its first-found primitive).
+    let soup = triangle_soup(1500);
+    let prims: Vec<Primitive> = soup.iter().chain(soup.iter()).copied().collect();
+    let g = Geometry::new(prims, vec![MeshShading::default()], Vec::new());
+    let (lo, hi) = g.bounds();
+    let pat = make_pattern(PatternKind::Random, 13);
+    let mut rays = Vec::new();
+    for k in 0..300u32 {
+        let a = pat.sample_2d(UVec2::new(k, 5), 0, 0, 1);
+        let o = lo - (hi - lo) * 0.2 + (hi - lo) * Vec3::new(a.x, a.y, 0.0) * 0.1;
+        let Some(p) = g.primitive(k % g.len() as u32) else {
+            continue;
+        };
+        for s in 0..PACKET as u32 {
+            let j = pat.sample_2d(UVec2::new(k, 6), 0, s, PACKET as u32) * 0.2;
+            let target = p.p[0] + (p.p[1] - p.p[0]) * j.x + (p.p[2] - p.p[0]) * j.y;
+            rays.push(Ray::new(o, target - o));
+        }
+    }
+    assert!(check(&g, &rays) > 2000);
+}
