@@ -18,7 +18,8 @@
 
 use super::accel::Geometry;
 use super::bvh::{NEAR_SLACK, ROUNDING_SLACK, safe_inverse};
-use super::tri4::RayShear4;
+use super::tri4::{RayShear4, TriPacket};
+use super::triangle::{RayShear, shear_axes};
 use super::wide::{Bary, LEAF, Node4, STACK, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use std::mem::MaybeUninit;
@@ -207,6 +208,188 @@ fn node_hits(node: &Node4, r: &PacketBox, t_max: &Lanes, near: &mut [Lanes; 4]) 
     m
 }
 
+/// Per-ray constants of the watertight triangle test, lanes over rays, for a packet whose
+/// active rays share the shear axes (the common case for coherent packets): the constants of
+/// [`RayShear4`] for each ray.
+struct PacketShear {
+    k: [usize; 3],
+    o: [Lanes; 3],
+    s: [Lanes; 3],
+}
+
+impl PacketShear {
+    /// `None` if the active rays do not all share the shear axes.
+    #[inline(always)]
+    fn new(rays: &[Ray; PACKET], active: u32) -> Option<Self> {
+        let k = shear_axes(rays[active.trailing_zeros() as usize & (PACKET - 1)].d);
+        let mut ps = PacketShear {
+            k,
+            o: [[0.0; PACKET]; 3],
+            s: [[0.0; PACKET]; 3],
+        };
+        for i in bits(active) {
+            let (o, d) = (rays[i].o.to_array(), rays[i].d.to_array());
+            if shear_axes(rays[i].d) != k {
+                return None;
+            }
+            // The quotients of `RayShear4::new` (its vector division is lane-wise IEEE).
+            let dz = d[k[2]];
+            for a in 0..3 {
+                ps.o[a][i] = o[k[a]];
+            }
+            ps.s[0][i] = -d[k[0]] / dz;
+            ps.s[1][i] = -d[k[1]] / dz;
+            ps.s[2][i] = 1.0 / dz;
+        }
+        Some(ps)
+    }
+}
+
+/// One triangle against every ray of the packet: each lane performs the f32 operations of
+/// [`RayShear4`]'s lane test for that ray (same order, hence the same bits).
+struct TriLanes {
+    /// Rays accepted by the f32 test with t in (0, t_max).
+    hit: u32,
+    /// Rays with an exactly-zero edge function: to be redone by the scalar test.
+    redo: u32,
+    t: Lanes,
+    b: [Lanes; 3],
+}
+
+#[inline(always)]
+fn triangle_lanes(ps: &PacketShear, p: [[f32; 3]; 3], t_max: &Lanes) -> TriLanes {
+    let [kx, ky, kz] = ps.k;
+    let mut r = TriLanes {
+        hit: 0,
+        redo: 0,
+        t: [0.0; PACKET],
+        b: [[0.0; PACKET]; 3],
+    };
+    let (mut hit, mut redo) = ([false; PACKET], [false; PACKET]);
+    for i in 0..PACKET {
+        let sheared = |v: [f32; 3]| {
+            let (ax, ay, az) = (v[kx] - ps.o[0][i], v[ky] - ps.o[1][i], v[kz] - ps.o[2][i]);
+            (ax + az * ps.s[0][i], ay + az * ps.s[1][i], az * ps.s[2][i])
+        };
+        let (ax, ay, az) = sheared(p[0]);
+        let (bx, by, bz) = sheared(p[1]);
+        let (cx, cy, cz) = sheared(p[2]);
+        let e0 = bx * cy - by * cx;
+        let e1 = cx * ay - cy * ax;
+        let e2 = ax * by - ay * bx;
+        redo[i] = e0 == 0.0 || e1 == 0.0 || e2 == 0.0;
+        let sign = |e: f32| e.to_bits() >> 31;
+        let mixed = (sign(e0) ^ sign(e1)) | (sign(e0) ^ sign(e2)) != 0;
+        let det = e0 + e1 + e2;
+        let t_scaled = e0 * az + e1 * bz + e2 * cz;
+        let tmd = t_max[i] * det;
+        let sgn = 1.0f32.copysign(det);
+        let (ts, tm) = (t_scaled * sgn, tmd * sgn);
+        let in_range = ts > 0.0 && ts <= tm;
+        let inv = 1.0 / det;
+        let t = t_scaled * inv;
+        hit[i] = in_range & !mixed & !redo[i] & (t > 0.0) & (t < t_max[i]);
+        r.t[i] = t;
+        r.b[0][i] = e0 * inv;
+        r.b[1][i] = e1 * inv;
+        r.b[2][i] = e2 * inv;
+    }
+    r.hit = to_mask(&hit);
+    r.redo = to_mask(&redo);
+    r
+}
+
+/// The lanes of `b` as a bit mask.
+#[inline(always)]
+fn to_mask(b: &[bool; PACKET]) -> u32 {
+    b.iter()
+        .enumerate()
+        .fold(0, |m, (i, &h)| m | (h as u32) << i)
+}
+
+/// Vertices of triangle `lane` of `pk` as `[vertex][axis]`.
+#[inline(always)]
+fn tri_vertices(pk: &TriPacket, lane: usize) -> [[f32; 3]; 3] {
+    let v = |j: usize, a: usize| pk.v[j][a].to_array()[lane & 3];
+    [
+        [v(0, 0), v(0, 1), v(0, 2)],
+        [v(1, 0), v(1, 1), v(1, 2)],
+        [v(2, 0), v(2, 1), v(2, 2)],
+    ]
+}
+
+/// The scalar test of a triangle with an exactly-zero f32 edge function for `ray` (rare, so
+/// out of line): (t, b0, b1, b2) with t in (0, t_max).
+#[cold]
+#[inline(never)]
+fn redo_triangle(ray: &Ray, p: [[f32; 3]; 3], t_max: f32) -> Option<(f32, f32, f32, f32)> {
+    let v = p.map(glam::Vec3::from_array);
+    RayShear::new(ray.o, ray.d).intersect(v[0], v[1], v[2], t_max)
+}
+
+/// `next_up` for the best distances of the closest-hit traversal (non-negative or +∞; other
+/// values, which admit no hit either way, are kept): a test with this bound accepts t = best.
+#[inline(always)]
+fn up(b: f32) -> f32 {
+    if b >= 0.0 && b < f32::INFINITY {
+        f32::from_bits(b.to_bits() + 1)
+    } else {
+        b
+    }
+}
+
+/// [`up`] on every lane.
+#[inline(always)]
+fn up_lanes(b: &Lanes) -> Lanes {
+    let mut u = *b;
+    for x in u.iter_mut() {
+        *x = up(*x);
+    }
+    u
+}
+
+/// Record a hit of ray `i` on primitive `id` at `t` (below `up(best[i])`): a closer one
+/// replaces the best, one at exactly the best t from another primitive marks a tie.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn consider(
+    best: &mut Lanes,
+    out: &mut [LaneHit; PACKET],
+    found: &mut u32,
+    ties: &mut u32,
+    i: usize,
+    id: usize,
+    t: f32,
+    b: Bary,
+) {
+    let bit = 1 << i;
+    if t < best[i] {
+        best[i] = t;
+        out[i] = (id, t, b);
+        *found |= bit;
+        *ties &= !bit;
+    } else if t == best[i] && *found & bit != 0 && out[i].0 != id {
+        *ties |= bit;
+    }
+}
+
+/// The [`RayShear4`] of ray `i`, built on first use (`built` marks the built ones).
+#[inline(always)]
+fn ray_shear<'a>(
+    shears: &'a mut [MaybeUninit<RayShear4>; PACKET],
+    built: &mut u32,
+    rays: &[Ray; PACKET],
+    i: usize,
+) -> &'a RayShear4 {
+    let i = i & (PACKET - 1);
+    if *built & (1 << i) == 0 {
+        shears[i].write(RayShear4::new(rays[i].o, rays[i].d));
+        *built |= 1 << i;
+    }
+    // SAFETY: slot i was written, now or at an earlier call (its bit in `built` is set).
+    unsafe { shears[i].assume_init_ref() }
+}
+
 /// A pending subtree of the closest-hit traversal: each ray's entry distance, so that a pop
 /// drops the rays whose best hit has since come closer (the scalar traversal's pop test).
 #[derive(Clone, Copy)]
@@ -279,14 +462,10 @@ impl WideBvh {
         for i in bits(active) {
             best[i] = rays[i].t_max;
         }
-        let shears: [RayShear4; PACKET] = std::array::from_fn(|i| {
-            let d = if active & (1 << i) != 0 {
-                rays[i].d
-            } else {
-                glam::Vec3::Z
-            };
-            RayShear4::new(rays[i].o, d)
-        });
+        let pshear = PacketShear::new(rays, active);
+        // Per-ray shears for packets whose rays differ in shear axes, built at first use.
+        let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
+        let mut built = 0u32;
         let (mut found, mut ties) = (0u32, 0u32);
         let mut stack = [const { MaybeUninit::<Pending>::uninit() }; STACK];
         let mut sp = 0usize;
@@ -339,30 +518,42 @@ impl WideBvh {
                     // SAFETY: a leaf reference is the first packet of a non-empty run inside
                     // `packets` whose final packet has `last` set (see `WideBvh::leaf`).
                     let pk = unsafe { self.packets.get_unchecked(pi) };
-                    for i in bits(mask) {
-                        let i = i & (PACKET - 1);
-                        // Accept t = best too, to notice ties (see the module docs).
-                        let t_max = best[i].next_up();
-                        let mut consider = |id: usize, t: f32, b: Bary| {
-                            if t < best[i] {
-                                best[i] = t;
-                                out[i] = (id, t, b);
-                                found |= 1 << i;
-                                ties &= !(1 << i);
-                            } else if t == best[i] && found & (1 << i) != 0 && out[i].0 != id {
-                                ties |= 1 << i;
-                            }
-                        };
-                        if pk.tri != 0
-                            && let Some((lane, t, b)) = shears[i].closest(pk, t_max)
-                        {
-                            consider(pk.ids[lane & 3] as usize, t, b);
-                        }
-                        for lane in bits(pk.other) {
+                    // Accept t = best too, to notice ties (see the module docs).
+                    if let Some(ps) = &pshear {
+                        for lane in bits(pk.tri) {
+                            let p = tri_vertices(pk, lane);
                             let id = pk.ids[lane & 3] as usize;
+                            let h = triangle_lanes(ps, p, &up_lanes(&best));
+                            for i in bits(h.hit & mask) {
+                                let i = i & (PACKET - 1);
+                                let b = [h.b[0][i], h.b[1][i], h.b[2][i]];
+                                consider(&mut best, out, &mut found, &mut ties, i, id, h.t[i], b);
+                            }
+                            for i in bits(h.redo & mask) {
+                                let i = i & (PACKET - 1);
+                                if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, up(best[i])) {
+                                    consider(&mut best, out, &mut found, &mut ties, i, id, t, [b0, b1, b2]);
+                                }
+                            }
+                        }
+                    } else if pk.tri != 0 {
+                        for i in bits(mask) {
+                            let i = i & (PACKET - 1);
+                            let shear = ray_shear(&mut shears, &mut built, rays, i);
+                            if let Some((lane, t, b)) = shear.closest(pk, up(best[i])) {
+                                let id = pk.ids[lane & 3] as usize;
+                                consider(&mut best, out, &mut found, &mut ties, i, id, t, b);
+                            }
+                        }
+                    }
+                    for lane in bits(pk.other) {
+                        let id = pk.ids[lane & 3] as usize;
+                        for i in bits(mask) {
+                            let i = i & (PACKET - 1);
+                            let t_max = up(best[i]);
                             let t = other(id, &rays[i], t_max);
                             if t < t_max {
-                                consider(id, t, [1.0 / 3.0; 3]);
+                                consider(&mut best, out, &mut found, &mut ties, i, id, t, [1.0 / 3.0; 3]);
                             }
                         }
                     }
@@ -433,14 +624,10 @@ impl WideBvh {
         for i in bits(active) {
             t_max[i] = rays[i].t_max;
         }
-        let shears: [RayShear4; PACKET] = std::array::from_fn(|i| {
-            let d = if active & (1 << i) != 0 {
-                rays[i].d
-            } else {
-                glam::Vec3::Z
-            };
-            RayShear4::new(rays[i].o, d)
-        });
+        let pshear = PacketShear::new(rays, active);
+        // Per-ray shears for packets whose rays differ in shear axes, built at first use.
+        let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
+        let mut built = 0u32;
         let mut blocked = 0u32;
         // Only interior nodes are pushed (leaves are tested on sight), with their ray mask.
         let mut stack = [const { MaybeUninit::<(u32, u32)>::uninit() }; STACK];
@@ -469,11 +656,29 @@ impl WideBvh {
                 loop {
                     // SAFETY: as in `closest_packet`, a leaf's packet run lies in `packets`.
                     let pk = unsafe { self.packets.get_unchecked(pi) };
-                    for i in bits(m & !blocked) {
-                        let i = i & (PACKET - 1);
-                        let hit = (pk.tri != 0 && shears[i].any(pk, rays[i].t_max))
-                            || bits(pk.other).any(|lane| other(pk.ids[lane & 3] as usize, &rays[i]));
-                        blocked |= (hit as u32) << i;
+                    if let Some(ps) = &pshear {
+                        for lane in bits(pk.tri) {
+                            let p = tri_vertices(pk, lane);
+                            let h = triangle_lanes(ps, p, &t_max);
+                            blocked |= h.hit & m;
+                            for i in bits(h.redo & m & !blocked) {
+                                let i = i & (PACKET - 1);
+                                let hit = redo_triangle(&rays[i], p, t_max[i]).is_some();
+                                blocked |= (hit as u32) << i;
+                            }
+                        }
+                    } else if pk.tri != 0 {
+                        for i in bits(m & !blocked) {
+                            let i = i & (PACKET - 1);
+                            let shear = ray_shear(&mut shears, &mut built, rays, i);
+                            blocked |= (shear.any(pk, t_max[i]) as u32) << i;
+                        }
+                    }
+                    for lane in bits(pk.other) {
+                        for i in bits(m & !blocked) {
+                            let hit = other(pk.ids[lane & 3] as usize, &rays[i]);
+                            blocked |= (hit as u32) << i;
+                        }
                     }
                     if pk.last || m & !blocked == 0 {
                         break;
