@@ -256,47 +256,136 @@ struct TriLanes {
     b: [Lanes; 3],
 }
 
+/// One f32 per ray, with lane-wise operators written as plain loops: each statement becomes a
+/// few vector instructions (the loop vectoriser does not take the whole triangle test at once).
+#[derive(Clone, Copy)]
+struct V(Lanes);
+
+/// A lane-wise comparison result (all ones / zero per lane).
+#[derive(Clone, Copy)]
+struct M([u32; PACKET]);
+
+macro_rules! lanewise {
+    ($tr:ident, $f:ident, $op:tt) => {
+        impl std::ops::$tr for V {
+            type Output = V;
+            #[inline(always)]
+            fn $f(self, o: V) -> V {
+                let mut r = [0.0; PACKET];
+                for i in 0..PACKET {
+                    r[i] = self.0[i] $op o.0[i];
+                }
+                V(r)
+            }
+        }
+    };
+}
+lanewise!(Add, add, +);
+lanewise!(Sub, sub, -);
+lanewise!(Mul, mul, *);
+lanewise!(Div, div, /);
+
+impl V {
+    #[inline(always)]
+    fn splat(x: f32) -> V {
+        V([x; PACKET])
+    }
+    #[inline(always)]
+    fn cmp(self, o: V, f: impl Fn(f32, f32) -> bool) -> M {
+        let mut m = [0; PACKET];
+        for i in 0..PACKET {
+            m[i] = if f(self.0[i], o.0[i]) { !0 } else { 0 };
+        }
+        M(m)
+    }
+    /// Sign bits as a lane mask.
+    #[inline(always)]
+    fn sign(self) -> M {
+        let mut m = [0; PACKET];
+        for i in 0..PACKET {
+            m[i] = ((self.0[i].to_bits() as i32) >> 31) as u32;
+        }
+        M(m)
+    }
+    /// `1.0` with the sign of each lane.
+    #[inline(always)]
+    fn sign_one(self) -> V {
+        let mut r = [0.0; PACKET];
+        for i in 0..PACKET {
+            r[i] = f32::from_bits(1.0f32.to_bits() | (self.0[i].to_bits() & 0x8000_0000));
+        }
+        V(r)
+    }
+}
+
+impl M {
+    #[inline(always)]
+    fn zip(self, o: M, f: impl Fn(u32, u32) -> u32) -> M {
+        let mut m = [0; PACKET];
+        for i in 0..PACKET {
+            m[i] = f(self.0[i], o.0[i]);
+        }
+        M(m)
+    }
+    /// One bit per lane.
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        self.0
+            .iter()
+            .enumerate()
+            .fold(0, |b, (i, &m)| b | (m >> 31) << i)
+    }
+}
+
 #[inline(always)]
 fn triangle_lanes(ps: &PacketShear, p: [[f32; 3]; 3], t_max: &Lanes) -> TriLanes {
     let [kx, ky, kz] = ps.k;
-    let mut r = TriLanes {
-        hit: 0,
-        redo: 0,
-        t: [0.0; PACKET],
-        b: [[0.0; PACKET]; 3],
+    let (o, s) = (ps.o.map(V), ps.s.map(V));
+    let sheared = |v: [f32; 3]| {
+        let (ax, ay, az) = (
+            V::splat(v[kx]) - o[0],
+            V::splat(v[ky]) - o[1],
+            V::splat(v[kz]) - o[2],
+        );
+        (ax + az * s[0], ay + az * s[1], az * s[2])
     };
-    let (mut hit, mut redo) = ([false; PACKET], [false; PACKET]);
-    for i in 0..PACKET {
-        let sheared = |v: [f32; 3]| {
-            let (ax, ay, az) = (v[kx] - ps.o[0][i], v[ky] - ps.o[1][i], v[kz] - ps.o[2][i]);
-            (ax + az * ps.s[0][i], ay + az * ps.s[1][i], az * ps.s[2][i])
-        };
-        let (ax, ay, az) = sheared(p[0]);
-        let (bx, by, bz) = sheared(p[1]);
-        let (cx, cy, cz) = sheared(p[2]);
-        let e0 = bx * cy - by * cx;
-        let e1 = cx * ay - cy * ax;
-        let e2 = ax * by - ay * bx;
-        redo[i] = e0 == 0.0 || e1 == 0.0 || e2 == 0.0;
-        let sign = |e: f32| e.to_bits() >> 31;
-        let mixed = (sign(e0) ^ sign(e1)) | (sign(e0) ^ sign(e2)) != 0;
-        let det = e0 + e1 + e2;
-        let t_scaled = e0 * az + e1 * bz + e2 * cz;
-        let tmd = t_max[i] * det;
-        let sgn = 1.0f32.copysign(det);
-        let (ts, tm) = (t_scaled * sgn, tmd * sgn);
-        let in_range = ts > 0.0 && ts <= tm;
-        let inv = 1.0 / det;
-        let t = t_scaled * inv;
-        hit[i] = in_range & !mixed & !redo[i] & (t > 0.0) & (t < t_max[i]);
-        r.t[i] = t;
-        r.b[0][i] = e0 * inv;
-        r.b[1][i] = e1 * inv;
-        r.b[2][i] = e2 * inv;
+    let (ax, ay, az) = sheared(p[0]);
+    let (bx, by, bz) = sheared(p[1]);
+    let (cx, cy, cz) = sheared(p[2]);
+    let e0 = bx * cy - by * cx;
+    let e1 = cx * ay - cy * ax;
+    let e2 = ax * by - ay * bx;
+    let zero = V::splat(0.0);
+    let eq = |a: f32, b: f32| a == b;
+    let redo = e0.cmp(zero, eq).zip(e1.cmp(zero, eq), |a, b| a | b);
+    let redo = redo.zip(e2.cmp(zero, eq), |a, b| a | b);
+    let n0 = e0.sign();
+    let mixed = n0
+        .zip(e1.sign(), |a, b| a ^ b)
+        .zip(n0.zip(e2.sign(), |a, b| a ^ b), |a, b| a | b);
+    let det = e0 + e1 + e2;
+    let t_scaled = e0 * az + e1 * bz + e2 * cz;
+    let t_max = V(*t_max);
+    let tmd = t_max * det;
+    let sgn = det.sign_one();
+    let (ts, tm) = (t_scaled * sgn, tmd * sgn);
+    let in_range = ts
+        .cmp(zero, |a, b| a > b)
+        .zip(ts.cmp(tm, |a, b| a <= b), |a, b| a & b);
+    let inv = V::splat(1.0) / det;
+    let t = t_scaled * inv;
+    let ok = t
+        .cmp(zero, |a, b| a > b)
+        .zip(t.cmp(t_max, |a, b| a < b), |a, b| a & b);
+    let hit = in_range
+        .zip(ok, |a, b| a & b)
+        .zip(mixed.zip(redo, |a, b| a | b), |a, b| a & !b);
+    TriLanes {
+        hit: hit.bits(),
+        redo: redo.bits(),
+        t: t.0,
+        b: [(e0 * inv).0, (e1 * inv).0, (e2 * inv).0],
     }
-    r.hit = to_mask(&hit);
-    r.redo = to_mask(&redo);
-    r
 }
 
 /// The lanes of `b` as a bit mask.
@@ -331,11 +420,8 @@ fn redo_triangle(ray: &Ray, p: [[f32; 3]; 3], t_max: f32) -> Option<(f32, f32, f
 /// values, which admit no hit either way, are kept): a test with this bound accepts t = best.
 #[inline(always)]
 fn up(b: f32) -> f32 {
-    if b >= 0.0 && b < f32::INFINITY {
-        f32::from_bits(b.to_bits() + 1)
-    } else {
-        b
-    }
+    // Branch-free (it runs on every lane): +1 ulp exactly for 0 ≤ b < ∞.
+    f32::from_bits(b.to_bits() + (b >= 0.0 && b < f32::INFINITY) as u32)
 }
 
 /// [`up`] on every lane.
