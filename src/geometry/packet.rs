@@ -341,17 +341,21 @@ impl M {
 fn triangle_lanes(ps: &PacketShear, p: [[f32; 3]; 3], t_max: &Lanes) -> TriLanes {
     let [kx, ky, kz] = ps.k;
     let (o, s) = (ps.o.map(V), ps.s.map(V));
-    let sheared = |v: [f32; 3]| {
+    // A function, not a closure: closures are not inlined reliably, and out of line they
+    // would miss the caller's AVX2.
+    #[inline(always)]
+    fn shear(v: [f32; 3], k: [usize; 3], o: &[V; 3], s: &[V; 3]) -> (V, V, V) {
         let (ax, ay, az) = (
-            V::splat(v[kx]) - o[0],
-            V::splat(v[ky]) - o[1],
-            V::splat(v[kz]) - o[2],
+            V::splat(v[k[0]]) - o[0],
+            V::splat(v[k[1]]) - o[1],
+            V::splat(v[k[2]]) - o[2],
         );
         (ax + az * s[0], ay + az * s[1], az * s[2])
-    };
-    let (ax, ay, az) = sheared(p[0]);
-    let (bx, by, bz) = sheared(p[1]);
-    let (cx, cy, cz) = sheared(p[2]);
+    }
+
+    let (ax, ay, az) = shear(p[0], [kx, ky, kz], &o, &s);
+    let (bx, by, bz) = shear(p[1], [kx, ky, kz], &o, &s);
+    let (cx, cy, cz) = shear(p[2], [kx, ky, kz], &o, &s);
     let e0 = bx * cy - by * cx;
     let e1 = cx * ay - cy * ax;
     let e2 = ax * by - ay * bx;
@@ -440,6 +444,7 @@ fn up_lanes(b: &Lanes) -> Lanes {
 #[inline(always)]
 fn consider(
     best: &mut Lanes,
+    tm: &mut Lanes,
     out: &mut [LaneHit; PACKET],
     found: &mut u32,
     ties: &mut u32,
@@ -451,6 +456,7 @@ fn consider(
     let bit = 1 << i;
     if t < best[i] {
         best[i] = t;
+        tm[i] = up(t);
         out[i] = (id, t, b);
         *found |= bit;
         *ties &= !bit;
@@ -548,6 +554,8 @@ impl WideBvh {
         for i in bits(active) {
             best[i] = rays[i].t_max;
         }
+        // Bounds of the tests: up(best), so that hits at exactly the best t are seen.
+        let mut tm = up_lanes(&best);
         let pshear = PacketShear::new(rays, active);
         // Per-ray shears for packets whose rays differ in shear axes, built at first use.
         let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
@@ -609,16 +617,16 @@ impl WideBvh {
                         for lane in bits(pk.tri) {
                             let p = tri_vertices(pk, lane);
                             let id = pk.ids[lane & 3] as usize;
-                            let h = triangle_lanes(ps, p, &up_lanes(&best));
+                            let h = triangle_lanes(ps, p, &tm);
                             for i in bits(h.hit & mask) {
                                 let i = i & (PACKET - 1);
                                 let b = [h.b[0][i], h.b[1][i], h.b[2][i]];
-                                consider(&mut best, out, &mut found, &mut ties, i, id, h.t[i], b);
+                                consider(&mut best, &mut tm, out, &mut found, &mut ties, i, id, h.t[i], b);
                             }
                             for i in bits(h.redo & mask) {
                                 let i = i & (PACKET - 1);
-                                if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, up(best[i])) {
-                                    consider(&mut best, out, &mut found, &mut ties, i, id, t, [b0, b1, b2]);
+                                if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, tm[i]) {
+                                    consider(&mut best, &mut tm, out, &mut found, &mut ties, i, id, t, [b0, b1, b2]);
                                 }
                             }
                         }
@@ -626,9 +634,9 @@ impl WideBvh {
                         for i in bits(mask) {
                             let i = i & (PACKET - 1);
                             let shear = ray_shear(&mut shears, &mut built, rays, i);
-                            if let Some((lane, t, b)) = shear.closest(pk, up(best[i])) {
+                            if let Some((lane, t, b)) = shear.closest(pk, tm[i]) {
                                 let id = pk.ids[lane & 3] as usize;
-                                consider(&mut best, out, &mut found, &mut ties, i, id, t, b);
+                                consider(&mut best, &mut tm, out, &mut found, &mut ties, i, id, t, b);
                             }
                         }
                     }
@@ -636,10 +644,10 @@ impl WideBvh {
                         let id = pk.ids[lane & 3] as usize;
                         for i in bits(mask) {
                             let i = i & (PACKET - 1);
-                            let t_max = up(best[i]);
+                            let t_max = tm[i];
                             let t = other(id, &rays[i], t_max);
                             if t < t_max {
-                                consider(&mut best, out, &mut found, &mut ties, i, id, t, [1.0 / 3.0; 3]);
+                                consider(&mut best, &mut tm, out, &mut found, &mut ties, i, id, t, [1.0 / 3.0; 3]);
                             }
                         }
                     }
