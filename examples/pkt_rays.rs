@@ -109,18 +109,20 @@ fn main() -> anyhow::Result<()> {
                 let mut shadow = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); PACKET];
                 let mut sh_active = 0u32;
                 for (i, r) in rays.iter().enumerate() {
-                    let Some(h) = (active & (1 << i) != 0)
-                        .then(|| g.intersect(r))
-                        .flatten()
-                    else {
+                    let Some(h) = (active & (1 << i) != 0).then(|| g.intersect(r)).flatten() else {
                         continue;
                     };
                     let (u, v) = uniform_pair(key ^ 0x5bd1_e995, s0 + i as u32);
-                    let Some(p) = lights.primitive(((u * 7919.0) as usize % lights.len().max(1)) as u32)
+                    let Some(p) =
+                        lights.primitive(((u * 7919.0) as usize % lights.len().max(1)) as u32)
                     else {
                         continue;
                     };
-                    let (a, b) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+                    let (a, b) = if u + v > 1.0 {
+                        (1.0 - u, 1.0 - v)
+                    } else {
+                        (u, v)
+                    };
                     let target = p.p[0] + (p.p[1] - p.p[0]) * a + (p.p[2] - p.p[0]) * b;
                     let o = h.spawn_origin(target - h.p);
                     shadow[i] = Ray {
@@ -154,13 +156,21 @@ fn main() -> anyhow::Result<()> {
         "closest: scalar {:.2} Mrays/s, packet {:.2} Mrays/s (results {})",
         mrays(n_cam, time[0]),
         mrays(n_cam, time[1]),
-        if sums[0] == sums[1] { "equal" } else { "DIFFER" }
+        if sums[0] == sums[1] {
+            "equal"
+        } else {
+            "DIFFER"
+        }
     );
     println!(
         "any-hit: scalar {:.2} Mrays/s, packet {:.2} Mrays/s (results {})",
         mrays(n_shadow, time[2]),
         mrays(n_shadow, time[3]),
-        if sums[2] == sums[3] { "equal" } else { "DIFFER" }
+        if sums[2] == sums[3] {
+            "equal"
+        } else {
+            "DIFFER"
+        }
     );
     Ok(())
 }

@@ -48,7 +48,11 @@ fn check(g: &Geometry, rays: &[Ray]) -> u32 {
             assert_eq!(key(&out[i]), key(&want), "lane {i} of packet {k}: {ray:?}");
             hits += want.is_some() as u32;
             let occluded = on && g.occluded(ray);
-            assert_eq!(blocked & (1 << i) != 0, occluded, "any-hit lane {i}: {ray:?}");
+            assert_eq!(
+                blocked & (1 << i) != 0,
+                occluded,
+                "any-hit lane {i}: {ray:?}"
+            );
         }
     }
     hits

@@ -16,6 +16,9 @@
 //! watches for hits at exactly the best t from another primitive, and the (very rare) rays
 //! with such a tie are redone by the scalar query.
 
+// Lane loops `for i in 0..PACKET` over several arrays at once are what LLVM vectorises.
+#![allow(clippy::needless_range_loop)]
+
 use super::accel::Geometry;
 use super::bvh::{NEAR_SLACK, ROUNDING_SLACK, safe_inverse};
 use super::tri4::{RayShear4, TriPacket};
@@ -137,7 +140,11 @@ impl PacketBox {
             }
         }
         if (0..3).all(|a| !any_neg[a] || all_neg[a]) {
-            b.uniform = Some([any_neg[0] as usize, any_neg[1] as usize, any_neg[2] as usize]);
+            b.uniform = Some([
+                any_neg[0] as usize,
+                any_neg[1] as usize,
+                any_neg[2] as usize,
+            ]);
         }
         b
     }
@@ -392,14 +399,6 @@ fn triangle_lanes(ps: &PacketShear, p: [[f32; 3]; 3], t_max: &Lanes) -> TriLanes
     }
 }
 
-/// The lanes of `b` as a bit mask.
-#[inline(always)]
-fn to_mask(b: &[bool; PACKET]) -> u32 {
-    b.iter()
-        .enumerate()
-        .fold(0, |m, (i, &h)| m | (h as u32) << i)
-}
-
 /// Vertices of triangle `lane` of `pk` as `[vertex][axis]`.
 #[inline(always)]
 fn tri_vertices(pk: &TriPacket, lane: usize) -> [[f32; 3]; 3] {
@@ -425,7 +424,7 @@ fn redo_triangle(ray: &Ray, p: [[f32; 3]; 3], t_max: f32) -> Option<(f32, f32, f
 #[inline(always)]
 fn up(b: f32) -> f32 {
     // Branch-free (it runs on every lane): +1 ulp exactly for 0 ≤ b < ∞.
-    f32::from_bits(b.to_bits() + (b >= 0.0 && b < f32::INFINITY) as u32)
+    f32::from_bits(b.to_bits() + (0.0..f32::INFINITY).contains(&b) as u32)
 }
 
 /// [`up`] on every lane.
@@ -621,12 +620,25 @@ impl WideBvh {
                             for i in bits(h.hit & mask) {
                                 let i = i & (PACKET - 1);
                                 let b = [h.b[0][i], h.b[1][i], h.b[2][i]];
-                                consider(&mut best, &mut tm, out, &mut found, &mut ties, i, id, h.t[i], b);
+                                consider(
+                                    &mut best, &mut tm, out, &mut found, &mut ties, i, id, h.t[i],
+                                    b,
+                                );
                             }
                             for i in bits(h.redo & mask) {
                                 let i = i & (PACKET - 1);
                                 if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, tm[i]) {
-                                    consider(&mut best, &mut tm, out, &mut found, &mut ties, i, id, t, [b0, b1, b2]);
+                                    consider(
+                                        &mut best,
+                                        &mut tm,
+                                        out,
+                                        &mut found,
+                                        &mut ties,
+                                        i,
+                                        id,
+                                        t,
+                                        [b0, b1, b2],
+                                    );
                                 }
                             }
                         }
@@ -636,7 +648,9 @@ impl WideBvh {
                             let shear = ray_shear(&mut shears, &mut built, rays, i);
                             if let Some((lane, t, b)) = shear.closest(pk, tm[i]) {
                                 let id = pk.ids[lane & 3] as usize;
-                                consider(&mut best, &mut tm, out, &mut found, &mut ties, i, id, t, b);
+                                consider(
+                                    &mut best, &mut tm, out, &mut found, &mut ties, i, id, t, b,
+                                );
                             }
                         }
                     }
@@ -647,7 +661,17 @@ impl WideBvh {
                             let t_max = tm[i];
                             let t = other(id, &rays[i], t_max);
                             if t < t_max {
-                                consider(&mut best, &mut tm, out, &mut found, &mut ties, i, id, t, [1.0 / 3.0; 3]);
+                                consider(
+                                    &mut best,
+                                    &mut tm,
+                                    out,
+                                    &mut found,
+                                    &mut ties,
+                                    i,
+                                    id,
+                                    t,
+                                    [1.0 / 3.0; 3],
+                                );
                             }
                         }
                     }
