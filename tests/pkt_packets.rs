@@ -28,6 +28,11 @@ fn check(g: &Geometry, rays: &[Ray]) -> u32 {
         let mut out = [None; PACKET];
         g.intersect_packet(&pk, active, &mut out);
         let blocked = g.occluded_packet(&pk, active);
+        assert_eq!(
+            blocked,
+            g.occluded_packet_traversal(&pk, active),
+            "packet {k}"
+        );
         for (i, ray) in pk.iter().enumerate() {
             let on = active & (1 << i) != 0;
             let want = if on { g.intersect(ray) } else { None };
