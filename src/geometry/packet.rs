@@ -47,7 +47,7 @@ impl Geometry {
     ) {
         let active = active & PACKET_MASK;
         *out = [None; PACKET];
-        let Some(bvh) = self.wide() else {
+        let Some(bvh) = self.wide().filter(|b| !b.is_single_leaf()) else {
             for i in bits(active) {
                 out[i] = self.intersect(&rays[i]);
             }

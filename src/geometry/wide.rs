@@ -172,6 +172,11 @@ impl WideBvh {
         Some(w)
     }
 
+    /// True if the whole tree is one leaf (most scenes' emitter-only geometry).
+    pub fn is_single_leaf(&self) -> bool {
+        self.single_leaf.is_some()
+    }
+
     /// Number of nodes and of leaf packets (statistics).
     pub fn size(&self) -> (usize, usize) {
         (self.nodes.len(), self.packets.len())
