@@ -10,7 +10,7 @@ mod geometry_support;
 use geometry_support::{brute_force_t, random_rays, triangle_soup};
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::{
-    Backend, Geometry, MeshShading, PACKET, PrimKind, Primitive, Quadric, QuadricKind, Ray,
+    Backend, Geometry, MeshShading, PACKET, PacketIsa, PrimKind, Primitive, Quadric, QuadricKind, Ray,
     RayQuery, Transform,
 };
 use penumbra::sampling::{PatternKind, make_pattern};
@@ -19,19 +19,34 @@ use penumbra::scene::Scene;
 /// Active masks cycled through the packets: full, partial, single lanes.
 const MASKS: [u32; 5] = [0xffff, 0xa5c3, 0x0001, 0x8000, 0x7ffe];
 
-/// Compares packet and scalar queries over `rays` in packets of 16; returns the number of hits.
+/// Every vector backend of the packet kernels (those this CPU lacks resolve to a narrower one,
+/// so they are still run, and the supported ones are checked: see `isas_resolve`).
+const ISAS: [PacketIsa; 4] = [
+    PacketIsa::Auto,
+    PacketIsa::Portable,
+    PacketIsa::Avx2,
+    PacketIsa::Avx512,
+];
+
+/// Compares packet and scalar queries over `rays` in packets of 16 on every vector backend;
+/// returns the number of hits.
 fn check(g: &Geometry, rays: &[Ray]) -> u32 {
+    ISAS.iter().map(|&isa| check_on(g, rays, isa)).max().unwrap_or(0)
+}
+
+/// [`check`] on one backend.
+fn check_on(g: &Geometry, rays: &[Ray], isa: PacketIsa) -> u32 {
     let mut hits = 0;
     for (k, chunk) in rays.chunks_exact(PACKET).enumerate() {
         let pk: [Ray; PACKET] = std::array::from_fn(|i| chunk[i]);
         let active = MASKS[k % MASKS.len()];
         let mut out = [None; PACKET];
-        g.intersect_packet(&pk, active, &mut out);
+        g.intersect_packet_on(isa, &pk, active, &mut out);
         let blocked = g.occluded_packet(&pk, active);
         assert_eq!(
             blocked,
-            g.occluded_packet_traversal(&pk, active),
-            "packet {k}"
+            g.occluded_packet_traversal_on(isa, &pk, active),
+            "packet {k} on {isa:?}"
         );
         for (i, ray) in pk.iter().enumerate() {
             let on = active & (1 << i) != 0;
@@ -50,7 +65,7 @@ fn check(g: &Geometry, rays: &[Ray]) -> u32 {
                     )
                 })
             };
-            assert_eq!(key(&out[i]), key(&want), "lane {i} of packet {k}: {ray:?}");
+            assert_eq!(key(&out[i]), key(&want), "lane {i} of packet {k} on {isa:?}: {ray:?}");
             hits += want.is_some() as u32;
             let occluded = on && g.occluded(ray);
             assert_eq!(
@@ -256,4 +271,16 @@ fn packets_match_scalar_queries_on_duplicated_triangles() {
         }
     }
     assert!(check(&g, &rays) > 2000);
+}
+
+#[test]
+fn isas_resolve_to_supported_backends() {
+    // Portable stays portable; the others never resolve to something wider than asked.
+    assert_eq!(PacketIsa::Portable.resolve(), PacketIsa::Portable);
+    assert_ne!(PacketIsa::Avx2.resolve(), PacketIsa::Avx512);
+    assert_ne!(PacketIsa::Auto.resolve(), PacketIsa::Auto);
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512dq") {
+        assert_eq!(PacketIsa::Auto.resolve(), PacketIsa::Avx512);
+    }
 }

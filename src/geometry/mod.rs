@@ -6,6 +6,7 @@ pub mod bvh;
 pub mod float;
 pub mod interaction;
 pub mod packet;
+mod simd16;
 pub mod quadric;
 pub mod ray;
 pub mod transform;
@@ -16,7 +17,7 @@ pub mod wide;
 
 pub use accel::{Backend, Geometry, MeshShading, PrimKind, Primitive};
 pub use interaction::SurfaceHit;
-pub use packet::PACKET;
+pub use packet::{PACKET, PacketIsa};
 pub use quadric::{Quadric, QuadricKind};
 pub use ray::{Ray, random_query_rays};
 pub use transform::Transform;

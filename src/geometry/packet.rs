@@ -23,15 +23,15 @@ use super::accel::Geometry;
 use super::bvh::{NEAR_SLACK, ROUNDING_SLACK, safe_inverse};
 use super::tri4::{RayShear4, TriPacket};
 use super::triangle::{RayShear, shear_axes};
+use super::simd16::{Lanes, Portable, Simd};
+#[cfg(target_arch = "x86_64")]
+use super::simd16::{Avx2, Avx512};
 use super::wide::{Bary, LEAF, Node4, STACK, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use std::mem::MaybeUninit;
 
 /// Rays per packet query.
 pub const PACKET: usize = 16;
-
-/// One f32 per ray of a packet.
-type Lanes = [f32; PACKET];
 
 /// Closest-hit record of one ray: (leaf-order id, t, barycentrics).
 type LaneHit = (usize, f32, Bary);
@@ -45,6 +45,17 @@ impl Geometry {
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
+        self.intersect_packet_on(PacketIsa::Auto, rays, active, out);
+    }
+
+    /// [`Self::intersect_packet`] on a chosen vector backend (for tests and benchmarks).
+    pub fn intersect_packet_on(
+        &self,
+        isa: PacketIsa,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+    ) {
         let active = active & PACKET_MASK;
         *out = [None; PACKET];
         let Some(bvh) = self.wide().filter(|b| !b.is_single_leaf()) else {
@@ -54,7 +65,7 @@ impl Geometry {
             return;
         };
         let mut hits = [(0usize, 0.0f32, [0.0f32; 3]); PACKET];
-        let (found, ties) = bvh.closest_packet(rays, active, &mut hits, |id, ray, t_max| {
+        let (found, ties) = bvh.closest_packet(isa, rays, active, &mut hits, |id, ray, t_max| {
             self.quadric_t_outlined(id, ray.o, ray.d, t_max)
         });
         for i in bits(found & !ties) {
@@ -79,11 +90,21 @@ impl Geometry {
     /// [`Self::occluded_packet`] by one traversal of the wide BVH for the whole packet (same
     /// results; faster only on small scenes so far, see there).
     pub fn occluded_packet_traversal(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+        self.occluded_packet_traversal_on(PacketIsa::Auto, rays, active)
+    }
+
+    /// [`Self::occluded_packet_traversal`] on a chosen vector backend (for tests).
+    pub fn occluded_packet_traversal_on(
+        &self,
+        isa: PacketIsa,
+        rays: &[Ray; PACKET],
+        active: u32,
+    ) -> u32 {
         let active = active & PACKET_MASK;
         let Some(bvh) = self.wide() else {
             return bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i);
         };
-        bvh.any_packet(rays, active, |id, ray| {
+        bvh.any_packet(isa, rays, active, |id, ray| {
             self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
         })
     }
@@ -105,121 +126,97 @@ fn bits(mut m: u32) -> impl Iterator<Item = usize> {
     })
 }
 
-/// SSE `maxps` on one lane (the second operand if either is NaN): `Vec4::max` of `Node4::hit`.
-#[inline(always)]
-fn mx(a: f32, b: f32) -> f32 {
-    if a > b { a } else { b }
-}
-
-/// SSE `minps` on one lane (see [`mx`]).
-#[inline(always)]
-fn mn(a: f32, b: f32) -> f32 {
-    if a < b { a } else { b }
-}
 
 /// Per-ray constants of the slab test, lanes over rays.
-struct PacketBox {
-    o: [Lanes; 3],
-    inv: [Lanes; 3],
-    /// All ones where the ray enters the box through the upper plane of that axis.
-    neg: [[u32; PACKET]; 3],
+struct PacketBox<S: Simd> {
+    o: [S::F; 3],
+    inv: [S::F; 3],
+    /// Rays that enter the box through the upper plane of that axis.
+    neg: [S::M; 3],
     /// Entry side (0 = lower plane) per axis when all active rays agree, else `None`.
     uniform: Option<[usize; 3]>,
 }
 
-impl PacketBox {
+impl<S: Simd> PacketBox<S> {
     #[inline(always)]
     fn new(rays: &[Ray; PACKET], active: u32) -> Self {
-        let mut b = PacketBox {
-            o: [[0.0; PACKET]; 3],
-            inv: [[0.0; PACKET]; 3],
-            neg: [[0; PACKET]; 3],
-            uniform: None,
-        };
+        let (mut o, mut inv) = ([[0.0f32; PACKET]; 3], [[0.0f32; PACKET]; 3]);
         let (mut any_neg, mut all_neg) = ([false; 3], [true; 3]);
         for (i, r) in rays.iter().enumerate() {
-            let inv = safe_inverse(r.d).to_array();
-            let o = r.o.to_array();
+            let ri = safe_inverse(r.d).to_array();
+            let ro = r.o.to_array();
             let on = active & (1 << i) != 0;
             for a in 0..3 {
-                b.o[a][i] = o[a];
-                b.inv[a][i] = inv[a];
-                let neg = inv[a] < 0.0;
-                b.neg[a][i] = if neg { !0 } else { 0 };
+                o[a][i] = ro[a];
+                inv[a][i] = ri[a];
+                let neg = ri[a] < 0.0;
                 any_neg[a] |= on & neg;
                 all_neg[a] &= !on | neg;
             }
         }
-        if (0..3).all(|a| !any_neg[a] || all_neg[a]) {
-            b.uniform = Some([
-                any_neg[0] as usize,
-                any_neg[1] as usize,
-                any_neg[2] as usize,
-            ]);
+        let inv = inv.map(|v| S::load(&v));
+        let uniform = (0..3)
+            .all(|a| !any_neg[a] || all_neg[a])
+            .then(|| any_neg.map(|n| n as usize));
+        PacketBox {
+            o: o.map(|v| S::load(&v)),
+            inv,
+            neg: inv.map(|v| S::lt(v, S::splat(0.0))),
+            uniform,
         }
-        b
     }
-}
-
-/// `if m { a } else { b }` lane-wise on bit patterns (a blend after vectorisation).
-#[inline(always)]
-fn pick(m: u32, a: f32, b: f32) -> f32 {
-    f32::from_bits((a.to_bits() & m) | (b.to_bits() & !m))
 }
 
 /// The slab test of child `c` of `node` against every ray: each lane computes exactly what
 /// `Node4::hit` computes for that ray and lane c. Writes the entry distances to `near` and
 /// returns the mask of rays that enter the box before their `t_max`.
 #[inline(always)]
-fn child_hits<const MIXED: bool>(
+fn child_hits<S: Simd, const MIXED: bool>(
     node: &Node4,
     c: usize,
-    r: &PacketBox,
+    r: &PacketBox<S>,
     side: [usize; 3],
-    t_max: &Lanes,
+    t_max: S::F,
     near: &mut Lanes,
 ) -> u32 {
-    let plane = |s: usize, a: usize| node.b[s][a].to_array()[c];
-    let lo = [plane(0, 0), plane(0, 1), plane(0, 2)];
-    let hi = [plane(1, 0), plane(1, 1), plane(1, 2)];
-    let planes = [lo, hi];
-    let mut hit = [false; PACKET];
-    for i in 0..PACKET {
-        let t = |a: usize| {
-            let (n, f) = if MIXED {
-                let m = r.neg[a][i];
-                (pick(m, hi[a], lo[a]), pick(m, lo[a], hi[a]))
-            } else {
-                (planes[side[a] & 1][a], planes[(side[a] ^ 1) & 1][a])
-            };
-            ((n - r.o[a][i]) * r.inv[a][i], (f - r.o[a][i]) * r.inv[a][i])
+    let plane = |s: usize, a: usize| node.b[s & 1][a].to_array()[c & 3];
+    let mut n = [S::splat(0.0); 3];
+    let mut f = [S::splat(0.0); 3];
+    for a in 0..3 {
+        let (np, fp) = if MIXED {
+            let (lo, hi) = (S::splat(plane(0, a)), S::splat(plane(1, a)));
+            (S::select(r.neg[a], hi, lo), S::select(r.neg[a], lo, hi))
+        } else {
+            (S::splat(plane(side[a], a)), S::splat(plane(side[a] ^ 1, a)))
         };
-        let (nx, fx) = t(0);
-        let (ny, fy) = t(1);
-        let (nz, fz) = t(2);
-        let n = mx(mx(mx(nx, ny), nz), 0.0) * NEAR_SLACK;
-        let f = mn(mn(fx, fy), fz) * ROUNDING_SLACK;
-        near[i] = n;
-        hit[i] = n <= mn(f, t_max[i]);
+        n[a] = (np - r.o[a]) * r.inv[a];
+        f[a] = (fp - r.o[a]) * r.inv[a];
     }
-    hit.iter()
-        .enumerate()
-        .fold(0, |m, (i, &h)| m | (h as u32) << i)
+    let nr = S::max(S::max(S::max(n[0], n[1]), n[2]), S::splat(0.0)) * S::splat(NEAR_SLACK);
+    let fr = S::min(S::min(f[0], f[1]), f[2]) * S::splat(ROUNDING_SLACK);
+    S::store(nr, near);
+    S::bits(S::le(nr, S::min(fr, t_max)))
 }
 
 /// [`child_hits`] for the four children.
 #[inline(always)]
-fn node_hits(node: &Node4, r: &PacketBox, t_max: &Lanes, near: &mut [Lanes; 4]) -> [u32; 4] {
+fn node_hits<S: Simd>(
+    node: &Node4,
+    r: &PacketBox<S>,
+    t_max: &Lanes,
+    near: &mut [Lanes; 4],
+) -> [u32; 4] {
+    let t_max = S::load(t_max);
     let mut m = [0; 4];
     match r.uniform {
         Some(side) => {
             for c in 0..4 {
-                m[c] = child_hits::<false>(node, c, r, side, t_max, &mut near[c]);
+                m[c] = child_hits::<S, false>(node, c, r, side, t_max, &mut near[c]);
             }
         }
         None => {
             for c in 0..4 {
-                m[c] = child_hits::<true>(node, c, r, [0; 3], t_max, &mut near[c]);
+                m[c] = child_hits::<S, true>(node, c, r, [0; 3], t_max, &mut near[c]);
             }
         }
     }
@@ -229,184 +226,130 @@ fn node_hits(node: &Node4, r: &PacketBox, t_max: &Lanes, near: &mut [Lanes; 4]) 
 /// Per-ray constants of the watertight triangle test, lanes over rays, for a packet whose
 /// active rays share the shear axes (the common case for coherent packets): the constants of
 /// [`RayShear4`] for each ray.
-struct PacketShear {
+struct PacketShear<S: Simd> {
     k: [usize; 3],
-    o: [Lanes; 3],
-    s: [Lanes; 3],
+    o: [S::F; 3],
+    s: [S::F; 3],
 }
 
-impl PacketShear {
+impl<S: Simd> PacketShear<S> {
     /// `None` if the active rays do not all share the shear axes.
     #[inline(always)]
     fn new(rays: &[Ray; PACKET], active: u32) -> Option<Self> {
         let k = shear_axes(rays[active.trailing_zeros() as usize & (PACKET - 1)].d);
-        let mut ps = PacketShear {
-            k,
-            o: [[0.0; PACKET]; 3],
-            s: [[0.0; PACKET]; 3],
-        };
+        let (mut o, mut s) = ([[0.0f32; PACKET]; 3], [[0.0f32; PACKET]; 3]);
         for i in bits(active) {
-            let (o, d) = (rays[i].o.to_array(), rays[i].d.to_array());
+            let i = i & (PACKET - 1);
+            let (ro, d) = (rays[i].o.to_array(), rays[i].d.to_array());
             if shear_axes(rays[i].d) != k {
                 return None;
             }
             // The quotients of `RayShear4::new` (its vector division is lane-wise IEEE).
             let dz = d[k[2]];
             for a in 0..3 {
-                ps.o[a][i] = o[k[a]];
+                o[a][i] = ro[k[a]];
             }
-            ps.s[0][i] = -d[k[0]] / dz;
-            ps.s[1][i] = -d[k[1]] / dz;
-            ps.s[2][i] = 1.0 / dz;
+            s[0][i] = -d[k[0]] / dz;
+            s[1][i] = -d[k[1]] / dz;
+            s[2][i] = 1.0 / dz;
         }
-        Some(ps)
+        Some(PacketShear {
+            k,
+            o: o.map(|v| S::load(&v)),
+            s: s.map(|v| S::load(&v)),
+        })
     }
 }
 
 /// One triangle against every ray of the packet: each lane performs the f32 operations of
 /// [`RayShear4`]'s lane test for that ray (same order, hence the same bits).
-struct TriLanes {
+struct TriLanes<S: Simd> {
     /// Rays accepted by the f32 test with t in (0, t_max).
     hit: u32,
     /// Rays with an exactly-zero edge function: to be redone by the scalar test.
     redo: u32,
-    t: Lanes,
-    b: [Lanes; 3],
+    /// Hit distances (valid in `hit`).
+    t: S::F,
+    /// Edge functions and the reciprocal determinant: barycentric k = e[k] · inv.
+    e: [S::F; 3],
+    inv: S::F,
 }
 
-/// One f32 per ray, with lane-wise operators written as plain loops: each statement becomes a
-/// few vector instructions (the loop vectoriser does not take the whole triangle test at once).
-#[derive(Clone, Copy)]
-struct V(Lanes);
-
-/// A lane-wise comparison result (all ones / zero per lane).
-#[derive(Clone, Copy)]
-struct M([u32; PACKET]);
-
-macro_rules! lanewise {
-    ($tr:ident, $f:ident, $op:tt) => {
-        impl std::ops::$tr for V {
-            type Output = V;
-            #[inline(always)]
-            fn $f(self, o: V) -> V {
-                let mut r = [0.0; PACKET];
-                for i in 0..PACKET {
-                    r[i] = self.0[i] $op o.0[i];
-                }
-                V(r)
-            }
-        }
-    };
-}
-lanewise!(Add, add, +);
-lanewise!(Sub, sub, -);
-lanewise!(Mul, mul, *);
-lanewise!(Div, div, /);
-
-impl V {
+impl<S: Simd> TriLanes<S> {
+    /// The lanes of t, inv, e0, e1, e2 in memory (barycentric k of lane i = e_k[i] · inv[i],
+    /// the products of `RayShear4::closest`).
     #[inline(always)]
-    fn splat(x: f32) -> V {
-        V([x; PACKET])
-    }
-    #[inline(always)]
-    fn cmp(self, o: V, f: impl Fn(f32, f32) -> bool) -> M {
-        let mut m = [0; PACKET];
-        for i in 0..PACKET {
-            m[i] = if f(self.0[i], o.0[i]) { !0 } else { 0 };
+    fn spill(&self) -> [Lanes; 5] {
+        let mut a = [[0.0f32; PACKET]; 5];
+        S::store(self.t, &mut a[0]);
+        S::store(self.inv, &mut a[1]);
+        for k in 0..3 {
+            S::store(self.e[k], &mut a[2 + k]);
         }
-        M(m)
-    }
-    /// Sign bits as a lane mask.
-    #[inline(always)]
-    fn sign(self) -> M {
-        let mut m = [0; PACKET];
-        for i in 0..PACKET {
-            m[i] = ((self.0[i].to_bits() as i32) >> 31) as u32;
-        }
-        M(m)
-    }
-    /// `1.0` with the sign of each lane.
-    #[inline(always)]
-    fn sign_one(self) -> V {
-        let mut r = [0.0; PACKET];
-        for i in 0..PACKET {
-            r[i] = f32::from_bits(1.0f32.to_bits() | (self.0[i].to_bits() & 0x8000_0000));
-        }
-        V(r)
+        a
     }
 }
 
-impl M {
-    #[inline(always)]
-    fn zip(self, o: M, f: impl Fn(u32, u32) -> u32) -> M {
-        let mut m = [0; PACKET];
-        for i in 0..PACKET {
-            m[i] = f(self.0[i], o.0[i]);
-        }
-        M(m)
-    }
-    /// One bit per lane.
-    #[inline(always)]
-    fn bits(self) -> u32 {
-        self.0
-            .iter()
-            .enumerate()
-            .fold(0, |b, (i, &m)| b | (m >> 31) << i)
-    }
-}
-
+/// Ray-space vertex `v` (a function, not a closure: out of line it would miss the caller's
+/// target features).
 #[inline(always)]
-fn triangle_lanes(ps: &PacketShear, p: [[f32; 3]; 3], t_max: &Lanes) -> TriLanes {
-    let [kx, ky, kz] = ps.k;
-    let (o, s) = (ps.o.map(V), ps.s.map(V));
-    // A function, not a closure: closures are not inlined reliably, and out of line they
-    // would miss the caller's AVX2.
-    #[inline(always)]
-    fn shear(v: [f32; 3], k: [usize; 3], o: &[V; 3], s: &[V; 3]) -> (V, V, V) {
-        let (ax, ay, az) = (
-            V::splat(v[k[0]]) - o[0],
-            V::splat(v[k[1]]) - o[1],
-            V::splat(v[k[2]]) - o[2],
-        );
-        (ax + az * s[0], ay + az * s[1], az * s[2])
-    }
+fn shear<S: Simd>(v: [f32; 3], ps: &PacketShear<S>) -> (S::F, S::F, S::F) {
+    let k = ps.k;
+    let (ax, ay, az) = (
+        S::splat(v[k[0]]) - ps.o[0],
+        S::splat(v[k[1]]) - ps.o[1],
+        S::splat(v[k[2]]) - ps.o[2],
+    );
+    (ax + az * ps.s[0], ay + az * ps.s[1], az * ps.s[2])
+}
 
-    let (ax, ay, az) = shear(p[0], [kx, ky, kz], &o, &s);
-    let (bx, by, bz) = shear(p[1], [kx, ky, kz], &o, &s);
-    let (cx, cy, cz) = shear(p[2], [kx, ky, kz], &o, &s);
+/// The triangle test of [`TriLanes`] for rays `mask` (the division only if some ray is a
+/// candidate).
+#[inline(always)]
+fn triangle_lanes<S: Simd>(
+    ps: &PacketShear<S>,
+    p: [[f32; 3]; 3],
+    t_max: &Lanes,
+    mask: u32,
+) -> TriLanes<S> {
+    let (ax, ay, az) = shear(p[0], ps);
+    let (bx, by, bz) = shear(p[1], ps);
+    let (cx, cy, cz) = shear(p[2], ps);
     let e0 = bx * cy - by * cx;
     let e1 = cx * ay - cy * ax;
     let e2 = ax * by - ay * bx;
-    let zero = V::splat(0.0);
-    let eq = |a: f32, b: f32| a == b;
-    let redo = e0.cmp(zero, eq).zip(e1.cmp(zero, eq), |a, b| a | b);
-    let redo = redo.zip(e2.cmp(zero, eq), |a, b| a | b);
-    let n0 = e0.sign();
-    let mixed = n0
-        .zip(e1.sign(), |a, b| a ^ b)
-        .zip(n0.zip(e2.sign(), |a, b| a ^ b), |a, b| a | b);
+    let zero = S::splat(0.0);
+    let redo = S::or(S::or(S::eq(e0, zero), S::eq(e1, zero)), S::eq(e2, zero));
+    let n0 = S::sign(e0);
+    let mixed = S::or(S::xor(n0, S::sign(e1)), S::xor(n0, S::sign(e2)));
     let det = e0 + e1 + e2;
     let t_scaled = e0 * az + e1 * bz + e2 * cz;
-    let t_max = V(*t_max);
+    let t_max = S::load(t_max);
     let tmd = t_max * det;
-    let sgn = det.sign_one();
+    let sgn = S::sign_one(det);
     let (ts, tm) = (t_scaled * sgn, tmd * sgn);
-    let in_range = ts
-        .cmp(zero, |a, b| a > b)
-        .zip(ts.cmp(tm, |a, b| a <= b), |a, b| a & b);
-    let inv = V::splat(1.0) / det;
+    let in_range = S::and(S::lt(zero, ts), S::le(ts, tm));
+    let cand = S::andnot(in_range, S::or(mixed, redo));
+    let redo = S::bits(redo);
+    if S::bits(cand) & mask == 0 {
+        // The common miss: skip the division.
+        return TriLanes {
+            hit: 0,
+            redo,
+            t: zero,
+            e: [e0, e1, e2],
+            inv: zero,
+        };
+    }
+    let inv = S::div(S::splat(1.0), det);
     let t = t_scaled * inv;
-    let ok = t
-        .cmp(zero, |a, b| a > b)
-        .zip(t.cmp(t_max, |a, b| a < b), |a, b| a & b);
-    let hit = in_range
-        .zip(ok, |a, b| a & b)
-        .zip(mixed.zip(redo, |a, b| a | b), |a, b| a & !b);
+    let ok = S::and(S::lt(zero, t), S::lt(t, t_max));
     TriLanes {
-        hit: hit.bits(),
-        redo: redo.bits(),
-        t: t.0,
-        b: [(e0 * inv).0, (e1 * inv).0, (e2 * inv).0],
+        hit: S::bits(S::and(ok, cand)),
+        redo,
+        t,
+        e: [e0, e1, e2],
+        inv,
     }
 }
 
@@ -501,41 +444,86 @@ struct Pending {
     mask: u32,
 }
 
+
 /// Rays `mask` whose entry distance is not beyond their best hit.
 #[inline(always)]
-fn still_open(near: &Lanes, best: &Lanes, mask: u32) -> u32 {
-    let mut open = [false; PACKET];
-    for i in 0..PACKET {
-        // `<=`, not the scalar `<`: a box entered exactly at the best t may hold a tie.
-        open[i] = near[i] <= best[i];
+fn still_open<S: Simd>(near: &Lanes, best: &Lanes, mask: u32) -> u32 {
+    // `<=`, not the scalar `<`: a box entered exactly at the best t may hold a tie.
+    S::bits(S::le(S::load(near), S::load(best))) & mask
+}
+
+/// The vector backend of the packet kernels (what [`Geometry::intersect_packet_on`] runs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PacketIsa {
+    /// The best one this CPU supports.
+    Auto,
+    /// Portable lane loops (any CPU).
+    Portable,
+    /// Two 256-bit vectors per 16 lanes (x86-64 with AVX2).
+    Avx2,
+    /// One 512-bit vector per 16 lanes (x86-64 with AVX-512F/DQ).
+    Avx512,
+}
+
+impl PacketIsa {
+    /// The backend that runs for `self` on this CPU (`Auto` resolved; unsupported ones fall
+    /// back to the next narrower).
+    pub fn resolve(self) -> PacketIsa {
+        #[cfg(target_arch = "x86_64")]
+        {
+            let avx512 = std::is_x86_feature_detected!("avx512f")
+                && std::is_x86_feature_detected!("avx512dq");
+            let avx2 = std::is_x86_feature_detected!("avx2");
+            match self {
+                PacketIsa::Auto | PacketIsa::Avx512 if avx512 => return PacketIsa::Avx512,
+                PacketIsa::Auto | PacketIsa::Avx512 | PacketIsa::Avx2 if avx2 => {
+                    return PacketIsa::Avx2;
+                }
+                _ => {}
+            }
+        }
+        PacketIsa::Portable
     }
-    open.iter()
-        .enumerate()
-        .fold(0, |m, (i, &o)| m | (o as u32) << i)
-        & mask
 }
 
 impl WideBvh {
-    /// Closest hits of the rays `active`: writes `out[i]` for each ray i in the returned hit
-    /// mask; the second mask flags rays with another primitive hit at exactly their best t
-    /// (the caller redoes those with the scalar query). `other(id, ray, t_max)` is the hit
-    /// distance of a non-triangle primitive if below `t_max`, else +∞.
+    /// Closest hits of the rays `active` on backend `isa`: writes `out[i]` for each ray i in
+    /// the returned hit mask; the second mask flags rays with another primitive hit at exactly
+    /// their best t (the caller redoes those with the scalar query). `other(id, ray, t_max)`
+    /// is the hit distance of a non-triangle primitive if below `t_max`, else +∞.
     pub(super) fn closest_packet(
+        &self,
+        isa: PacketIsa,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [LaneHit; PACKET],
+        other: impl FnMut(usize, &Ray, f32) -> f32,
+    ) -> (u32, u32) {
+        match isa.resolve() {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
+            PacketIsa::Avx512 => unsafe { self.closest_packet_avx512(rays, active, out, other) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
+            PacketIsa::Avx2 => unsafe { self.closest_packet_avx2(rays, active, out, other) },
+            _ => self.closest_packet_impl::<Portable>(rays, active, out, other),
+        }
+    }
+
+    /// [`Self::closest_packet_impl`] on AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn closest_packet_avx512(
         &self,
         rays: &[Ray; PACKET],
         active: u32,
         out: &mut [LaneHit; PACKET],
         other: impl FnMut(usize, &Ray, f32) -> f32,
     ) -> (u32, u32) {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { self.closest_packet_avx2(rays, active, out, other) };
-        }
-        self.closest_packet_impl(rays, active, out, other)
+        self.closest_packet_impl::<Avx512>(rays, active, out, other)
     }
 
-    /// [`Self::closest_packet_impl`] compiled for AVX2 (8 rays per vector instead of 4).
+    /// [`Self::closest_packet_impl`] on AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn closest_packet_avx2(
@@ -545,11 +533,55 @@ impl WideBvh {
         out: &mut [LaneHit; PACKET],
         other: impl FnMut(usize, &Ray, f32) -> f32,
     ) -> (u32, u32) {
-        self.closest_packet_impl(rays, active, out, other)
+        self.closest_packet_impl::<Avx2>(rays, active, out, other)
+    }
+
+    /// Mask of the rays `active` that something blocks in (0, t_max), on backend `isa`;
+    /// `other(id, ray)` tells whether non-triangle primitive `id` blocks `ray`.
+    pub(super) fn any_packet(
+        &self,
+        isa: PacketIsa,
+        rays: &[Ray; PACKET],
+        active: u32,
+        other: impl FnMut(usize, &Ray) -> bool,
+    ) -> u32 {
+        match isa.resolve() {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
+            PacketIsa::Avx512 => unsafe { self.any_packet_avx512(rays, active, other) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
+            PacketIsa::Avx2 => unsafe { self.any_packet_avx2(rays, active, other) },
+            _ => self.any_packet_impl::<Portable>(rays, active, other),
+        }
+    }
+
+    /// [`Self::any_packet_impl`] on AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn any_packet_avx512(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        other: impl FnMut(usize, &Ray) -> bool,
+    ) -> u32 {
+        self.any_packet_impl::<Avx512>(rays, active, other)
+    }
+
+    /// [`Self::any_packet_impl`] on AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn any_packet_avx2(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        other: impl FnMut(usize, &Ray) -> bool,
+    ) -> u32 {
+        self.any_packet_impl::<Avx2>(rays, active, other)
     }
 
     #[inline(always)]
-    fn closest_packet_impl(
+    fn closest_packet_impl<S: Simd>(
         &self,
         rays: &[Ray; PACKET],
         active: u32,
@@ -559,14 +591,14 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return (0, 0);
         }
-        let r = PacketBox::new(rays, active);
+        let r = PacketBox::<S>::new(rays, active);
         let mut best: Lanes = [f32::NEG_INFINITY; PACKET];
         for i in bits(active) {
             best[i] = rays[i].t_max;
         }
         // Bounds of the tests: up(best), so that hits at exactly the best t are seen.
         let mut tm = up_lanes(&best);
-        let pshear = PacketShear::new(rays, active);
+        let pshear = PacketShear::<S>::new(rays, active);
         // Per-ray shears for packets whose rays differ in shear axes, built at first use.
         let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
         let mut built = 0u32;
@@ -580,7 +612,7 @@ impl WideBvh {
                 // SAFETY: interior references are node indices written by the build, and the
                 // root exists (`nodes` is not empty).
                 let node = unsafe { self.nodes.get_unchecked(cur as usize) };
-                let mut m = node_hits(node, &r, &best, &mut near);
+                let mut m = node_hits::<S>(node, &r, &best, &mut near);
                 let mut order = [0usize; 4];
                 let mut key = [0.0f32; 4];
                 let mut n = 0;
@@ -627,14 +659,18 @@ impl WideBvh {
                         for lane in bits(pk.tri) {
                             let p = tri_vertices(pk, lane);
                             let id = pk.ids[lane & 3] as usize;
-                            let h = triangle_lanes(ps, p, &tm);
-                            for i in bits(h.hit & mask) {
-                                let i = i & (PACKET - 1);
-                                let b = [h.b[0][i], h.b[1][i], h.b[2][i]];
-                                consider(
-                                    &mut best, &mut tm, out, &mut found, &mut ties, i, id, h.t[i],
-                                    b,
-                                );
+                            let h = triangle_lanes(ps, p, &tm, mask);
+                            let hits = h.hit & mask;
+                            if hits != 0 {
+                                let [t, inv, e0, e1, e2] = h.spill();
+                                for i in bits(hits) {
+                                    let i = i & (PACKET - 1);
+                                    let b = [e0[i] * inv[i], e1[i] * inv[i], e2[i] * inv[i]];
+                                    consider(
+                                        &mut best, &mut tm, out, &mut found, &mut ties, i, id,
+                                        t[i], b,
+                                    );
+                                }
                             }
                             for i in bits(h.redo & mask) {
                                 let i = i & (PACKET - 1);
@@ -700,7 +736,7 @@ impl WideBvh {
                 sp -= 1;
                 // SAFETY: every slot below the stack pointer was written by a push above.
                 let e = unsafe { stack.get_unchecked(sp).assume_init_ref() };
-                let m = still_open(&e.near, &best, e.mask);
+                let m = still_open::<S>(&e.near, &best, e.mask);
                 if m != 0 {
                     cur = e.child;
                     mask = m;
@@ -710,36 +746,8 @@ impl WideBvh {
         }
     }
 
-    /// Mask of the rays `active` that something blocks in (0, t_max); `other(id, ray)` tells
-    /// whether non-triangle primitive `id` blocks `ray`.
-    pub(super) fn any_packet(
-        &self,
-        rays: &[Ray; PACKET],
-        active: u32,
-        other: impl FnMut(usize, &Ray) -> bool,
-    ) -> u32 {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { self.any_packet_avx2(rays, active, other) };
-        }
-        self.any_packet_impl(rays, active, other)
-    }
-
-    /// [`Self::any_packet_impl`] compiled for AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn any_packet_avx2(
-        &self,
-        rays: &[Ray; PACKET],
-        active: u32,
-        other: impl FnMut(usize, &Ray) -> bool,
-    ) -> u32 {
-        self.any_packet_impl(rays, active, other)
-    }
-
     #[inline(always)]
-    fn any_packet_impl(
+    fn any_packet_impl<S: Simd>(
         &self,
         rays: &[Ray; PACKET],
         active: u32,
@@ -748,12 +756,12 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return 0;
         }
-        let r = PacketBox::new(rays, active);
+        let r = PacketBox::<S>::new(rays, active);
         let mut t_max: Lanes = [f32::NEG_INFINITY; PACKET];
         for i in bits(active) {
             t_max[i] = rays[i].t_max;
         }
-        let pshear = PacketShear::new(rays, active);
+        let pshear = PacketShear::<S>::new(rays, active);
         // Per-ray shears for packets whose rays differ in shear axes, built at first use.
         let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
         let mut built = 0u32;
@@ -766,7 +774,7 @@ impl WideBvh {
         loop {
             // SAFETY: as in `closest_packet`, node references are valid indices.
             let node = unsafe { self.nodes.get_unchecked(cur as usize) };
-            let m = node_hits(node, &r, &t_max, &mut near);
+            let m = node_hits::<S>(node, &r, &t_max, &mut near);
             let mut inner = [(0u32, 0u32); 4];
             let mut n = 0;
             for c in 0..4 {
@@ -788,7 +796,7 @@ impl WideBvh {
                     if let Some(ps) = &pshear {
                         for lane in bits(pk.tri) {
                             let p = tri_vertices(pk, lane);
-                            let h = triangle_lanes(ps, p, &t_max);
+                            let h = triangle_lanes(ps, p, &t_max, m & !blocked);
                             blocked |= h.hit & m;
                             for i in bits(h.redo & m & !blocked) {
                                 let i = i & (PACKET - 1);
