@@ -83,6 +83,10 @@ impl Geometry {
     /// ([`Self::occluded_packet_traversal`]) measured 517 vs 548 Ir per shadow ray on cornell
     /// but 2580 vs 779 on `dense` (the packet visits the union of the rays' subtrees).
     pub fn occluded_packet(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+        static ANY: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+        if *ANY.get_or_init(|| std::env::var_os("PKT_ANY").is_some()) {
+            return self.occluded_packet_traversal(rays, active);
+        }
         let active = active & PACKET_MASK;
         bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i)
     }
@@ -104,7 +108,9 @@ impl Geometry {
         let Some(bvh) = self.wide() else {
             return bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i);
         };
-        bvh.any_packet(isa, rays, active, |id, ray| {
+        static SP: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
+        let sparse = *SP.get_or_init(|| std::env::var("PKT_SPARSE").ok().and_then(|v| v.parse().ok()).unwrap_or(0));
+        bvh.any_packet(isa, rays, active, sparse, |id, ray| {
             self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
         })
     }
@@ -543,16 +549,17 @@ impl WideBvh {
         isa: PacketIsa,
         rays: &[Ray; PACKET],
         active: u32,
+        sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
         match isa.resolve() {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
-            PacketIsa::Avx512 => unsafe { self.any_packet_avx512(rays, active, other) },
+            PacketIsa::Avx512 => unsafe { self.any_packet_avx512(rays, active, sparse, other) },
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
-            PacketIsa::Avx2 => unsafe { self.any_packet_avx2(rays, active, other) },
-            _ => self.any_packet_impl::<Portable>(rays, active, other),
+            PacketIsa::Avx2 => unsafe { self.any_packet_avx2(rays, active, sparse, other) },
+            _ => self.any_packet_impl::<Portable>(rays, active, sparse, other),
         }
     }
 
@@ -563,9 +570,10 @@ impl WideBvh {
         &self,
         rays: &[Ray; PACKET],
         active: u32,
+        sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
-        self.any_packet_impl::<Avx512>(rays, active, other)
+        self.any_packet_impl::<Avx512>(rays, active, sparse, other)
     }
 
     /// [`Self::any_packet_impl`] on AVX2.
@@ -575,9 +583,10 @@ impl WideBvh {
         &self,
         rays: &[Ray; PACKET],
         active: u32,
+        sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
-        self.any_packet_impl::<Avx2>(rays, active, other)
+        self.any_packet_impl::<Avx2>(rays, active, sparse, other)
     }
 
     #[inline(always)]
@@ -751,6 +760,7 @@ impl WideBvh {
         &self,
         rays: &[Ray; PACKET],
         active: u32,
+        sparse: u32,
         mut other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
         if self.nodes.is_empty() || active == 0 {
@@ -772,75 +782,88 @@ impl WideBvh {
         let (mut cur, mut mask) = (0u32, active);
         let mut near = [[0.0f32; PACKET]; 4];
         loop {
-            // SAFETY: as in `closest_packet`, node references are valid indices.
-            let node = unsafe { self.nodes.get_unchecked(cur as usize) };
-            let m = node_hits::<S>(node, &r, &t_max, &mut near);
-            let mut inner = [(0u32, 0u32); 4];
-            let mut n = 0;
-            for c in 0..4 {
-                let m = m[c] & mask & !blocked;
-                if m == 0 {
-                    continue;
-                }
-                let child = node.child[c];
-                if child & LEAF == 0 {
-                    inner[n] = (child, m);
-                    n += 1;
-                    continue;
-                }
-                // Leaves first: a hit there drops rays from the packet.
-                let mut pi = (child & !LEAF) as usize;
-                loop {
-                    // SAFETY: as in `closest_packet`, a leaf's packet run lies in `packets`.
-                    let pk = unsafe { self.packets.get_unchecked(pi) };
-                    if let Some(ps) = &pshear {
-                        for lane in bits(pk.tri) {
-                            let p = tri_vertices(pk, lane);
-                            let h = triangle_lanes(ps, p, &t_max, m & !blocked);
-                            blocked |= h.hit & m;
-                            for i in bits(h.redo & m & !blocked) {
-                                let i = i & (PACKET - 1);
-                                let hit = redo_triangle(&rays[i], p, t_max[i]).is_some();
-                                blocked |= (hit as u32) << i;
-                            }
-                        }
-                    } else if pk.tri != 0 {
-                        for i in bits(m & !blocked) {
-                            let i = i & (PACKET - 1);
-                            let shear = ray_shear(&mut shears, &mut built, rays, i);
-                            blocked |= (shear.any(pk, t_max[i]) as u32) << i;
-                        }
-                    }
-                    for lane in bits(pk.other) {
-                        for i in bits(m & !blocked) {
-                            let hit = other(pk.ids[lane & 3] as usize, &rays[i]);
-                            blocked |= (hit as u32) << i;
-                        }
-                    }
-                    if pk.last || m & !blocked == 0 {
-                        break;
-                    }
-                    pi += 1;
+            if mask.count_ones() <= sparse {
+                // Few rays left in this subtree: the packet would test every box for all 16
+                // lanes, the scalar query only for these rays.
+                for i in bits(mask & !blocked) {
+                    let ray = &rays[i & (PACKET - 1)];
+                    let hit = self.any_from(cur, ray.o, ray.d, ray.t_max, |id| other(id, ray));
+                    blocked |= (hit as u32) << i;
                 }
                 if blocked == active {
                     return blocked;
                 }
-            }
-            let mut next = None;
-            for &(child, m) in inner[..n].iter().rev() {
-                let m = m & !blocked;
-                if m == 0 {
+            } else {
+                // SAFETY: as in `closest_packet`, node references are valid indices.
+                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
+                let m = node_hits::<S>(node, &r, &t_max, &mut near);
+                let mut inner = [(0u32, 0u32); 4];
+                let mut n = 0;
+                for c in 0..4 {
+                    let m = m[c] & mask & !blocked;
+                    if m == 0 {
+                        continue;
+                    }
+                    let child = node.child[c];
+                    if child & LEAF == 0 {
+                        inner[n] = (child, m);
+                        n += 1;
+                        continue;
+                    }
+                    // Leaves first: a hit there drops rays from the packet.
+                    let mut pi = (child & !LEAF) as usize;
+                    loop {
+                        // SAFETY: as in `closest_packet`, a leaf's packet run lies in `packets`.
+                        let pk = unsafe { self.packets.get_unchecked(pi) };
+                        if let Some(ps) = &pshear {
+                            for lane in bits(pk.tri) {
+                                let p = tri_vertices(pk, lane);
+                                let h = triangle_lanes(ps, p, &t_max, m & !blocked);
+                                blocked |= h.hit & m;
+                                for i in bits(h.redo & m & !blocked) {
+                                    let i = i & (PACKET - 1);
+                                    let hit = redo_triangle(&rays[i], p, t_max[i]).is_some();
+                                    blocked |= (hit as u32) << i;
+                                }
+                            }
+                        } else if pk.tri != 0 {
+                            for i in bits(m & !blocked) {
+                                let i = i & (PACKET - 1);
+                                let shear = ray_shear(&mut shears, &mut built, rays, i);
+                                blocked |= (shear.any(pk, t_max[i]) as u32) << i;
+                            }
+                        }
+                        for lane in bits(pk.other) {
+                            for i in bits(m & !blocked) {
+                                let hit = other(pk.ids[lane & 3] as usize, &rays[i]);
+                                blocked |= (hit as u32) << i;
+                            }
+                        }
+                        if pk.last || m & !blocked == 0 {
+                            break;
+                        }
+                        pi += 1;
+                    }
+                    if blocked == active {
+                        return blocked;
+                    }
+                }
+                let mut next = None;
+                for &(child, m) in inner[..n].iter().rev() {
+                    let m = m & !blocked;
+                    if m == 0 {
+                        continue;
+                    }
+                    if let Some(e) = next.replace((child, m)) {
+                        // SAFETY: at most three pushes per level (as in `WideBvh::any`).
+                        unsafe { stack.get_unchecked_mut(sp) }.write(e);
+                        sp += 1;
+                    }
+                }
+                if let Some((c, m)) = next {
+                    (cur, mask) = (c, m);
                     continue;
                 }
-                if let Some(e) = next.replace((child, m)) {
-                    // SAFETY: at most three pushes per level (as in `WideBvh::any`).
-                    unsafe { stack.get_unchecked_mut(sp) }.write(e);
-                    sp += 1;
-                }
-            }
-            if let Some((c, m)) = next {
-                (cur, mask) = (c, m);
-                continue;
             }
             loop {
                 if sp == 0 {

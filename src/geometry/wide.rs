@@ -434,17 +434,30 @@ impl WideBvh {
     /// True if a triangle, or a primitive for which `other(id, t_max)` is true, blocks the ray
     /// (o, d) in (0, t_max); stops at the first hit.
     #[inline]
-    pub fn any(&self, o: Vec3, d: Vec3, t_max: f32, mut other: impl FnMut(usize) -> bool) -> bool {
+    pub fn any(&self, o: Vec3, d: Vec3, t_max: f32, other: impl FnMut(usize) -> bool) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
+        self.any_from(0, o, d, t_max, other)
+    }
+
+    /// [`Self::any`] within the subtree of node `root` (a valid node index).
+    #[inline]
+    pub(super) fn any_from(
+        &self,
+        root: u32,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+        mut other: impl FnMut(usize) -> bool,
+    ) -> bool {
         let r = RayBox::new(o, d);
         let shear = RayShear4::new(o, d);
         // Not cleared per ray: only entries below `sp` are ever read, and those were written.
         // Only interior nodes are pushed (leaves are tested on sight).
         let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
         let mut sp = 0usize;
-        let mut cur = 0u32;
+        let mut cur = root;
         loop {
             // SAFETY: as in `closest`, node references are valid indices.
             let node = unsafe { self.nodes.get_unchecked(cur as usize) };
