@@ -61,7 +61,7 @@ fn trace_any_scalar(g: &Geometry, pks: &[Packet]) -> u64 {
 #[inline(never)]
 fn trace_any_packet(g: &Geometry, pks: &[Packet]) -> u64 {
     pks.iter()
-        .map(|(rays, active)| g.occluded_packet_traversal(rays, *active).count_ones() as u64)
+        .map(|(rays, active)| g.occluded_packet(rays, *active).count_ones() as u64)
         .sum()
 }
 

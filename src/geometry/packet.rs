@@ -79,42 +79,29 @@ impl Geometry {
 
     /// Bit i set ⇔ ray i is active and `self.occluded(&rays[i])`.
     ///
-    /// The scalar query per ray for now: the packet traversal
-    /// ([`Self::occluded_packet_traversal`]) measured 517 vs 548 Ir per shadow ray on cornell
-    /// but 2580 vs 779 on `dense` (the packet visits the union of the rays' subtrees).
+    /// One traversal of the wide BVH for the packet; a subtree that at most [`SPARSE`] of the
+    /// rays enter is finished by the scalar query of each (incoherent shadow rays, e.g. on
+    /// `dense`, would otherwise make the packet visit the union of the rays' subtrees).
     pub fn occluded_packet(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
-        static ANY: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-        if *ANY.get_or_init(|| std::env::var_os("PKT_ANY").is_some()) {
-            return self.occluded_packet_traversal(rays, active);
-        }
-        let active = active & PACKET_MASK;
-        bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i)
+        self.occluded_packet_on(PacketIsa::Auto, rays, active)
     }
 
-    /// [`Self::occluded_packet`] by one traversal of the wide BVH for the whole packet (same
-    /// results; faster only on small scenes so far, see there).
-    pub fn occluded_packet_traversal(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
-        self.occluded_packet_traversal_on(PacketIsa::Auto, rays, active)
-    }
-
-    /// [`Self::occluded_packet_traversal`] on a chosen vector backend (for tests).
-    pub fn occluded_packet_traversal_on(
-        &self,
-        isa: PacketIsa,
-        rays: &[Ray; PACKET],
-        active: u32,
-    ) -> u32 {
+    /// [`Self::occluded_packet`] on a chosen vector backend (for tests and benchmarks).
+    pub fn occluded_packet_on(&self, isa: PacketIsa, rays: &[Ray; PACKET], active: u32) -> u32 {
         let active = active & PACKET_MASK;
         let Some(bvh) = self.wide() else {
             return bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i);
         };
-        static SP: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
-        let sparse = *SP.get_or_init(|| std::env::var("PKT_SPARSE").ok().and_then(|v| v.parse().ok()).unwrap_or(0));
-        bvh.any_packet(isa, rays, active, sparse, |id, ray| {
+        bvh.any_packet(isa, rays, active, SPARSE, |id, ray| {
             self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
         })
     }
 }
+
+/// Subtrees entered by at most this many rays of a shadow packet are left to the scalar
+/// any-hit query (measured on cornell and `dense --triangles 200000`: 4 was fastest on both,
+/// 2 and 8 close behind; without the fallback `dense` was slower than scalar queries).
+pub const SPARSE: u32 = 4;
 
 /// The lanes of a packet as a mask.
 const PACKET_MASK: u32 = ((1u64 << PACKET) - 1) as u32;
