@@ -20,7 +20,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::accel::Geometry;
-use super::bvh::{NEAR_SLACK, ROUNDING_SLACK, safe_inverse};
+use super::bvh::{NEAR_SLACK, ROUNDING_SLACK};
 use super::tri4::{RayShear4, TriPacket};
 use super::triangle::{RayShear, shear_axes};
 use super::simd16::{Lanes, Portable, Simd};
@@ -131,30 +131,26 @@ struct PacketBox<S: Simd> {
 }
 
 impl<S: Simd> PacketBox<S> {
+    /// From the rays' lanes `l` ([`Simd::rays`]).
     #[inline(always)]
-    fn new(rays: &[Ray; PACKET], active: u32) -> Self {
-        let (mut o, mut inv) = ([[0.0f32; PACKET]; 3], [[0.0f32; PACKET]; 3]);
-        let (mut any_neg, mut all_neg) = ([false; 3], [true; 3]);
-        for (i, r) in rays.iter().enumerate() {
-            let ri = safe_inverse(r.d).to_array();
-            let ro = r.o.to_array();
-            let on = active & (1 << i) != 0;
-            for a in 0..3 {
-                o[a][i] = ro[a];
-                inv[a][i] = ri[a];
-                let neg = ri[a] < 0.0;
-                any_neg[a] |= on & neg;
-                all_neg[a] &= !on | neg;
-            }
-        }
-        let inv = inv.map(|v| S::load(&v));
-        let uniform = (0..3)
-            .all(|a| !any_neg[a] || all_neg[a])
-            .then(|| any_neg.map(|n| n as usize));
+    fn new(l: &[S::F; 7], active: u32) -> Self {
+        let d = [l[3], l[4], l[5]];
+        // `safe_inverse` per lane: tiny components become ±1e-30 with their sign bit.
+        let inv = d.map(|d| {
+            let tiny = S::lt(S::abs(d), S::splat(1e-30));
+            let small = S::select(S::sign(d), S::splat(-1e-30), S::splat(1e-30));
+            S::div(S::splat(1.0), S::select(tiny, small, d))
+        });
+        let neg = inv.map(|v| S::lt(v, S::splat(0.0)));
+        let negs = neg.map(|m| S::bits(m) & active);
+        let uniform = negs
+            .iter()
+            .all(|&n| n == 0 || n == active)
+            .then(|| negs.map(|n| (n != 0) as usize));
         PacketBox {
-            o: o.map(|v| S::load(&v)),
+            o: [l[0], l[1], l[2]],
             inv,
-            neg: inv.map(|v| S::lt(v, S::splat(0.0))),
+            neg,
             uniform,
         }
     }
@@ -226,30 +222,36 @@ struct PacketShear<S: Simd> {
 }
 
 impl<S: Simd> PacketShear<S> {
-    /// `None` if the active rays do not all share the shear axes.
+    /// From the rays' lanes `l` ([`Simd::rays`]); `None` if the active rays do not all share
+    /// the shear axes.
     #[inline(always)]
-    fn new(rays: &[Ray; PACKET], active: u32) -> Option<Self> {
+    fn new(rays: &[Ray; PACKET], l: &[S::F; 7], active: u32) -> Option<Self> {
         let k = shear_axes(rays[active.trailing_zeros() as usize & (PACKET - 1)].d);
-        let (mut o, mut s) = ([[0.0f32; PACKET]; 3], [[0.0f32; PACKET]; 3]);
-        for i in bits(active) {
-            let i = i & (PACKET - 1);
-            let (ro, d) = (rays[i].o.to_array(), rays[i].d.to_array());
-            if shear_axes(rays[i].d) != k {
-                return None;
-            }
-            // The quotients of `RayShear4::new` (its vector division is lane-wise IEEE).
-            let dz = d[k[2]];
-            for a in 0..3 {
-                o[a][i] = ro[k[a]];
-            }
-            s[0][i] = -d[k[0]] / dz;
-            s[1][i] = -d[k[1]] / dz;
-            s[2][i] = 1.0 / dz;
+        // `shear_axes` per lane: kz and the sign of d[kz] determine the axes.
+        let uniform = |m: S::M| {
+            let b = S::bits(m) & active;
+            b == 0 || b == active
+        };
+        let (d, a) = ([l[3], l[4], l[5]], [l[3], l[4], l[5]].map(S::abs));
+        let x_gt_y = S::lt(a[1], a[0]);
+        let x_max = S::and(x_gt_y, S::lt(a[2], a[0]));
+        let y_max = S::andnot(S::lt(a[2], a[1]), x_gt_y);
+        let kz_neg = S::lt(d[k[2] % 3], S::splat(0.0));
+        if !(uniform(x_max) && uniform(y_max) && uniform(kz_neg)) {
+            return None;
         }
+        // The quotients of `RayShear4::new`: −(a / b) = (−a) / b exactly, and the product
+        // with −1 is an exact negation.
+        let (dx, dy, dz) = (d[k[0] % 3], d[k[1] % 3], d[k[2] % 3]);
+        let minus = S::splat(-1.0);
         Some(PacketShear {
             k,
-            o: o.map(|v| S::load(&v)),
-            s: s.map(|v| S::load(&v)),
+            o: [l[k[0] % 3], l[k[1] % 3], l[k[2] % 3]],
+            s: [
+                S::div(dx, dz) * minus,
+                S::div(dy, dz) * minus,
+                S::div(S::splat(1.0), dz),
+            ],
         })
     }
 }
@@ -587,14 +589,15 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return (0, 0);
         }
-        let r = PacketBox::<S>::new(rays, active);
+        let l = S::rays(rays);
+        let r = PacketBox::<S>::new(&l, active);
         let mut best: Lanes = [f32::NEG_INFINITY; PACKET];
         for i in bits(active) {
             best[i] = rays[i].t_max;
         }
         // Bounds of the tests: up(best), so that hits at exactly the best t are seen.
         let mut tm = up_lanes(&best);
-        let pshear = PacketShear::<S>::new(rays, active);
+        let pshear = PacketShear::<S>::new(rays, &l, active);
         // Per-ray shears for packets whose rays differ in shear axes, built at first use.
         let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
         let mut built = 0u32;
@@ -753,12 +756,13 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return 0;
         }
-        let r = PacketBox::<S>::new(rays, active);
+        let l = S::rays(rays);
+        let r = PacketBox::<S>::new(&l, active);
         let mut t_max: Lanes = [f32::NEG_INFINITY; PACKET];
         for i in bits(active) {
             t_max[i] = rays[i].t_max;
         }
-        let pshear = PacketShear::<S>::new(rays, active);
+        let pshear = PacketShear::<S>::new(rays, &l, active);
         // Per-ray shears for packets whose rays differ in shear axes, built at first use.
         let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
         let mut built = 0u32;

@@ -11,6 +11,7 @@
 // Lane loops `for i in 0..PACKET` over several arrays at once are what LLVM vectorises.
 #![allow(clippy::needless_range_loop)]
 
+use super::Ray;
 use std::ops::{Add, Mul, Sub};
 
 /// Lanes per vector: rays per packet.
@@ -33,6 +34,9 @@ pub(super) trait Simd: Copy {
     fn store(v: Self::F, a: &mut Lanes);
     /// Lane-wise IEEE quotient.
     fn div(a: Self::F, b: Self::F) -> Self::F;
+    /// The rays' origins, directions and t_max transposed to lanes: `[o.x, o.y, o.z, d.x,
+    /// d.y, d.z, t_max]`.
+    fn rays(rays: &[Ray; LANES]) -> [Self::F; 7];
     /// `if a < b { a } else { b }` per lane (SSE `minps`).
     fn min(a: Self::F, b: Self::F) -> Self::F;
     /// `if a > b { a } else { b }` per lane (SSE `maxps`).
@@ -47,6 +51,8 @@ pub(super) trait Simd: Copy {
     fn sign(a: Self::F) -> Self::M;
     /// `1.0` with the sign of each lane.
     fn sign_one(a: Self::F) -> Self::F;
+    /// `|a|` (the sign bit cleared).
+    fn abs(a: Self::F) -> Self::F;
     /// `if m { a } else { b }` per lane.
     fn select(m: Self::M, a: Self::F, b: Self::F) -> Self::F;
     /// `a & b`.
@@ -59,6 +65,21 @@ pub(super) trait Simd: Copy {
     fn xor(a: Self::M, b: Self::M) -> Self::M;
     /// One bit per lane (bit i = lane i).
     fn bits(m: Self::M) -> u32;
+}
+
+/// [`Simd::rays`] by scalar moves.
+#[inline(always)]
+fn ray_arrays(rays: &[Ray; LANES]) -> [Lanes; 7] {
+    let mut a = [[0.0f32; LANES]; 7];
+    for (i, r) in rays.iter().enumerate() {
+        let (o, d) = (r.o.to_array(), r.d.to_array());
+        for k in 0..3 {
+            a[k][i] = o[k];
+            a[3 + k][i] = d[k];
+        }
+        a[6][i] = r.t_max;
+    }
+    a
 }
 
 /// The portable backend: plain lane loops (what LLVM makes of them).
@@ -137,6 +158,10 @@ impl Simd for Portable {
         a / b
     }
     #[inline(always)]
+    fn rays(rays: &[Ray; LANES]) -> [PV; 7] {
+        ray_arrays(rays).map(PV)
+    }
+    #[inline(always)]
     fn min(a: PV, b: PV) -> PV {
         a.map2(b, |a, b| if a < b { a } else { b })
     }
@@ -169,6 +194,14 @@ impl Simd for Portable {
         let mut r = [0.0; LANES];
         for i in 0..LANES {
             r[i] = f32::from_bits(1.0f32.to_bits() | (a.0[i].to_bits() & 0x8000_0000));
+        }
+        PV(r)
+    }
+    #[inline(always)]
+    fn abs(a: PV) -> PV {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = a.0[i].abs();
         }
         PV(r)
     }
@@ -212,8 +245,26 @@ pub(super) use x86::{Avx2, Avx512};
 /// after `is_x86_feature_detected!`, which is what the `SAFETY` comments below rely on.
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::{LANES, Lanes, Simd};
+    use super::{LANES, Lanes, Ray, Simd};
     use std::arch::x86_64::*;
+    use std::mem::{offset_of, size_of};
+
+    /// Byte offsets of the seven fields of [`Simd::rays`] within a `Ray` (glam's `Vec3` is
+    /// `repr(C)`: x, y, z at 0, 4, 8).
+    const FIELDS: [usize; 7] = [
+        offset_of!(Ray, o),
+        offset_of!(Ray, o) + 4,
+        offset_of!(Ray, o) + 8,
+        offset_of!(Ray, d),
+        offset_of!(Ray, d) + 4,
+        offset_of!(Ray, d) + 8,
+        offset_of!(Ray, t_max),
+    ];
+
+    /// Byte offset of ray `i` (for gathers; 16 rays are far below `i32::MAX` bytes).
+    const fn ray_offset(i: usize) -> i32 {
+        (i * size_of::<Ray>()) as i32
+    }
 
     /// AVX2 backend: two `__m256` per vector; a mask is the sign bits of a vector.
     #[derive(Clone, Copy)]
@@ -294,6 +345,34 @@ mod x86 {
             halves!(_mm256_div_ps, a, b)
         }
         #[inline(always)]
+        fn rays(rays: &[Ray; LANES]) -> [A2; 7] {
+            let base = rays.as_ptr() as *const f32;
+            // SAFETY: AVX2 is available; every gathered address is ray i's field at byte
+            // offset ray_offset(i) + FIELDS[k] < size_of_val(rays), inside the array.
+            unsafe {
+                let lo = _mm256_setr_epi32(
+                    ray_offset(0),
+                    ray_offset(1),
+                    ray_offset(2),
+                    ray_offset(3),
+                    ray_offset(4),
+                    ray_offset(5),
+                    ray_offset(6),
+                    ray_offset(7),
+                );
+                let hi = _mm256_add_epi32(lo, _mm256_set1_epi32(ray_offset(8)));
+                let mut out = [A2(_mm256_setzero_ps(), _mm256_setzero_ps()); 7];
+                for k in 0..7 {
+                    let f = _mm256_set1_epi32(FIELDS[k] as i32);
+                    out[k] = A2(
+                        _mm256_i32gather_ps::<1>(base, _mm256_add_epi32(lo, f)),
+                        _mm256_i32gather_ps::<1>(base, _mm256_add_epi32(hi, f)),
+                    );
+                }
+                out
+            }
+        }
+        #[inline(always)]
         fn min(a: A2, b: A2) -> A2 {
             halves!(_mm256_min_ps, a, b)
         }
@@ -329,6 +408,11 @@ mod x86 {
                     _mm256_or_ps(one.1, _mm256_and_ps(a.1, s.1)),
                 )
             }
+        }
+        #[inline(always)]
+        fn abs(a: A2) -> A2 {
+            // `_mm256_andnot_ps(x, y)` is `!x & y`.
+            halves!(_mm256_andnot_ps, Self::splat(-0.0), a)
         }
         #[inline(always)]
         fn select(m: A2, a: A2, b: A2) -> A2 {
@@ -390,6 +474,38 @@ mod x86 {
             unsafe { A5(_mm512_div_ps(a.0, b.0)) }
         }
         #[inline(always)]
+        fn rays(rays: &[Ray; LANES]) -> [A5; 7] {
+            let base = rays.as_ptr() as *const f32;
+            // SAFETY: AVX-512F is available; every gathered address is ray i's field at byte
+            // offset ray_offset(i) + FIELDS[k] < size_of_val(rays), inside the array.
+            unsafe {
+                let idx = _mm512_setr_epi32(
+                    ray_offset(0),
+                    ray_offset(1),
+                    ray_offset(2),
+                    ray_offset(3),
+                    ray_offset(4),
+                    ray_offset(5),
+                    ray_offset(6),
+                    ray_offset(7),
+                    ray_offset(8),
+                    ray_offset(9),
+                    ray_offset(10),
+                    ray_offset(11),
+                    ray_offset(12),
+                    ray_offset(13),
+                    ray_offset(14),
+                    ray_offset(15),
+                );
+                let mut out = [A5(_mm512_setzero_ps()); 7];
+                for k in 0..7 {
+                    let idx = _mm512_add_epi32(idx, _mm512_set1_epi32(FIELDS[k] as i32));
+                    out[k] = A5(_mm512_i32gather_ps::<1>(idx, base));
+                }
+                out
+            }
+        }
+        #[inline(always)]
         fn min(a: A5, b: A5) -> A5 {
             // SAFETY: AVX-512F is available (see the module docs).
             unsafe { A5(_mm512_min_ps(a.0, b.0)) }
@@ -428,6 +544,11 @@ mod x86 {
                 let x = _mm512_and_si512(_mm512_castps_si512(a.0), s);
                 A5(_mm512_castsi512_ps(_mm512_or_si512(x, one)))
             }
+        }
+        #[inline(always)]
+        fn abs(a: A5) -> A5 {
+            // SAFETY: AVX-512F is available (see the module docs).
+            unsafe { A5(_mm512_abs_ps(a.0)) }
         }
         #[inline(always)]
         fn select(m: __mmask16, a: A5, b: A5) -> A5 {
