@@ -134,19 +134,24 @@ impl<S: Simd> PacketBox<S> {
     /// From the rays' lanes `l` ([`Simd::rays`]).
     #[inline(always)]
     fn new(l: &[S::F; 7], active: u32) -> Self {
-        let d = [l[3], l[4], l[5]];
-        // `safe_inverse` per lane: tiny components become ±1e-30 with their sign bit.
-        let inv = d.map(|d| {
+        // Loops, not closures: a closure left out of line would lack the caller's target
+        // features, and so would every intrinsic in it.
+        let (mut inv, mut neg) = ([l[3]; 3], [S::lt(l[3], l[3]); 3]);
+        let mut negs = [0u32; 3];
+        for a in 0..3 {
+            // `safe_inverse` per lane: tiny components become ±1e-30 with their sign bit.
+            let d = l[3 + a];
             let tiny = S::lt(S::abs(d), S::splat(1e-30));
             let small = S::select(S::sign(d), S::splat(-1e-30), S::splat(1e-30));
-            S::div(S::splat(1.0), S::select(tiny, small, d))
-        });
-        let neg = inv.map(|v| S::lt(v, S::splat(0.0)));
-        let negs = neg.map(|m| S::bits(m) & active);
-        let uniform = negs
-            .iter()
-            .all(|&n| n == 0 || n == active)
-            .then(|| negs.map(|n| (n != 0) as usize));
+            inv[a] = S::div(S::splat(1.0), S::select(tiny, small, d));
+            neg[a] = S::lt(inv[a], S::splat(0.0));
+            negs[a] = S::bits(neg[a]) & active;
+        }
+        let uniform = (negs.iter().all(|&n| n == 0 || n == active)).then_some([
+            (negs[0] != 0) as usize,
+            (negs[1] != 0) as usize,
+            (negs[2] != 0) as usize,
+        ]);
         PacketBox {
             o: [l[0], l[1], l[2]],
             inv,
@@ -228,16 +233,17 @@ impl<S: Simd> PacketShear<S> {
     fn new(rays: &[Ray; PACKET], l: &[S::F; 7], active: u32) -> Option<Self> {
         let k = shear_axes(rays[active.trailing_zeros() as usize & (PACKET - 1)].d);
         // `shear_axes` per lane: kz and the sign of d[kz] determine the axes.
-        let uniform = |m: S::M| {
-            let b = S::bits(m) & active;
+        let uniform = |b: u32| {
+            let b = b & active;
             b == 0 || b == active
         };
-        let (d, a) = ([l[3], l[4], l[5]], [l[3], l[4], l[5]].map(S::abs));
+        let d = [l[3], l[4], l[5]];
+        let a = [S::abs(l[3]), S::abs(l[4]), S::abs(l[5])];
         let x_gt_y = S::lt(a[1], a[0]);
         let x_max = S::and(x_gt_y, S::lt(a[2], a[0]));
         let y_max = S::andnot(S::lt(a[2], a[1]), x_gt_y);
         let kz_neg = S::lt(d[k[2] % 3], S::splat(0.0));
-        if !(uniform(x_max) && uniform(y_max) && uniform(kz_neg)) {
+        if !(uniform(S::bits(x_max)) && uniform(S::bits(y_max)) && uniform(S::bits(kz_neg))) {
             return None;
         }
         // The quotients of `RayShear4::new`: −(a / b) = (−a) / b exactly, and the product
