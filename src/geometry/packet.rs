@@ -60,7 +60,11 @@ impl Geometry {
         *out = [None; PACKET];
         let Some(bvh) = self.wide().filter(|b| !b.is_single_leaf()) else {
             for i in bits(active) {
-                out[i] = self.intersect(&rays[i]);
+                // Only hits are stored: copying a whole `None` (68 bytes of which 4 were just
+                // written) stalls on store forwarding.
+                if let Some(h) = self.intersect(&rays[i]) {
+                    out[i] = Some(h);
+                }
             }
             return;
         };
