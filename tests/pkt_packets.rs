@@ -10,8 +10,8 @@ mod geometry_support;
 use geometry_support::{brute_force_t, random_rays, triangle_soup};
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::{
-    Backend, Geometry, MeshShading, PACKET, PacketIsa, PrimKind, Primitive, Quadric, QuadricKind, Ray,
-    RayQuery, Transform,
+    Backend, Geometry, MeshShading, PACKET, PacketIsa, PrimKind, Primitive, Quadric, QuadricKind,
+    Ray, RayQuery, Transform,
 };
 use penumbra::sampling::{PatternKind, make_pattern};
 use penumbra::scene::Scene;
@@ -31,7 +31,10 @@ const ISAS: [PacketIsa; 4] = [
 /// Compares packet and scalar queries over `rays` in packets of 16 on every vector backend;
 /// returns the number of hits.
 fn check(g: &Geometry, rays: &[Ray]) -> u32 {
-    ISAS.iter().map(|&isa| check_on(g, rays, isa)).max().unwrap_or(0)
+    ISAS.iter()
+        .map(|&isa| check_on(g, rays, isa))
+        .max()
+        .unwrap_or(0)
 }
 
 /// [`check`] on one backend.
@@ -60,7 +63,11 @@ fn check_on(g: &Geometry, rays: &[Ray], isa: PacketIsa) -> u32 {
                     )
                 })
             };
-            assert_eq!(key(&out[i]), key(&want), "lane {i} of packet {k} on {isa:?}: {ray:?}");
+            assert_eq!(
+                key(&out[i]),
+                key(&want),
+                "lane {i} of packet {k} on {isa:?}: {ray:?}"
+            );
             hits += want.is_some() as u32;
             let occluded = on && g.occluded(ray);
             assert_eq!(

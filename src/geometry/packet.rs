@@ -3,10 +3,11 @@
 //! query's ([`RayQuery::intersect`] / [`RayQuery::occluded`]) bit for bit.
 //!
 //! On the default backend ([`WideBvh`]) one traversal serves the whole packet: each node's four
-//! child boxes are tested against every ray (lane loops over `[f32; PACKET]` that LLVM
-//! vectorises; an AVX2 copy is picked at run time), with each ray's own arithmetic of
-//! `Node4::hit` and its own best distance, so a ray's box verdicts are the scalar ones. A ray
-//! tests a leaf's triangles only if it passed that leaf's box, with its own [`RayShear4`].
+//! child boxes are tested against every ray, with each ray's own arithmetic of `Node4::hit` and
+//! its own best distance, so a ray's box verdicts are the scalar ones, and a leaf's triangles
+//! are tested against the rays that passed its box, each lane doing [`RayShear4`]'s f32
+//! operations. The kernels are generic over the 16-lane vector type of `simd16` (AVX-512,
+//! AVX2 or portable lane loops, picked at run time: [`PacketIsa`]).
 //!
 //! Why the closest hit is the scalar one: a triangle (or quadric) test accepts a hit exactly
 //! when it is valid and its t is below the current best (the t_max pre-filter never rejects
@@ -16,16 +17,13 @@
 //! watches for hits at exactly the best t from another primitive, and the (very rare) rays
 //! with such a tie are redone by the scalar query.
 
-// Lane loops `for i in 0..PACKET` over several arrays at once are what LLVM vectorises.
-#![allow(clippy::needless_range_loop)]
-
 use super::accel::Geometry;
 use super::bvh::{NEAR_SLACK, ROUNDING_SLACK};
-use super::tri4::{RayShear4, TriPacket};
-use super::triangle::{RayShear, shear_axes};
-use super::simd16::{Lanes, Portable, Simd};
 #[cfg(target_arch = "x86_64")]
 use super::simd16::{Avx2, Avx512};
+use super::simd16::{Lanes, Portable, Simd};
+use super::tri4::{RayShear4, TriPacket};
+use super::triangle::{RayShear, shear_axes};
 use super::wide::{Bary, LEAF, Node4, STACK, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use std::mem::MaybeUninit;
@@ -122,7 +120,6 @@ fn bits(mut m: u32) -> impl Iterator<Item = usize> {
         Some(i)
     })
 }
-
 
 /// Per-ray constants of the slab test, lanes over rays.
 struct PacketBox<S: Simd> {
@@ -448,7 +445,6 @@ struct Pending {
     child: u32,
     mask: u32,
 }
-
 
 /// Rays `mask` whose entry distance is not beyond their best hit.
 #[inline(always)]
