@@ -577,3 +577,129 @@ mod x86 {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// Special values for the lanes: zeros of both signs, infinities, NaN, tiny and huge.
+    const SPECIAL: [f32; 8] = [
+        0.0,
+        -0.0,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        1e-30,
+        -3.5,
+        f32::MAX,
+    ];
+
+    /// All pairs of special values over two 16-lane rows (64 pairs in four rounds).
+    fn rows(round: usize) -> (Lanes, Lanes) {
+        let (mut a, mut b) = ([0.0; LANES], [0.0; LANES]);
+        for i in 0..LANES {
+            let k = round * LANES + i;
+            a[i] = SPECIAL[k / 8];
+            b[i] = SPECIAL[k % 8];
+        }
+        (a, b)
+    }
+
+    /// The bit patterns of the lanes of `f`, NaNs as one pattern: LLVM may fold the portable
+    /// lanes at compile time with other NaN bits than x86's default NaN, and a NaN's sign and
+    /// payload never decide a ray query (every comparison with a NaN lane fails).
+    fn lane_bits<S: Simd>(f: S::F) -> [u32; LANES] {
+        let mut a = [0.0; LANES];
+        S::store(f, &mut a);
+        a.map(canon)
+    }
+
+    /// `x`'s bits, with every NaN as `f32::NAN` (see [`lane_bits`]).
+    fn canon(x: f32) -> u32 {
+        if x.is_nan() { f32::NAN } else { x }.to_bits()
+    }
+
+    /// Every operation of backend `S` on the special values, as bit patterns.
+    fn results<S: Simd>() -> Vec<u32> {
+        let mut v = Vec::new();
+        for round in 0..4 {
+            let (a, b) = std::hint::black_box(rows(round));
+            let (x, y) = (S::load(&a), S::load(&b));
+            let values = [
+                x + y,
+                x - y,
+                x * y,
+                S::div(x, y),
+                S::min(x, y),
+                S::max(x, y),
+                S::sign_one(x),
+                S::abs(x),
+                S::select(S::lt(x, y), x, y),
+            ];
+            for f in values {
+                v.extend(lane_bits::<S>(f));
+            }
+            let masks = [S::lt(x, y), S::le(x, y), S::eq(x, y), S::sign(x)];
+            let (m0, m1) = (masks[0], masks[2]);
+            let combos = [
+                S::and(m0, m1),
+                S::or(m0, m1),
+                S::andnot(m0, m1),
+                S::xor(m0, m1),
+            ];
+            v.extend(masks.iter().chain(&combos).map(|&m| S::bits(m)));
+        }
+        let rays: [Ray; LANES] = std::array::from_fn(|i| Ray {
+            o: Vec3::new(i as f32, -(i as f32), 0.5),
+            d: Vec3::new(1.0, i as f32 * 0.25, -2.0),
+            t_max: 100.0 + i as f32,
+        });
+        for f in S::rays(&rays) {
+            v.extend(lane_bits::<S>(f));
+        }
+        v
+    }
+
+    /// The scalar reference of [`results`]: per lane what the portable backend must compute.
+    #[test]
+    fn portable_lanes_are_the_scalar_operations() {
+        let (a, b) = rows(1);
+        let r = results::<Portable>();
+        let per_round = 9 * LANES + 8;
+        for i in 0..LANES {
+            let (x, y) = (a[i], b[i]);
+            let at = |k: usize| r[per_round + k * LANES + i];
+            assert_eq!(at(0), canon(x + y));
+            assert_eq!(at(3), canon(x / y));
+            // SSE semantics: the second operand unless the first is strictly smaller/larger.
+            assert_eq!(at(4), canon(if x < y { x } else { y }));
+            assert_eq!(at(5), canon(if x > y { x } else { y }));
+            assert_eq!(at(6), canon(1.0f32.copysign(x)));
+            assert_eq!(at(7), canon(x.abs()));
+        }
+    }
+
+    /// The x86 backends agree with the portable one bit for bit (where the CPU has them).
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn x86_backends_match_portable_lanes() {
+        let want = results::<Portable>();
+        if std::is_x86_feature_detected!("avx2") {
+            #[target_feature(enable = "avx2")]
+            fn avx2() -> Vec<u32> {
+                results::<Avx2>()
+            }
+            // SAFETY: AVX2 was detected just above.
+            assert_eq!(unsafe { avx2() }, want);
+        }
+        if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512dq") {
+            #[target_feature(enable = "avx512f,avx512dq")]
+            fn avx512() -> Vec<u32> {
+                results::<Avx512>()
+            }
+            // SAFETY: AVX-512F and DQ were detected just above.
+            assert_eq!(unsafe { avx512() }, want);
+        }
+    }
+}
