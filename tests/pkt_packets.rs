@@ -286,3 +286,30 @@ fn isas_resolve_to_supported_backends() {
         assert_eq!(PacketIsa::Auto.resolve(), PacketIsa::Avx512);
     }
 }
+
+#[test]
+fn packets_match_scalar_queries_on_a_single_leaf() {
+    // At most four primitives make a one-leaf tree (the emitter-only geometry of most scenes),
+    // whose box the packet tests on vectors before the scalar queries: rays around it, many
+    // missing, some grazing its box, in coherent packets (one origin) and incoherent ones.
+    let g = Geometry::new(triangle_soup(3), vec![MeshShading::default()], Vec::new());
+    let (lo, hi) = g.bounds();
+    let ext = hi - lo;
+    let pat = make_pattern(PatternKind::Random, 17);
+    let mut rays = random_rays((lo - ext, hi + ext), 16 * 40, 3);
+    for k in 0..200u32 {
+        let a = pat.sample_2d(UVec2::new(k, 1), 0, 0, 1);
+        let o = lo - ext + ext * 3.0 * Vec3::new(a.x, a.y, 0.0);
+        let Some(p) = g.primitive(k % g.len() as u32) else {
+            continue;
+        };
+        for s in 0..PACKET as u32 {
+            // Barycentric-like offsets in [-0.2, 1.2]²: inside the triangle or near it.
+            let j = pat.sample_2d(UVec2::new(k, 2), 0, s, PACKET as u32) * 1.4 - Vec2::splat(0.2);
+            let target = p.p[0] + (p.p[1] - p.p[0]) * j.x + (p.p[2] - p.p[0]) * j.y;
+            rays.push(Ray::new(o, target - o));
+        }
+    }
+    let hits = check(&g, &rays);
+    assert!(hits > 100 && hits < rays.len() as u32 / 2, "{hits} hits");
+}

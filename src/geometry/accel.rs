@@ -430,7 +430,7 @@ impl Geometry {
     /// [`RayQuery::intersect`] after the cheap pre-test, out of line: its frame (traversal
     /// stack, six saved registers) is not set up for rays that the pre-test rejects.
     #[inline(never)]
-    fn intersect_full(&self, ray: &Ray) -> Option<SurfaceHit> {
+    pub(super) fn intersect_full(&self, ray: &Ray) -> Option<SurfaceHit> {
         let (id, t, b) = match &self.accel {
             // The wide BVH tests triangles itself; only quadrics come back here.
             Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {

@@ -56,16 +56,27 @@ impl Geometry {
     ) {
         let active = active & PACKET_MASK;
         *out = [None; PACKET];
-        let Some(bvh) = self.wide().filter(|b| !b.is_single_leaf()) else {
+        // Only hits are stored below: copying a whole `None` (68 bytes of which 4 were just
+        // written) stalls on store forwarding.
+        let Some(bvh) = self.wide() else {
             for i in bits(active) {
-                // Only hits are stored: copying a whole `None` (68 bytes of which 4 were just
-                // written) stalls on store forwarding.
                 if let Some(h) = self.intersect(&rays[i]) {
                     out[i] = Some(h);
                 }
             }
             return;
         };
+        if bvh.is_single_leaf() {
+            // Most scenes' emitter-only geometry, which most rays miss: its box test on the
+            // vectors (`RayQuery::intersect`'s pre-test, lane by lane), then the scalar query
+            // for the rays that enter the box.
+            for i in bits(bvh.root_box_packet(isa, rays, active)) {
+                if let Some(h) = self.intersect_full(&rays[i]) {
+                    out[i] = Some(h);
+                }
+            }
+            return;
+        }
         let mut hits = [(0usize, 0.0f32, [0.0f32; 3]); PACKET];
         let (found, ties) = bvh.closest_packet(isa, rays, active, &mut hits, |id, ray, t_max| {
             self.quadric_t_outlined(id, ray.o, ray.d, t_max)
@@ -484,6 +495,52 @@ impl PacketIsa {
             }
         }
         PacketIsa::Portable
+    }
+}
+
+impl WideBvh {
+    /// The rays `active` that enter the box of the root's first child before their t_max, on
+    /// backend `isa`; for a single-leaf tree, bit i is `!self.single_leaf_missed(ray i)` (the
+    /// same operations on the same values: `SingleLeaf::hit` is lane 0 of `Node4::hit`).
+    pub(super) fn root_box_packet(&self, isa: PacketIsa, rays: &[Ray; PACKET], active: u32) -> u32 {
+        match isa.resolve() {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
+            PacketIsa::Avx512 => unsafe { self.root_box_avx512(rays, active) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
+            PacketIsa::Avx2 => unsafe { self.root_box_avx2(rays, active) },
+            _ => self.root_box_impl::<Portable>(rays, active),
+        }
+    }
+
+    /// [`Self::root_box_impl`] on AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn root_box_avx512(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+        self.root_box_impl::<Avx512>(rays, active)
+    }
+
+    /// [`Self::root_box_impl`] on AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn root_box_avx2(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+        self.root_box_impl::<Avx2>(rays, active)
+    }
+
+    #[inline(always)]
+    fn root_box_impl<S: Simd>(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+        let Some(root) = self.nodes.first() else {
+            return 0;
+        };
+        let l = S::rays(rays);
+        let r = PacketBox::<S>::new(&l, active);
+        let mut near = [0.0f32; PACKET];
+        let m = match r.uniform {
+            Some(side) => child_hits::<S, false>(root, 0, &r, side, l[6], &mut near),
+            None => child_hits::<S, true>(root, 0, &r, [0; 3], l[6], &mut near),
+        };
+        m & active
     }
 }
 
