@@ -192,6 +192,14 @@ impl Geometry {
         }
     }
 
+    /// The default backend's BVH, if that is the one built (packet queries).
+    pub(super) fn wide(&self) -> Option<&WideBvh> {
+        match &self.accel {
+            Accel::Wide(w) => Some(w),
+            _ => None,
+        }
+    }
+
     /// Number of primitives.
     pub fn len(&self) -> usize {
         self.prims.len()
@@ -236,7 +244,7 @@ impl Geometry {
     /// hoists its per-ray setup (splats of the ray) out of the traversal loop, which every ray
     /// pays for although triangle-only scenes never run it.
     #[inline(never)]
-    fn quadric_t_outlined(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+    pub(super) fn quadric_t_outlined(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
         self.quadric_t(id, o, d, t_max)
     }
 
@@ -247,7 +255,7 @@ impl Geometry {
     }
 
     /// The hit record of primitive `id` hit at `t` with triangle barycentrics `b`.
-    fn surface_hit(&self, id: usize, ray: &Ray, t: f32, b: Bary) -> SurfaceHit {
+    pub(super) fn surface_hit(&self, id: usize, ray: &Ray, t: f32, b: Bary) -> SurfaceHit {
         // SAFETY: `id` comes from a traversal, which reports only ids it has tested: leaf-order
         // ids < prims.len() stored by the wide BVH's build, or ids the callback backends passed
         // to `prim_hit`, which indexes `prims` with a bounds check. `tri_ng` has one entry per
@@ -422,7 +430,7 @@ impl Geometry {
     /// [`RayQuery::intersect`] after the cheap pre-test, out of line: its frame (traversal
     /// stack, six saved registers) is not set up for rays that the pre-test rejects.
     #[inline(never)]
-    fn intersect_full(&self, ray: &Ray) -> Option<SurfaceHit> {
+    pub(super) fn intersect_full(&self, ray: &Ray) -> Option<SurfaceHit> {
         let (id, t, b) = match &self.accel {
             // The wide BVH tests triangles itself; only quadrics come back here.
             Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {

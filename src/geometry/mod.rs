@@ -8,6 +8,7 @@ pub mod interaction;
 pub mod packet;
 pub mod quadric;
 pub mod ray;
+mod simd16;
 pub mod transform;
 pub mod tree2;
 pub mod tri4;
@@ -16,7 +17,7 @@ pub mod wide;
 
 pub use accel::{Backend, Geometry, MeshShading, PrimKind, Primitive};
 pub use interaction::SurfaceHit;
-pub use packet::PACKET;
+pub use packet::{PACKET, PacketIsa};
 pub use quadric::{Quadric, QuadricKind};
 pub use ray::{Ray, random_query_rays};
 pub use transform::Transform;

@@ -1,37 +1,937 @@
-//! Packet ray queries: [`PACKET`] rays traced together, each with exactly the result of its
-//! own scalar query.
+//! Packet ray queries: [`PACKET`] rays traced together (coherent camera rays of one pixel,
+//! shadow rays from nearby points toward one light). Each lane's result equals the scalar
+//! query's ([`RayQuery::intersect`] / [`RayQuery::occluded`]) bit for bit.
+//!
+//! On the default backend ([`WideBvh`]) one traversal serves the whole packet: each node's four
+//! child boxes are tested against every ray, with each ray's own arithmetic of `Node4::hit` and
+//! its own best distance, so a ray's box verdicts are the scalar ones, and a leaf's triangles
+//! are tested against the rays that passed its box, each lane doing [`RayShear4`]'s f32
+//! operations. The kernels are generic over the 16-lane vector type of `simd16` (AVX-512,
+//! AVX2 or portable lane loops, picked at run time: [`PacketIsa`]).
+//!
+//! Why the closest hit is the scalar one: a triangle (or quadric) test accepts a hit exactly
+//! when it is valid and its t is below the current best (the t_max pre-filter never rejects
+//! such a hit), and the box tests are conservative, so both traversals find the minimum t over
+//! the valid hits. Only the primitive chosen among hits at exactly equal t depends on the
+//! visiting order (the scalar keeps the first found). The packet traversal therefore also
+//! watches for hits at exactly the best t from another primitive, and the (very rare) rays
+//! with such a tie are redone by the scalar query.
 
-use super::{Geometry, Ray, RayQuery, SurfaceHit};
+use super::accel::Geometry;
+use super::bvh::{NEAR_SLACK, ROUNDING_SLACK};
+#[cfg(target_arch = "x86_64")]
+use super::simd16::{Avx2, Avx512};
+use super::simd16::{Lanes, Portable, Simd};
+use super::tri4::{RayShear4, TriPacket};
+use super::triangle::{RayShear, shear_axes};
+use super::wide::{Bary, LEAF, Node4, STACK, WideBvh};
+use super::{Ray, RayQuery, SurfaceHit};
+use std::mem::MaybeUninit;
 
 /// Rays per packet query.
 pub const PACKET: usize = 16;
 
+/// Closest-hit record of one ray: (leaf-order id, t, barycentrics).
+type LaneHit = (usize, f32, Bary);
+
 impl Geometry {
-    /// Closest hit of each active ray (bit i of `active` ⇒ `rays[i]` is traced); `out[i]` is
-    /// `None` for inactive lanes and misses. Lane by lane equal to [`RayQuery::intersect`].
+    /// Closest hit of each active ray (bit i of `active` ⇒ rays[i] is traced); out[i] = None for
+    /// inactive lanes and misses. Equal, lane by lane, to `self.intersect(&rays[i])`.
     pub fn intersect_packet(
         &self,
         rays: &[Ray; PACKET],
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        for (i, (ray, o)) in rays.iter().zip(out.iter_mut()).enumerate() {
-            *o = if active >> i & 1 != 0 {
-                self.intersect(ray)
-            } else {
-                None
-            };
+        self.intersect_packet_on(PacketIsa::Auto, rays, active, out);
+    }
+
+    /// [`Self::intersect_packet`] on a chosen vector backend (for tests and benchmarks).
+    pub fn intersect_packet_on(
+        &self,
+        isa: PacketIsa,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+    ) {
+        let active = active & PACKET_MASK;
+        *out = [None; PACKET];
+        // Only hits are stored below: copying a whole `None` (68 bytes of which 4 were just
+        // written) stalls on store forwarding.
+        let Some(bvh) = self.wide() else {
+            for i in bits(active) {
+                if let Some(h) = self.intersect(&rays[i]) {
+                    out[i] = Some(h);
+                }
+            }
+            return;
+        };
+        if bvh.is_single_leaf() {
+            // Most scenes' emitter-only geometry, which most rays miss: its box test on the
+            // vectors (`RayQuery::intersect`'s pre-test, lane by lane), then the scalar query
+            // for the rays that enter the box.
+            for i in bits(bvh.root_box_packet(isa, rays, active)) {
+                if let Some(h) = self.intersect_full(&rays[i]) {
+                    out[i] = Some(h);
+                }
+            }
+            return;
+        }
+        let mut hits = [(0usize, 0.0f32, [0.0f32; 3]); PACKET];
+        let (found, ties) = bvh.closest_packet(isa, rays, active, &mut hits, |id, ray, t_max| {
+            self.quadric_t_outlined(id, ray.o, ray.d, t_max)
+        });
+        for i in bits(found & !ties) {
+            let (id, t, b) = hits[i];
+            out[i] = Some(self.surface_hit(id, &rays[i], t, b));
+        }
+        for i in bits(ties) {
+            out[i] = self.intersect(&rays[i]);
         }
     }
 
-    /// Bit i set ⇔ ray i is active and [`RayQuery::occluded`] holds for it.
+    /// Bit i set ⇔ ray i is active and `self.occluded(&rays[i])`.
+    ///
+    /// One traversal of the wide BVH for the packet; a subtree that at most [`SPARSE`] of the
+    /// rays enter is finished by the scalar query of each (incoherent shadow rays, e.g. on
+    /// `dense`, would otherwise make the packet visit the union of the rays' subtrees).
     pub fn occluded_packet(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
-        let mut mask = 0;
-        for (i, ray) in rays.iter().enumerate() {
-            if active >> i & 1 != 0 && self.occluded(ray) {
-                mask |= 1 << i;
+        self.occluded_packet_on(PacketIsa::Auto, rays, active)
+    }
+
+    /// [`Self::occluded_packet`] on a chosen vector backend (for tests and benchmarks).
+    pub fn occluded_packet_on(&self, isa: PacketIsa, rays: &[Ray; PACKET], active: u32) -> u32 {
+        let active = active & PACKET_MASK;
+        let Some(bvh) = self.wide() else {
+            return bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i);
+        };
+        bvh.any_packet(isa, rays, active, SPARSE, |id, ray| {
+            self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
+        })
+    }
+}
+
+/// Subtrees entered by at most this many rays of a shadow packet are left to the scalar
+/// any-hit query (measured on cornell and `dense --triangles 200000`: 4 was fastest on both,
+/// 2 and 8 close behind; without the fallback `dense` was slower than scalar queries).
+pub const SPARSE: u32 = 4;
+
+/// The lanes of a packet as a mask.
+const PACKET_MASK: u32 = ((1u64 << PACKET) - 1) as u32;
+
+/// Indices of the set bits of `m`, lowest first.
+#[inline(always)]
+fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        if m == 0 {
+            return None;
+        }
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        Some(i)
+    })
+}
+
+/// Per-ray constants of the slab test, lanes over rays.
+struct PacketBox<S: Simd> {
+    o: [S::F; 3],
+    inv: [S::F; 3],
+    /// Rays that enter the box through the upper plane of that axis.
+    neg: [S::M; 3],
+    /// Entry side (0 = lower plane) per axis when all active rays agree, else `None`.
+    uniform: Option<[usize; 3]>,
+}
+
+impl<S: Simd> PacketBox<S> {
+    /// From the rays' lanes `l` ([`Simd::rays`]).
+    #[inline(always)]
+    fn new(l: &[S::F; 7], active: u32) -> Self {
+        // Loops, not closures: a closure left out of line would lack the caller's target
+        // features, and so would every intrinsic in it.
+        let (mut inv, mut neg) = ([l[3]; 3], [S::lt(l[3], l[3]); 3]);
+        let mut negs = [0u32; 3];
+        for a in 0..3 {
+            // `safe_inverse` per lane: tiny components become ±1e-30 with their sign bit.
+            let d = l[3 + a];
+            let tiny = S::lt(S::abs(d), S::splat(1e-30));
+            let small = S::select(S::sign(d), S::splat(-1e-30), S::splat(1e-30));
+            inv[a] = S::div(S::splat(1.0), S::select(tiny, small, d));
+            neg[a] = S::lt(inv[a], S::splat(0.0));
+            negs[a] = S::bits(neg[a]) & active;
+        }
+        let uniform = (negs.iter().all(|&n| n == 0 || n == active)).then_some([
+            (negs[0] != 0) as usize,
+            (negs[1] != 0) as usize,
+            (negs[2] != 0) as usize,
+        ]);
+        PacketBox {
+            o: [l[0], l[1], l[2]],
+            inv,
+            neg,
+            uniform,
+        }
+    }
+}
+
+/// The slab test of child `c` of `node` against every ray: each lane computes exactly what
+/// `Node4::hit` computes for that ray and lane c. Writes the entry distances to `near` and
+/// returns the mask of rays that enter the box before their `t_max`.
+#[inline(always)]
+fn child_hits<S: Simd, const MIXED: bool>(
+    node: &Node4,
+    c: usize,
+    r: &PacketBox<S>,
+    side: [usize; 3],
+    t_max: S::F,
+    near: &mut Lanes,
+) -> u32 {
+    let plane = |s: usize, a: usize| node.b[s & 1][a].to_array()[c & 3];
+    let mut n = [S::splat(0.0); 3];
+    let mut f = [S::splat(0.0); 3];
+    for a in 0..3 {
+        let (np, fp) = if MIXED {
+            let (lo, hi) = (S::splat(plane(0, a)), S::splat(plane(1, a)));
+            (S::select(r.neg[a], hi, lo), S::select(r.neg[a], lo, hi))
+        } else {
+            (S::splat(plane(side[a], a)), S::splat(plane(side[a] ^ 1, a)))
+        };
+        n[a] = (np - r.o[a]) * r.inv[a];
+        f[a] = (fp - r.o[a]) * r.inv[a];
+    }
+    let nr = S::max(S::max(S::max(n[0], n[1]), n[2]), S::splat(0.0)) * S::splat(NEAR_SLACK);
+    let fr = S::min(S::min(f[0], f[1]), f[2]) * S::splat(ROUNDING_SLACK);
+    S::store(nr, near);
+    S::bits(S::le(nr, S::min(fr, t_max)))
+}
+
+/// [`child_hits`] for the four children.
+#[inline(always)]
+fn node_hits<S: Simd>(
+    node: &Node4,
+    r: &PacketBox<S>,
+    t_max: &Lanes,
+    near: &mut [Lanes; 4],
+) -> [u32; 4] {
+    let t_max = S::load(t_max);
+    let mut m = [0; 4];
+    match r.uniform {
+        Some(side) => {
+            for c in 0..4 {
+                m[c] = child_hits::<S, false>(node, c, r, side, t_max, &mut near[c]);
             }
         }
-        mask
+        None => {
+            for c in 0..4 {
+                m[c] = child_hits::<S, true>(node, c, r, [0; 3], t_max, &mut near[c]);
+            }
+        }
+    }
+    m
+}
+
+/// Per-ray constants of the watertight triangle test, lanes over rays, for a packet whose
+/// active rays share the shear axes (the common case for coherent packets): the constants of
+/// [`RayShear4`] for each ray.
+struct PacketShear<S: Simd> {
+    k: [usize; 3],
+    o: [S::F; 3],
+    s: [S::F; 3],
+}
+
+impl<S: Simd> PacketShear<S> {
+    /// From the rays' lanes `l` ([`Simd::rays`]); `None` if the active rays do not all share
+    /// the shear axes.
+    #[inline(always)]
+    fn new(rays: &[Ray; PACKET], l: &[S::F; 7], active: u32) -> Option<Self> {
+        let k = shear_axes(rays[active.trailing_zeros() as usize & (PACKET - 1)].d);
+        // `shear_axes` per lane: kz and the sign of d[kz] determine the axes.
+        let uniform = |b: u32| {
+            let b = b & active;
+            b == 0 || b == active
+        };
+        let d = [l[3], l[4], l[5]];
+        let a = [S::abs(l[3]), S::abs(l[4]), S::abs(l[5])];
+        let x_gt_y = S::lt(a[1], a[0]);
+        let x_max = S::and(x_gt_y, S::lt(a[2], a[0]));
+        let y_max = S::andnot(S::lt(a[2], a[1]), x_gt_y);
+        let kz_neg = S::lt(d[k[2] % 3], S::splat(0.0));
+        if !(uniform(S::bits(x_max)) && uniform(S::bits(y_max)) && uniform(S::bits(kz_neg))) {
+            return None;
+        }
+        // The quotients of `RayShear4::new`: −(a / b) = (−a) / b exactly, and the product
+        // with −1 is an exact negation.
+        let (dx, dy, dz) = (d[k[0] % 3], d[k[1] % 3], d[k[2] % 3]);
+        let minus = S::splat(-1.0);
+        Some(PacketShear {
+            k,
+            o: [l[k[0] % 3], l[k[1] % 3], l[k[2] % 3]],
+            s: [
+                S::div(dx, dz) * minus,
+                S::div(dy, dz) * minus,
+                S::div(S::splat(1.0), dz),
+            ],
+        })
+    }
+}
+
+/// One triangle against every ray of the packet: each lane performs the f32 operations of
+/// [`RayShear4`]'s lane test for that ray (same order, hence the same bits).
+struct TriLanes<S: Simd> {
+    /// Rays accepted by the f32 test with t in (0, t_max).
+    hit: u32,
+    /// Rays with an exactly-zero edge function: to be redone by the scalar test.
+    redo: u32,
+    /// Hit distances (valid in `hit`).
+    t: S::F,
+    /// Edge functions and the reciprocal determinant: barycentric k = e[k] · inv.
+    e: [S::F; 3],
+    inv: S::F,
+}
+
+impl<S: Simd> TriLanes<S> {
+    /// The lanes of t, inv, e0, e1, e2 in memory (barycentric k of lane i = e_k[i] · inv[i],
+    /// the products of `RayShear4::closest`).
+    #[inline(always)]
+    fn spill(&self) -> [Lanes; 5] {
+        let mut a = [[0.0f32; PACKET]; 5];
+        S::store(self.t, &mut a[0]);
+        S::store(self.inv, &mut a[1]);
+        for k in 0..3 {
+            S::store(self.e[k], &mut a[2 + k]);
+        }
+        a
+    }
+}
+
+/// Ray-space vertex `v` (a function, not a closure: out of line it would miss the caller's
+/// target features).
+#[inline(always)]
+fn shear<S: Simd>(v: [f32; 3], ps: &PacketShear<S>) -> (S::F, S::F, S::F) {
+    let k = ps.k;
+    let (ax, ay, az) = (
+        S::splat(v[k[0]]) - ps.o[0],
+        S::splat(v[k[1]]) - ps.o[1],
+        S::splat(v[k[2]]) - ps.o[2],
+    );
+    (ax + az * ps.s[0], ay + az * ps.s[1], az * ps.s[2])
+}
+
+/// The triangle test of [`TriLanes`] for rays `mask` (the division only if some ray is a
+/// candidate).
+#[inline(always)]
+fn triangle_lanes<S: Simd>(
+    ps: &PacketShear<S>,
+    p: [[f32; 3]; 3],
+    t_max: &Lanes,
+    mask: u32,
+) -> TriLanes<S> {
+    let (ax, ay, az) = shear(p[0], ps);
+    let (bx, by, bz) = shear(p[1], ps);
+    let (cx, cy, cz) = shear(p[2], ps);
+    let e0 = bx * cy - by * cx;
+    let e1 = cx * ay - cy * ax;
+    let e2 = ax * by - ay * bx;
+    let zero = S::splat(0.0);
+    let redo = S::or(S::or(S::eq(e0, zero), S::eq(e1, zero)), S::eq(e2, zero));
+    let n0 = S::sign(e0);
+    let mixed = S::or(S::xor(n0, S::sign(e1)), S::xor(n0, S::sign(e2)));
+    let det = e0 + e1 + e2;
+    let t_scaled = e0 * az + e1 * bz + e2 * cz;
+    let t_max = S::load(t_max);
+    let tmd = t_max * det;
+    let sgn = S::sign_one(det);
+    let (ts, tm) = (t_scaled * sgn, tmd * sgn);
+    let in_range = S::and(S::lt(zero, ts), S::le(ts, tm));
+    let cand = S::andnot(in_range, S::or(mixed, redo));
+    let redo = S::bits(redo);
+    if S::bits(cand) & mask == 0 {
+        // The common miss: skip the division.
+        return TriLanes {
+            hit: 0,
+            redo,
+            t: zero,
+            e: [e0, e1, e2],
+            inv: zero,
+        };
+    }
+    let inv = S::div(S::splat(1.0), det);
+    let t = t_scaled * inv;
+    let ok = S::and(S::lt(zero, t), S::lt(t, t_max));
+    TriLanes {
+        hit: S::bits(S::and(ok, cand)),
+        redo,
+        t,
+        e: [e0, e1, e2],
+        inv,
+    }
+}
+
+/// Vertices of triangle `lane` of `pk` as `[vertex][axis]`.
+#[inline(always)]
+fn tri_vertices(pk: &TriPacket, lane: usize) -> [[f32; 3]; 3] {
+    let v = |j: usize, a: usize| pk.v[j][a].to_array()[lane & 3];
+    [
+        [v(0, 0), v(0, 1), v(0, 2)],
+        [v(1, 0), v(1, 1), v(1, 2)],
+        [v(2, 0), v(2, 1), v(2, 2)],
+    ]
+}
+
+/// The scalar test of a triangle with an exactly-zero f32 edge function for `ray` (rare, so
+/// out of line): (t, b0, b1, b2) with t in (0, t_max).
+#[cold]
+#[inline(never)]
+fn redo_triangle(ray: &Ray, p: [[f32; 3]; 3], t_max: f32) -> Option<(f32, f32, f32, f32)> {
+    let v = p.map(glam::Vec3::from_array);
+    RayShear::new(ray.o, ray.d).intersect(v[0], v[1], v[2], t_max)
+}
+
+/// `next_up` for the best distances of the closest-hit traversal (non-negative or +∞; other
+/// values, which admit no hit either way, are kept): a test with this bound accepts t = best.
+#[inline(always)]
+fn up(b: f32) -> f32 {
+    // Branch-free (it runs on every lane): +1 ulp exactly for 0 ≤ b < ∞.
+    f32::from_bits(b.to_bits() + (0.0..f32::INFINITY).contains(&b) as u32)
+}
+
+/// [`up`] on every lane.
+#[inline(always)]
+fn up_lanes(b: &Lanes) -> Lanes {
+    let mut u = *b;
+    for x in u.iter_mut() {
+        *x = up(*x);
+    }
+    u
+}
+
+/// Record a hit of ray `i` on primitive `id` at `t` (below `up(best[i])`): a closer one
+/// replaces the best, one at exactly the best t from another primitive marks a tie.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn consider(
+    best: &mut Lanes,
+    tm: &mut Lanes,
+    out: &mut [LaneHit; PACKET],
+    found: &mut u32,
+    ties: &mut u32,
+    i: usize,
+    id: usize,
+    t: f32,
+    b: Bary,
+) {
+    let bit = 1 << i;
+    if t < best[i] {
+        best[i] = t;
+        tm[i] = up(t);
+        out[i] = (id, t, b);
+        *found |= bit;
+        *ties &= !bit;
+    } else if t == best[i] && *found & bit != 0 && out[i].0 != id {
+        *ties |= bit;
+    }
+}
+
+/// The [`RayShear4`] of ray `i`, built on first use (`built` marks the built ones).
+#[inline(always)]
+fn ray_shear<'a>(
+    shears: &'a mut [MaybeUninit<RayShear4>; PACKET],
+    built: &mut u32,
+    rays: &[Ray; PACKET],
+    i: usize,
+) -> &'a RayShear4 {
+    let i = i & (PACKET - 1);
+    if *built & (1 << i) == 0 {
+        shears[i].write(RayShear4::new(rays[i].o, rays[i].d));
+        *built |= 1 << i;
+    }
+    // SAFETY: slot i was written, now or at an earlier call (its bit in `built` is set).
+    unsafe { shears[i].assume_init_ref() }
+}
+
+/// A pending subtree of the closest-hit traversal: each ray's entry distance, so that a pop
+/// drops the rays whose best hit has since come closer (the scalar traversal's pop test).
+#[derive(Clone, Copy)]
+struct Pending {
+    near: Lanes,
+    child: u32,
+    mask: u32,
+}
+
+/// Rays `mask` whose entry distance is not beyond their best hit.
+#[inline(always)]
+fn still_open<S: Simd>(near: &Lanes, best: &Lanes, mask: u32) -> u32 {
+    // `<=`, not the scalar `<`: a box entered exactly at the best t may hold a tie.
+    S::bits(S::le(S::load(near), S::load(best))) & mask
+}
+
+/// The vector backend of the packet kernels (what [`Geometry::intersect_packet_on`] runs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PacketIsa {
+    /// The best one this CPU supports.
+    Auto,
+    /// Portable lane loops (any CPU).
+    Portable,
+    /// Two 256-bit vectors per 16 lanes (x86-64 with AVX2).
+    Avx2,
+    /// One 512-bit vector per 16 lanes (x86-64 with AVX-512F/DQ).
+    Avx512,
+}
+
+impl PacketIsa {
+    /// The backend that runs for `self` on this CPU (`Auto` resolved; unsupported ones fall
+    /// back to the next narrower).
+    pub fn resolve(self) -> PacketIsa {
+        #[cfg(target_arch = "x86_64")]
+        {
+            let avx512 = std::is_x86_feature_detected!("avx512f")
+                && std::is_x86_feature_detected!("avx512dq");
+            let avx2 = std::is_x86_feature_detected!("avx2");
+            match self {
+                PacketIsa::Auto | PacketIsa::Avx512 if avx512 => return PacketIsa::Avx512,
+                PacketIsa::Auto | PacketIsa::Avx512 | PacketIsa::Avx2 if avx2 => {
+                    return PacketIsa::Avx2;
+                }
+                _ => {}
+            }
+        }
+        PacketIsa::Portable
+    }
+}
+
+impl WideBvh {
+    /// The rays `active` that enter the box of the root's first child before their t_max, on
+    /// backend `isa`; for a single-leaf tree, bit i is `!self.single_leaf_missed(ray i)` (the
+    /// same operations on the same values: `SingleLeaf::hit` is lane 0 of `Node4::hit`).
+    pub(super) fn root_box_packet(&self, isa: PacketIsa, rays: &[Ray; PACKET], active: u32) -> u32 {
+        match isa.resolve() {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
+            PacketIsa::Avx512 => unsafe { self.root_box_avx512(rays, active) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
+            PacketIsa::Avx2 => unsafe { self.root_box_avx2(rays, active) },
+            _ => self.root_box_impl::<Portable>(rays, active),
+        }
+    }
+
+    /// [`Self::root_box_impl`] on AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn root_box_avx512(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+        self.root_box_impl::<Avx512>(rays, active)
+    }
+
+    /// [`Self::root_box_impl`] on AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn root_box_avx2(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+        self.root_box_impl::<Avx2>(rays, active)
+    }
+
+    #[inline(always)]
+    fn root_box_impl<S: Simd>(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+        let Some(root) = self.nodes.first() else {
+            return 0;
+        };
+        let l = S::rays(rays);
+        let r = PacketBox::<S>::new(&l, active);
+        let mut near = [0.0f32; PACKET];
+        let m = match r.uniform {
+            Some(side) => child_hits::<S, false>(root, 0, &r, side, l[6], &mut near),
+            None => child_hits::<S, true>(root, 0, &r, [0; 3], l[6], &mut near),
+        };
+        m & active
+    }
+}
+
+impl WideBvh {
+    /// Closest hits of the rays `active` on backend `isa`: writes `out[i]` for each ray i in
+    /// the returned hit mask; the second mask flags rays with another primitive hit at exactly
+    /// their best t (the caller redoes those with the scalar query). `other(id, ray, t_max)`
+    /// is the hit distance of a non-triangle primitive if below `t_max`, else +∞.
+    pub(super) fn closest_packet(
+        &self,
+        isa: PacketIsa,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [LaneHit; PACKET],
+        other: impl FnMut(usize, &Ray, f32) -> f32,
+    ) -> (u32, u32) {
+        match isa.resolve() {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
+            PacketIsa::Avx512 => unsafe { self.closest_packet_avx512(rays, active, out, other) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
+            PacketIsa::Avx2 => unsafe { self.closest_packet_avx2(rays, active, out, other) },
+            _ => self.closest_packet_impl::<Portable>(rays, active, out, other),
+        }
+    }
+
+    /// [`Self::closest_packet_impl`] on AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn closest_packet_avx512(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [LaneHit; PACKET],
+        other: impl FnMut(usize, &Ray, f32) -> f32,
+    ) -> (u32, u32) {
+        self.closest_packet_impl::<Avx512>(rays, active, out, other)
+    }
+
+    /// [`Self::closest_packet_impl`] on AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn closest_packet_avx2(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [LaneHit; PACKET],
+        other: impl FnMut(usize, &Ray, f32) -> f32,
+    ) -> (u32, u32) {
+        self.closest_packet_impl::<Avx2>(rays, active, out, other)
+    }
+
+    /// Mask of the rays `active` that something blocks in (0, t_max), on backend `isa`;
+    /// `other(id, ray)` tells whether non-triangle primitive `id` blocks `ray`.
+    pub(super) fn any_packet(
+        &self,
+        isa: PacketIsa,
+        rays: &[Ray; PACKET],
+        active: u32,
+        sparse: u32,
+        other: impl FnMut(usize, &Ray) -> bool,
+    ) -> u32 {
+        match isa.resolve() {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
+            PacketIsa::Avx512 => unsafe { self.any_packet_avx512(rays, active, sparse, other) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
+            PacketIsa::Avx2 => unsafe { self.any_packet_avx2(rays, active, sparse, other) },
+            _ => self.any_packet_impl::<Portable>(rays, active, sparse, other),
+        }
+    }
+
+    /// [`Self::any_packet_impl`] on AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn any_packet_avx512(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        sparse: u32,
+        other: impl FnMut(usize, &Ray) -> bool,
+    ) -> u32 {
+        self.any_packet_impl::<Avx512>(rays, active, sparse, other)
+    }
+
+    /// [`Self::any_packet_impl`] on AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn any_packet_avx2(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        sparse: u32,
+        other: impl FnMut(usize, &Ray) -> bool,
+    ) -> u32 {
+        self.any_packet_impl::<Avx2>(rays, active, sparse, other)
+    }
+
+    #[inline(always)]
+    fn closest_packet_impl<S: Simd>(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [LaneHit; PACKET],
+        mut other: impl FnMut(usize, &Ray, f32) -> f32,
+    ) -> (u32, u32) {
+        if self.nodes.is_empty() || active == 0 {
+            return (0, 0);
+        }
+        let l = S::rays(rays);
+        let r = PacketBox::<S>::new(&l, active);
+        let mut best: Lanes = [f32::NEG_INFINITY; PACKET];
+        for i in bits(active) {
+            best[i] = rays[i].t_max;
+        }
+        // Bounds of the tests: up(best), so that hits at exactly the best t are seen.
+        let mut tm = up_lanes(&best);
+        let pshear = PacketShear::<S>::new(rays, &l, active);
+        // Per-ray shears for packets whose rays differ in shear axes, built at first use.
+        let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
+        let mut built = 0u32;
+        let (mut found, mut ties) = (0u32, 0u32);
+        let mut stack = [const { MaybeUninit::<Pending>::uninit() }; STACK];
+        let mut sp = 0usize;
+        let (mut cur, mut mask) = (0u32, active);
+        let mut near = [[0.0f32; PACKET]; 4];
+        loop {
+            if cur & LEAF == 0 {
+                // SAFETY: interior references are node indices written by the build, and the
+                // root exists (`nodes` is not empty).
+                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
+                let mut m = node_hits::<S>(node, &r, &best, &mut near);
+                let mut order = [0usize; 4];
+                let mut key = [0.0f32; 4];
+                let mut n = 0;
+                for c in 0..4 {
+                    m[c] &= mask;
+                    if m[c] != 0 {
+                        // Front to back by the first ray's entry distance (insertion sort).
+                        let k = near[c][m[c].trailing_zeros() as usize & (PACKET - 1)];
+                        let mut j = n;
+                        while j > 0 && key[j - 1] > k {
+                            key[j] = key[j - 1];
+                            order[j] = order[j - 1];
+                            j -= 1;
+                        }
+                        key[j] = k;
+                        order[j] = c;
+                        n += 1;
+                    }
+                }
+                if n > 0 {
+                    // Push the farther children far to near, visit the nearest.
+                    for &c in order[1..n].iter().rev() {
+                        // SAFETY: at most three pushes per wide level of a tree at most
+                        // MAX_TREE_DEPTH deep, so sp < STACK (as in `WideBvh::closest`).
+                        unsafe { stack.get_unchecked_mut(sp) }.write(Pending {
+                            near: near[c],
+                            child: node.child[c],
+                            mask: m[c],
+                        });
+                        sp += 1;
+                    }
+                    cur = node.child[order[0]];
+                    mask = m[order[0]];
+                    continue;
+                }
+            } else {
+                let mut pi = (cur & !LEAF) as usize;
+                loop {
+                    // SAFETY: a leaf reference is the first packet of a non-empty run inside
+                    // `packets` whose final packet has `last` set (see `WideBvh::leaf`).
+                    let pk = unsafe { self.packets.get_unchecked(pi) };
+                    // Accept t = best too, to notice ties (see the module docs).
+                    if let Some(ps) = &pshear {
+                        for lane in bits(pk.tri) {
+                            let p = tri_vertices(pk, lane);
+                            let id = pk.ids[lane & 3] as usize;
+                            let h = triangle_lanes(ps, p, &tm, mask);
+                            let hits = h.hit & mask;
+                            if hits != 0 {
+                                let [t, inv, e0, e1, e2] = h.spill();
+                                for i in bits(hits) {
+                                    let i = i & (PACKET - 1);
+                                    let b = [e0[i] * inv[i], e1[i] * inv[i], e2[i] * inv[i]];
+                                    consider(
+                                        &mut best, &mut tm, out, &mut found, &mut ties, i, id,
+                                        t[i], b,
+                                    );
+                                }
+                            }
+                            for i in bits(h.redo & mask) {
+                                let i = i & (PACKET - 1);
+                                if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, tm[i]) {
+                                    consider(
+                                        &mut best,
+                                        &mut tm,
+                                        out,
+                                        &mut found,
+                                        &mut ties,
+                                        i,
+                                        id,
+                                        t,
+                                        [b0, b1, b2],
+                                    );
+                                }
+                            }
+                        }
+                    } else if pk.tri != 0 {
+                        for i in bits(mask) {
+                            let i = i & (PACKET - 1);
+                            let shear = ray_shear(&mut shears, &mut built, rays, i);
+                            if let Some((lane, t, b)) = shear.closest(pk, tm[i]) {
+                                let id = pk.ids[lane & 3] as usize;
+                                consider(
+                                    &mut best, &mut tm, out, &mut found, &mut ties, i, id, t, b,
+                                );
+                            }
+                        }
+                    }
+                    for lane in bits(pk.other) {
+                        let id = pk.ids[lane & 3] as usize;
+                        for i in bits(mask) {
+                            let i = i & (PACKET - 1);
+                            let t_max = tm[i];
+                            let t = other(id, &rays[i], t_max);
+                            if t < t_max {
+                                consider(
+                                    &mut best,
+                                    &mut tm,
+                                    out,
+                                    &mut found,
+                                    &mut ties,
+                                    i,
+                                    id,
+                                    t,
+                                    [1.0 / 3.0; 3],
+                                );
+                            }
+                        }
+                    }
+                    if pk.last {
+                        break;
+                    }
+                    pi += 1;
+                }
+            }
+            // Pop the nearest pending subtree that some ray may still find a hit in.
+            loop {
+                if sp == 0 {
+                    return (found, ties);
+                }
+                sp -= 1;
+                // SAFETY: every slot below the stack pointer was written by a push above.
+                let e = unsafe { stack.get_unchecked(sp).assume_init_ref() };
+                let m = still_open::<S>(&e.near, &best, e.mask);
+                if m != 0 {
+                    cur = e.child;
+                    mask = m;
+                    break;
+                }
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn any_packet_impl<S: Simd>(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        sparse: u32,
+        mut other: impl FnMut(usize, &Ray) -> bool,
+    ) -> u32 {
+        if self.nodes.is_empty() || active == 0 {
+            return 0;
+        }
+        let l = S::rays(rays);
+        let r = PacketBox::<S>::new(&l, active);
+        let mut t_max: Lanes = [f32::NEG_INFINITY; PACKET];
+        for i in bits(active) {
+            t_max[i] = rays[i].t_max;
+        }
+        let pshear = PacketShear::<S>::new(rays, &l, active);
+        // Per-ray shears for packets whose rays differ in shear axes, built at first use.
+        let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
+        let mut built = 0u32;
+        let mut blocked = 0u32;
+        // Only interior nodes are pushed (leaves are tested on sight), with their ray mask.
+        let mut stack = [const { MaybeUninit::<(u32, u32)>::uninit() }; STACK];
+        let mut sp = 0usize;
+        let (mut cur, mut mask) = (0u32, active);
+        let mut near = [[0.0f32; PACKET]; 4];
+        loop {
+            if mask.count_ones() <= sparse {
+                // Few rays left in this subtree: the packet would test every box for all 16
+                // lanes, the scalar query only for these rays.
+                for i in bits(mask & !blocked) {
+                    let ray = &rays[i & (PACKET - 1)];
+                    let hit = self.any_from(cur, ray.o, ray.d, ray.t_max, |id| other(id, ray));
+                    blocked |= (hit as u32) << i;
+                }
+                if blocked == active {
+                    return blocked;
+                }
+            } else {
+                // SAFETY: as in `closest_packet`, node references are valid indices.
+                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
+                let m = node_hits::<S>(node, &r, &t_max, &mut near);
+                let mut inner = [(0u32, 0u32); 4];
+                let mut n = 0;
+                for c in 0..4 {
+                    let m = m[c] & mask & !blocked;
+                    if m == 0 {
+                        continue;
+                    }
+                    let child = node.child[c];
+                    if child & LEAF == 0 {
+                        inner[n] = (child, m);
+                        n += 1;
+                        continue;
+                    }
+                    // Leaves first: a hit there drops rays from the packet.
+                    let mut pi = (child & !LEAF) as usize;
+                    loop {
+                        // SAFETY: as in `closest_packet`, a leaf's packet run lies in `packets`.
+                        let pk = unsafe { self.packets.get_unchecked(pi) };
+                        if let Some(ps) = &pshear {
+                            for lane in bits(pk.tri) {
+                                let p = tri_vertices(pk, lane);
+                                let h = triangle_lanes(ps, p, &t_max, m & !blocked);
+                                blocked |= h.hit & m;
+                                for i in bits(h.redo & m & !blocked) {
+                                    let i = i & (PACKET - 1);
+                                    let hit = redo_triangle(&rays[i], p, t_max[i]).is_some();
+                                    blocked |= (hit as u32) << i;
+                                }
+                            }
+                        } else if pk.tri != 0 {
+                            for i in bits(m & !blocked) {
+                                let i = i & (PACKET - 1);
+                                let shear = ray_shear(&mut shears, &mut built, rays, i);
+                                blocked |= (shear.any(pk, t_max[i]) as u32) << i;
+                            }
+                        }
+                        for lane in bits(pk.other) {
+                            for i in bits(m & !blocked) {
+                                let hit = other(pk.ids[lane & 3] as usize, &rays[i]);
+                                blocked |= (hit as u32) << i;
+                            }
+                        }
+                        if pk.last || m & !blocked == 0 {
+                            break;
+                        }
+                        pi += 1;
+                    }
+                    if blocked == active {
+                        return blocked;
+                    }
+                }
+                let mut next = None;
+                for &(child, m) in inner[..n].iter().rev() {
+                    let m = m & !blocked;
+                    if m == 0 {
+                        continue;
+                    }
+                    if let Some(e) = next.replace((child, m)) {
+                        // SAFETY: at most three pushes per level (as in `WideBvh::any`).
+                        unsafe { stack.get_unchecked_mut(sp) }.write(e);
+                        sp += 1;
+                    }
+                }
+                if let Some((c, m)) = next {
+                    (cur, mask) = (c, m);
+                    continue;
+                }
+            }
+            loop {
+                if sp == 0 {
+                    return blocked;
+                }
+                sp -= 1;
+                // SAFETY: every slot below the stack pointer was written by a push above.
+                let (c, m) = unsafe { stack.get_unchecked(sp).assume_init() };
+                let m = m & !blocked;
+                if m != 0 {
+                    (cur, mask) = (c, m);
+                    break;
+                }
+            }
+        }
     }
 }

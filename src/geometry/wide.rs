@@ -16,12 +16,12 @@ use std::mem::MaybeUninit;
 use std::ops::Range;
 
 /// Child-reference flag: the low bits are the first packet of a leaf, not a node index.
-const LEAF: u32 = 1 << 31;
+pub(super) const LEAF: u32 = 1 << 31;
 /// Deepest binary tree that is collapsed (deeper ones are rejected by [`WideBvh::build`]).
 pub const MAX_TREE_DEPTH: usize = 96;
 /// Traversal stack depth: each wide level consumes at least one binary level, and a node
 /// pushes at most three children.
-const STACK: usize = 3 * MAX_TREE_DEPTH + 1;
+pub(super) const STACK: usize = 3 * MAX_TREE_DEPTH + 1;
 
 /// Subtrees with at most this many primitives become a single leaf.
 const LEAF_PRIMS: usize = 4;
@@ -32,11 +32,12 @@ pub type Bary = [f32; 3];
 /// One node: `b[0][axis]` / `b[1][axis]` hold the lower / upper box plane of the four children.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
-struct Node4 {
-    b: [[Vec4; 3]; 2],
+pub(super) struct Node4 {
+    /// Box planes: `b[side][axis]` lane c = that plane of child c.
+    pub(super) b: [[Vec4; 3]; 2],
     /// Node index, or `LEAF | first packet` (unused slots have inverted boxes and are never
     /// followed).
-    child: [u32; 4],
+    pub(super) child: [u32; 4],
 }
 
 impl Node4 {
@@ -91,8 +92,8 @@ impl RayBox {
 /// The 4-wide BVH (see the module docs). Primitive ids are leaf-order indices of the BVH2.
 #[derive(Clone, Debug, Default)]
 pub struct WideBvh {
-    nodes: Vec<Node4>,
-    packets: Vec<TriPacket>,
+    pub(super) nodes: Vec<Node4>,
+    pub(super) packets: Vec<TriPacket>,
     /// Set when the whole tree is one leaf (the emitter-only geometry of most scenes): its
     /// box (the root's lane 0) and leaf reference, for [`WideBvh::closest`]'s fast path.
     single_leaf: Option<SingleLeaf>,
@@ -169,6 +170,11 @@ impl WideBvh {
             }
         }
         Some(w)
+    }
+
+    /// True if the whole tree is one leaf (most scenes' emitter-only geometry).
+    pub fn is_single_leaf(&self) -> bool {
+        self.single_leaf.is_some()
     }
 
     /// Number of nodes and of leaf packets (statistics).
@@ -428,17 +434,30 @@ impl WideBvh {
     /// True if a triangle, or a primitive for which `other(id, t_max)` is true, blocks the ray
     /// (o, d) in (0, t_max); stops at the first hit.
     #[inline]
-    pub fn any(&self, o: Vec3, d: Vec3, t_max: f32, mut other: impl FnMut(usize) -> bool) -> bool {
+    pub fn any(&self, o: Vec3, d: Vec3, t_max: f32, other: impl FnMut(usize) -> bool) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
+        self.any_from(0, o, d, t_max, other)
+    }
+
+    /// [`Self::any`] within the subtree of node `root` (a valid node index).
+    #[inline]
+    pub(super) fn any_from(
+        &self,
+        root: u32,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+        mut other: impl FnMut(usize) -> bool,
+    ) -> bool {
         let r = RayBox::new(o, d);
         let shear = RayShear4::new(o, d);
         // Not cleared per ray: only entries below `sp` are ever read, and those were written.
         // Only interior nodes are pushed (leaves are tested on sight).
         let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
         let mut sp = 0usize;
-        let mut cur = 0u32;
+        let mut cur = root;
         loop {
             // SAFETY: as in `closest`, node references are valid indices.
             let node = unsafe { self.nodes.get_unchecked(cur as usize) };

@@ -1,0 +1,315 @@
+//! Packet queries (`intersect_packet`, `occluded_packet`) must answer every active lane exactly
+//! like the scalar query on the same ray (t bits, primitive, point, normals, uv) and leave
+//! inactive lanes empty: coherent camera packets, incoherent random rays, shadow rays to points
+//! on the light, partial masks, rays leaving surfaces, on every backend and on cornell, a dense
+//! mesh (rays aimed at shared vertices and edges: exact ties), triangles with quadrics and an
+//! empty scene.
+
+mod geometry_support;
+
+use geometry_support::{brute_force_t, random_rays, triangle_soup};
+use glam::{UVec2, Vec2, Vec3};
+use penumbra::geometry::{
+    Backend, Geometry, MeshShading, PACKET, PacketIsa, PrimKind, Primitive, Quadric, QuadricKind,
+    Ray, RayQuery, Transform,
+};
+use penumbra::sampling::{PatternKind, make_pattern};
+use penumbra::scene::Scene;
+
+/// Active masks cycled through the packets: full, partial, single lanes.
+const MASKS: [u32; 5] = [0xffff, 0xa5c3, 0x0001, 0x8000, 0x7ffe];
+
+/// Every vector backend of the packet kernels (those this CPU lacks resolve to a narrower one,
+/// so they are still run, and the supported ones are checked: see `isas_resolve`).
+const ISAS: [PacketIsa; 4] = [
+    PacketIsa::Auto,
+    PacketIsa::Portable,
+    PacketIsa::Avx2,
+    PacketIsa::Avx512,
+];
+
+/// Compares packet and scalar queries over `rays` in packets of 16 on every vector backend;
+/// returns the number of hits.
+fn check(g: &Geometry, rays: &[Ray]) -> u32 {
+    ISAS.iter()
+        .map(|&isa| check_on(g, rays, isa))
+        .max()
+        .unwrap_or(0)
+}
+
+/// [`check`] on one backend.
+fn check_on(g: &Geometry, rays: &[Ray], isa: PacketIsa) -> u32 {
+    let mut hits = 0;
+    for (k, chunk) in rays.chunks_exact(PACKET).enumerate() {
+        let pk: [Ray; PACKET] = std::array::from_fn(|i| chunk[i]);
+        let active = MASKS[k % MASKS.len()];
+        let mut out = [None; PACKET];
+        g.intersect_packet_on(isa, &pk, active, &mut out);
+        let blocked = g.occluded_packet_on(isa, &pk, active);
+        for (i, ray) in pk.iter().enumerate() {
+            let on = active & (1 << i) != 0;
+            let want = if on { g.intersect(ray) } else { None };
+            let key = |h: &Option<penumbra::geometry::SurfaceHit>| {
+                h.map(|h| {
+                    (
+                        h.t.to_bits(),
+                        h.prim,
+                        h.p.to_array().map(f32::to_bits),
+                        h.ng.to_array().map(f32::to_bits),
+                        h.ns.to_array().map(f32::to_bits),
+                        h.uv.to_array().map(f32::to_bits),
+                        h.p_error.to_bits(),
+                        (h.material, h.light),
+                    )
+                })
+            };
+            assert_eq!(
+                key(&out[i]),
+                key(&want),
+                "lane {i} of packet {k} on {isa:?}: {ray:?}"
+            );
+            hits += want.is_some() as u32;
+            let occluded = on && g.occluded(ray);
+            assert_eq!(
+                blocked & (1 << i) != 0,
+                occluded,
+                "any-hit lane {i}: {ray:?}"
+            );
+        }
+    }
+    hits
+}
+
+/// 16 jittered camera rays per pixel for `pixels` pixels spread over the image.
+fn camera_packets(scene: &Scene, pixels: u32) -> Vec<Ray> {
+    let res = UVec2::new(64, 64);
+    let cam = scene.camera.rays(res);
+    let pat = make_pattern(PatternKind::Random, 11);
+    let mut rays = Vec::new();
+    for k in 0..pixels {
+        let px = UVec2::new((k * 37) % res.x, (k * 101 / res.x) % res.y);
+        for s in 0..PACKET as u32 {
+            let j = pat.sample_2d(px, 0, s, PACKET as u32);
+            rays.push(cam.generate(px.as_vec2() + j));
+        }
+    }
+    rays
+}
+
+/// For each closest hit of `rays`: a shadow ray to a random point of an emitter triangle
+/// (t_max < 1) and a ray leaving the surface exactly at the hit point.
+fn secondary_rays(scene: &Scene, rays: &[Ray]) -> Vec<Ray> {
+    let g = &scene.geometry;
+    let em = &scene.emitters;
+    let pat = make_pattern(PatternKind::Random, 12);
+    let mut out = Vec::new();
+    for (i, ray) in rays.iter().enumerate() {
+        let Some(h) = g.intersect(ray) else {
+            continue;
+        };
+        let u = pat.sample_2d(UVec2::new(i as u32, 0), 0, 0, 1);
+        let Some(p) = em.primitive((i % em.len().max(1)) as u32) else {
+            continue;
+        };
+        let (a, b) = if u.x + u.y > 1.0 {
+            (1.0 - u.x, 1.0 - u.y)
+        } else {
+            (u.x, u.y)
+        };
+        let target = p.p[0] + (p.p[1] - p.p[0]) * a + (p.p[2] - p.p[0]) * b;
+        let o = h.spawn_origin(target - h.p);
+        out.push(Ray {
+            o,
+            d: target - o,
+            t_max: 1.0 - 1e-4,
+        });
+        out.push(Ray::new(h.p, -ray.d.reflect(h.ng)));
+    }
+    out
+}
+
+fn load(name: &str, triangles: Option<u32>) -> Scene {
+    let opts = penumbra::scene::load::LoadOptions {
+        builtin: penumbra::scene::builtin::BuiltinOptions {
+            triangles,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    penumbra::scene::load::load(name, &opts)
+        .expect("built-in scene")
+        .scene
+}
+
+#[test]
+fn packets_match_scalar_queries_on_cornell_for_every_backend() {
+    let scene = load("cornell", None);
+    let cam = camera_packets(&scene, 400);
+    let shadow = secondary_rays(&scene, &cam);
+    let random = random_rays(scene.geometry.bounds(), 16 * 400, 3);
+    for backend in [Backend::Wide, Backend::Own, Backend::Obvhs] {
+        let g = scene.geometry.rebuild(backend);
+        let hits = check(&g, &cam);
+        assert!(hits > 16 * 400 / 3, "{backend:?}: {hits} camera hits");
+        assert!(check(&g, &shadow) > 1000, "{backend:?} secondary");
+        assert!(check(&g, &random) > 1000, "{backend:?} random");
+    }
+    // The emitter-only geometry (a single leaf).
+    assert!(check(&scene.emitters, &cam) + check(&scene.emitters, &random) > 0);
+}
+
+#[test]
+fn packets_match_scalar_queries_on_a_dense_mesh_with_ties() {
+    let scene = load("dense", Some(20_000));
+    let g = &scene.geometry;
+    let cam = camera_packets(&scene, 200);
+    assert!(check(g, &cam) > 1000);
+    assert!(check(g, &secondary_rays(&scene, &cam)) > 100);
+    // Coherent packets aimed at shared vertices and edge midpoints: exact ties on equal t.
+    let pat = make_pattern(PatternKind::Random, 9);
+    let (lo, hi) = g.bounds();
+    let mut aimed = Vec::new();
+    for k in 0..400u32 {
+        let a = pat.sample_2d(UVec2::new(k, 0), 0, 0, 1);
+        let b = pat.sample_2d(UVec2::new(k, 0), 1, 0, 1);
+        let o = lo + (hi - lo) * Vec3::new(a.x, a.y, b.x);
+        for s in 0..PACKET as u32 {
+            let Some(p) = g.primitive((k * 131 + s * 7) % g.len() as u32) else {
+                continue;
+            };
+            let target = if s % 2 == 0 {
+                p.p[0]
+            } else {
+                (p.p[0] + p.p[1]) * 0.5
+            };
+            aimed.push(Ray::new(o, target - o));
+        }
+    }
+    assert!(check(g, &aimed) > 1000);
+    let own = g.rebuild(Backend::Own);
+    assert!(check(&own, &aimed[..16 * 50]) > 100);
+}
+
+#[test]
+fn packets_match_scalar_queries_with_spheres_and_disks() {
+    let pat = make_pattern(PatternKind::Random, 5);
+    let mut prims = triangle_soup(2000);
+    let mut quadrics = Vec::new();
+    for i in 0..40u32 {
+        let c = pat.sample_2d(UVec2::new(i, 2), 0, 0, 1);
+        let h = pat.sample_2d(UVec2::new(i, 2), 1, 0, 1);
+        let kind = if i % 2 == 0 {
+            QuadricKind::Sphere { radius: 0.6 }
+        } else {
+            QuadricKind::Disk {
+                height: 0.0,
+                radius: 0.8,
+            }
+        };
+        quadrics.push(Quadric {
+            kind,
+            to_world: Transform::translate(Vec3::new(c.x, c.y, h.x) * 10.0),
+            flip: false,
+        });
+        prims.push(Primitive {
+            p: [Vec3::ZERO; 3],
+            kind: PrimKind::Quadric(i),
+            material: 1,
+            light: u32::MAX,
+        });
+    }
+    let g = Geometry::new(prims, vec![MeshShading::default()], quadrics);
+    // Coherent packets: 16 nearby directions from one origin.
+    let mut coherent = Vec::new();
+    let (lo, hi) = g.bounds();
+    for k in 0..300u32 {
+        let a = pat.sample_2d(UVec2::new(k, 3), 0, 0, 1);
+        let b = pat.sample_2d(UVec2::new(k, 3), 1, 0, 1);
+        let o = lo + (hi - lo) * Vec3::new(a.x, a.y, b.x);
+        let target = lo + (hi - lo) * Vec3::new(b.y, a.y, a.x);
+        for s in 0..PACKET as u32 {
+            let j = pat.sample_2d(UVec2::new(k, 4), 0, s, PACKET as u32) - Vec2::splat(0.5);
+            coherent.push(Ray::new(o, target - o + Vec3::new(j.x, j.y, 0.0)));
+        }
+    }
+    let random = random_rays(g.bounds(), 16 * 300, 7);
+    for ray in &coherent[..16 * 20] {
+        assert_eq!(g.intersect(ray).map(|h| h.t), brute_force_t(&g, ray));
+    }
+    for backend in [Backend::Wide, Backend::Own] {
+        let g = g.rebuild(backend);
+        assert!(check(&g, &coherent) > 500, "{backend:?} coherent");
+        assert!(check(&g, &random) > 500, "{backend:?} random");
+    }
+}
+
+#[test]
+fn packets_on_an_empty_scene_miss() {
+    let g = Geometry::new(Vec::new(), Vec::new(), Vec::new());
+    let rays = random_rays((Vec3::ZERO, Vec3::ONE), 16 * 4, 1);
+    assert_eq!(check(&g, &rays), 0);
+}
+
+#[test]
+fn packets_match_scalar_queries_on_duplicated_triangles() {
+    // Every triangle twice: each hit ties on exactly equal t, which the packet traversal must
+    // resolve like the scalar one (its first-found primitive).
+    let soup = triangle_soup(1500);
+    let prims: Vec<Primitive> = soup.iter().chain(soup.iter()).copied().collect();
+    let g = Geometry::new(prims, vec![MeshShading::default()], Vec::new());
+    let (lo, hi) = g.bounds();
+    let pat = make_pattern(PatternKind::Random, 13);
+    let mut rays = Vec::new();
+    for k in 0..300u32 {
+        let a = pat.sample_2d(UVec2::new(k, 5), 0, 0, 1);
+        let o = lo - (hi - lo) * 0.2 + (hi - lo) * Vec3::new(a.x, a.y, 0.0) * 0.1;
+        let Some(p) = g.primitive(k % g.len() as u32) else {
+            continue;
+        };
+        for s in 0..PACKET as u32 {
+            let j = pat.sample_2d(UVec2::new(k, 6), 0, s, PACKET as u32) * 0.2;
+            let target = p.p[0] + (p.p[1] - p.p[0]) * j.x + (p.p[2] - p.p[0]) * j.y;
+            rays.push(Ray::new(o, target - o));
+        }
+    }
+    assert!(check(&g, &rays) > 2000);
+}
+
+#[test]
+fn isas_resolve_to_supported_backends() {
+    // Portable stays portable; the others never resolve to something wider than asked.
+    assert_eq!(PacketIsa::Portable.resolve(), PacketIsa::Portable);
+    assert_ne!(PacketIsa::Avx2.resolve(), PacketIsa::Avx512);
+    assert_ne!(PacketIsa::Auto.resolve(), PacketIsa::Auto);
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512dq") {
+        assert_eq!(PacketIsa::Auto.resolve(), PacketIsa::Avx512);
+    }
+}
+
+#[test]
+fn packets_match_scalar_queries_on_a_single_leaf() {
+    // At most four primitives make a one-leaf tree (the emitter-only geometry of most scenes),
+    // whose box the packet tests on vectors before the scalar queries: rays around it, many
+    // missing, some grazing its box, in coherent packets (one origin) and incoherent ones.
+    let g = Geometry::new(triangle_soup(3), vec![MeshShading::default()], Vec::new());
+    let (lo, hi) = g.bounds();
+    let ext = hi - lo;
+    let pat = make_pattern(PatternKind::Random, 17);
+    let mut rays = random_rays((lo - ext, hi + ext), 16 * 40, 3);
+    for k in 0..200u32 {
+        let a = pat.sample_2d(UVec2::new(k, 1), 0, 0, 1);
+        let o = lo - ext + ext * 3.0 * Vec3::new(a.x, a.y, 0.0);
+        let Some(p) = g.primitive(k % g.len() as u32) else {
+            continue;
+        };
+        for s in 0..PACKET as u32 {
+            // Barycentric-like offsets in [-0.2, 1.2]²: inside the triangle or near it.
+            let j = pat.sample_2d(UVec2::new(k, 2), 0, s, PACKET as u32) * 1.4 - Vec2::splat(0.2);
+            let target = p.p[0] + (p.p[1] - p.p[0]) * j.x + (p.p[2] - p.p[0]) * j.y;
+            rays.push(Ray::new(o, target - o));
+        }
+    }
+    let hits = check(&g, &rays);
+    assert!(hits > 100 && hits < rays.len() as u32 / 2, "{hits} hits");
+}
