@@ -258,7 +258,6 @@ impl PacketScratch {
 
 /// The shading state of a camera-ray hit, owned per lane of a packet.
 struct LaneShading {
-    hit: SurfaceHit,
     bsdf: Bsdf,
     /// The hit point and the geometric normal flipped toward the viewer.
     ctx: LightSampleContext,
@@ -271,9 +270,9 @@ struct LaneShading {
 impl LaneShading {
     /// The borrowed view the per-sample estimators take.
     #[inline]
-    fn view(&self, uniform: Option<u32>) -> Shading<'_> {
+    fn view<'a>(&'a self, hit: &'a SurfaceHit, uniform: Option<u32>) -> Shading<'a> {
         Shading {
-            hit: &self.hit,
+            hit,
             bsdf: &self.bsdf,
             ctx: &self.ctx,
             frame: self.frame,
@@ -392,9 +391,12 @@ impl<'a> DirectLighting<'a> {
         let mut rays = n as u64;
         for k in 0..n {
             let ray = &cam.ray[k];
-            (out[k], lanes[k]) = match &hits[k] {
-                None => (self.escaped(ray.d), None),
-                Some(hit) => self.shade(hit, ray),
+            out[k] = match &hits[k] {
+                None => {
+                    lanes[k] = None;
+                    self.escaped(ray.d)
+                }
+                Some(hit) => self.shade(hit, ray, &mut lanes[k]),
             };
         }
         let uniform = if use_light {
@@ -410,7 +412,8 @@ impl<'a> DirectLighting<'a> {
             sampled.active = 0;
             for k in 0..n {
                 let Some(lane) = &lanes[k] else { continue };
-                let sh = lane.view(uniform);
+                let Some(hit) = &hits[k] else { continue };
+                let sh = lane.view(hit, uniform);
                 let d = if j == 0 { first[k] } else { draws(k, j) };
                 if use_light && let Some((r, v)) = self.light_sample(&sh, &d, mis) {
                     light.set(k, r, v);
@@ -431,10 +434,12 @@ impl<'a> DirectLighting<'a> {
                     if sampled.active >> k & 1 == 0 {
                         continue;
                     }
-                    let Some(lane) = &lanes[k] else { continue };
+                    let (Some(lane), Some(at)) = (&lanes[k], &hits[k]) else {
+                        continue;
+                    };
                     let b = &sampled.lanes[k];
                     let hit = emitter_hits[k].as_ref();
-                    if let Some((r, v)) = self.bsdf_gather(&lane.view(uniform), b, hit, mis) {
+                    if let Some((r, v)) = self.bsdf_gather(&lane.view(at, uniform), b, hit, mis) {
                         bsdf.set(k, r, v);
                     }
                 }
@@ -460,10 +465,11 @@ impl<'a> DirectLighting<'a> {
         rays
     }
 
-    /// Emitted radiance at camera hit `hit` of `ray` and, if it has a material, its shading
-    /// state.
-    #[inline]
-    fn shade(&self, hit: &SurfaceHit, ray: &Ray) -> (Rgb, Option<LaneShading>) {
+    /// Emitted radiance at camera hit `hit` of `ray`; its shading state (if it has a material)
+    /// goes to `lane`, built in place: returned, the state was copied twice (stalling on
+    /// store forwarding).
+    #[inline(always)]
+    fn shade(&self, hit: &SurfaceHit, ray: &Ray, lane: &mut Option<LaneShading>) -> Rgb {
         let scene = self.scene;
         let wo = -ray.d.normalize();
         let mut l = Rgb::ZERO;
@@ -479,21 +485,21 @@ impl<'a> DirectLighting<'a> {
         };
         let frame = Frame::from_normal(ns);
         let Some(material) = scene.materials.get(hit.material as usize) else {
-            return (l, None);
+            *lane = None;
+            return l;
         };
         let mut bsdf = material.bsdf(hit, front);
         if self.bsdf_sampling != LobeSampling::Importance {
             bsdf.set_sampling(self.bsdf_sampling);
         }
-        let lane = LaneShading {
-            hit: *hit,
+        *lane = Some(LaneShading {
             bsdf,
             ctx: LightSampleContext { p: hit.p, n: ng },
             wo_local: frame.to_local(wo),
             frame,
             wo,
-        };
-        (l, Some(lane))
+        });
+        l
     }
 
     /// Radiance of the infinite lights seen along an escaping ray.
