@@ -7,11 +7,10 @@
 
 mod geometry_support;
 
-use geometry_support::{brute_force_t, random_rays, triangle_soup};
+use geometry_support::{brute_force_t, random_rays, soup_with_quadrics, triangle_soup};
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::{
-    Backend, Geometry, MeshShading, PACKET, PacketIsa, PrimKind, Primitive, Quadric, QuadricKind,
-    Ray, RayQuery, Transform,
+    Backend, Geometry, MeshShading, PACKET, PacketIsa, Primitive, Ray, RayQuery,
 };
 use penumbra::sampling::{PatternKind, make_pattern};
 use penumbra::scene::Scene;
@@ -192,33 +191,8 @@ fn packets_match_scalar_queries_on_a_dense_mesh_with_ties() {
 
 #[test]
 fn packets_match_scalar_queries_with_spheres_and_disks() {
+    let g = soup_with_quadrics(2000, 0.6, 0.8);
     let pat = make_pattern(PatternKind::Random, 5);
-    let mut prims = triangle_soup(2000);
-    let mut quadrics = Vec::new();
-    for i in 0..40u32 {
-        let c = pat.sample_2d(UVec2::new(i, 2), 0, 0, 1);
-        let h = pat.sample_2d(UVec2::new(i, 2), 1, 0, 1);
-        let kind = if i % 2 == 0 {
-            QuadricKind::Sphere { radius: 0.6 }
-        } else {
-            QuadricKind::Disk {
-                height: 0.0,
-                radius: 0.8,
-            }
-        };
-        quadrics.push(Quadric {
-            kind,
-            to_world: Transform::translate(Vec3::new(c.x, c.y, h.x) * 10.0),
-            flip: false,
-        });
-        prims.push(Primitive {
-            p: [Vec3::ZERO; 3],
-            kind: PrimKind::Quadric(i),
-            material: 1,
-            light: u32::MAX,
-        });
-    }
-    let g = Geometry::new(prims, vec![MeshShading::default()], quadrics);
     // Coherent packets: 16 nearby directions from one origin.
     let mut coherent = Vec::new();
     let (lo, hi) = g.bounds();

@@ -5,12 +5,9 @@
 
 mod geometry_support;
 
-use geometry_support::{brute_force_t, random_rays, triangle, triangle_soup};
+use geometry_support::{brute_force_t, random_rays, soup_with_quadrics, triangle};
 use glam::{UVec2, Vec3};
-use penumbra::geometry::{
-    Backend, Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Ray, RayQuery,
-    Transform,
-};
+use penumbra::geometry::{Backend, Geometry, MeshShading, Primitive, Ray, RayQuery};
 use penumbra::sampling::{PatternKind, make_pattern};
 
 /// Checks the wide backend ray by ray; returns (hits, ties on equal t with a different prim).
@@ -71,33 +68,7 @@ fn wide_matches_brute_force_on_cornell() {
 
 #[test]
 fn wide_matches_brute_force_on_triangles_spheres_and_disks() {
-    let pat = make_pattern(PatternKind::Random, 5);
-    let mut prims = triangle_soup(3000);
-    let mut quadrics = Vec::new();
-    for i in 0..40u32 {
-        let c = pat.sample_2d(UVec2::new(i, 2), 0, 0, 1);
-        let h = pat.sample_2d(UVec2::new(i, 2), 1, 0, 1);
-        let kind = if i % 2 == 0 {
-            QuadricKind::Sphere { radius: 0.3 }
-        } else {
-            QuadricKind::Disk {
-                height: 0.0,
-                radius: 0.5,
-            }
-        };
-        quadrics.push(Quadric {
-            kind,
-            to_world: Transform::translate(Vec3::new(c.x, c.y, h.x) * 10.0),
-            flip: false,
-        });
-        prims.push(Primitive {
-            p: [Vec3::ZERO; 3],
-            kind: PrimKind::Quadric(i),
-            material: 1,
-            light: u32::MAX,
-        });
-    }
-    let g = Geometry::new(prims, vec![MeshShading::default()], quadrics);
+    let g = soup_with_quadrics(3000, 0.3, 0.5);
     let rays = random_rays(g.bounds(), 30_000, 7);
     let (hits, ties) = check(&g, &rays, true);
     eprintln!("soup: {hits} hits, {ties} ties");

@@ -71,3 +71,39 @@ pub fn triangle_soup(n: u32) -> Vec<Primitive> {
         })
         .collect()
 }
+
+/// A soup of `tris` random triangles plus 20 spheres of `sphere_radius` and 20 disks of
+/// `disk_radius` at random places in the same box.
+#[allow(dead_code)]
+pub fn soup_with_quadrics(tris: u32, sphere_radius: f32, disk_radius: f32) -> Geometry {
+    use penumbra::geometry::{MeshShading, Quadric, QuadricKind, Transform};
+    let pat = make_pattern(PatternKind::Random, 5);
+    let mut prims = triangle_soup(tris);
+    let mut quadrics = Vec::new();
+    for i in 0..40u32 {
+        let c = pat.sample_2d(UVec2::new(i, 2), 0, 0, 1);
+        let h = pat.sample_2d(UVec2::new(i, 2), 1, 0, 1);
+        let kind = if i % 2 == 0 {
+            QuadricKind::Sphere {
+                radius: sphere_radius,
+            }
+        } else {
+            QuadricKind::Disk {
+                height: 0.0,
+                radius: disk_radius,
+            }
+        };
+        quadrics.push(Quadric {
+            kind,
+            to_world: Transform::translate(Vec3::new(c.x, c.y, h.x) * 10.0),
+            flip: false,
+        });
+        prims.push(Primitive {
+            p: [Vec3::ZERO; 3],
+            kind: PrimKind::Quadric(i),
+            material: 1,
+            light: u32::MAX,
+        });
+    }
+    Geometry::new(prims, vec![MeshShading::default()], quadrics)
+}
