@@ -116,7 +116,7 @@ pub trait SamplePattern: Send + Sync {
 
 /// Make the pattern of `kind` with a global seed.
 pub fn make_pattern(kind: PatternKind, seed: u64) -> Box<dyn SamplePattern> {
-    Box::new(Pattern { seed, kind })
+    Box::new(Pattern::new(seed, kind))
 }
 
 /// Near-square factorisation nx × ny = count with nx the largest divisor ≤ √count (nx ≤ ny).
@@ -148,9 +148,64 @@ pub struct Pattern {
     pub seed: u64,
     /// Which pattern.
     pub kind: PatternKind,
+    /// The instruction set of the `stratified` chunk fills (detected once, in [`Pattern::new`]).
+    isa: ChunkIsa,
+}
+
+/// The instruction set a `stratified` chunk fill is compiled for: the default x86-64 target
+/// has SSE2 only (4 u32 lanes, no 64-bit vector multiply), so the same code is also compiled
+/// for AVX2 and AVX-512 (16 u32 lanes = one vector) and picked at run time. Every version
+/// computes the same values (integer ops, exact conversions, IEEE division, a compare-select).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ChunkIsa {
+    /// Whatever the build target has.
+    Portable,
+    /// x86-64 with AVX2.
+    Avx2,
+    /// x86-64 with AVX-512 F/BW/DQ/VL.
+    Avx512,
+}
+
+impl ChunkIsa {
+    /// The widest one this CPU supports.
+    fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx512f")
+                && std::is_x86_feature_detected!("avx512bw")
+                && std::is_x86_feature_detected!("avx512dq")
+                && std::is_x86_feature_detected!("avx512vl")
+            {
+                return ChunkIsa::Avx512;
+            }
+            if std::is_x86_feature_detected!("avx2") {
+                return ChunkIsa::Avx2;
+            }
+        }
+        ChunkIsa::Portable
+    }
+
+    /// Every version this CPU can run (for tests).
+    #[cfg(test)]
+    fn available() -> Vec<Self> {
+        let best = Self::detect();
+        [ChunkIsa::Portable, ChunkIsa::Avx2, ChunkIsa::Avx512]
+            .into_iter()
+            .filter(|&i| i as u8 <= best as u8)
+            .collect()
+    }
 }
 
 impl Pattern {
+    /// The pattern `kind` with global seed `seed`, its chunk fills on this CPU's widest vectors.
+    pub fn new(seed: u64, kind: PatternKind) -> Self {
+        Self {
+            seed,
+            kind,
+            isa: ChunkIsa::detect(),
+        }
+    }
+
     /// Hash state after (seed, pixel): the prefix shared by every dimension of the pixel.
     #[inline]
     fn pixel_hash(&self, pixel: UVec2) -> u64 {
@@ -473,6 +528,62 @@ impl FastStrata {
         let y = fixed_chunk(&sy, &jy, self.div_y, self.small_2d);
         std::array::from_fn(|k| Vec2::new(x[k], y[k]))
     }
+
+    /// [`FastStrata::chunk_1d`] on `isa`.
+    #[inline(always)]
+    fn chunk_1d_on(&self, isa: ChunkIsa, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `ChunkIsa::detect` returned Avx512 only if the CPU has these features.
+            ChunkIsa::Avx512 => unsafe { self.chunk_1d_avx512(set, base) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `ChunkIsa::detect` returned Avx2 (or better) only if the CPU has AVX2.
+            ChunkIsa::Avx2 => unsafe { self.chunk_1d_avx2(set, base) },
+            _ => self.chunk_1d(set, base),
+        }
+    }
+
+    /// [`FastStrata::chunk_2d`] on `isa`.
+    #[inline(always)]
+    fn chunk_2d_on(&self, isa: ChunkIsa, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `chunk_1d_on`.
+            ChunkIsa::Avx512 => unsafe { self.chunk_2d_avx512(set, base) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `chunk_1d_on`.
+            ChunkIsa::Avx2 => unsafe { self.chunk_2d_avx2(set, base) },
+            _ => self.chunk_2d(set, base),
+        }
+    }
+
+    /// [`FastStrata::chunk_1d`] compiled for AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn chunk_1d_avx512(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+        self.chunk_1d(set, base)
+    }
+
+    /// [`FastStrata::chunk_2d`] compiled for AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn chunk_2d_avx512(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+        self.chunk_2d(set, base)
+    }
+
+    /// [`FastStrata::chunk_1d`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn chunk_1d_avx2(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+        self.chunk_1d(set, base)
+    }
+
+    /// [`FastStrata::chunk_2d`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn chunk_2d_avx2(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+        self.chunk_2d(set, base)
+    }
 }
 
 /// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form that
@@ -647,7 +758,7 @@ impl PixelSamples {
                 count,
                 general: |p: &Pattern| p.sample_1d(self.pixel, dim, index, count),
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_1d(kind, i, st),
-                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_1d(set, base),
+                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_1d_on(self.pattern.isa, set, base),
             },
         )
     }
@@ -675,7 +786,7 @@ impl PixelSamples {
                 count,
                 general: |p: &Pattern| p.sample_2d(self.pixel, dim, index, count),
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_2d(kind, i, st),
-                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_2d(set, base),
+                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_2d_on(self.pattern.isa, set, base),
             },
         )
     }
@@ -763,13 +874,24 @@ mod tests {
     fn pixel_samples_equal_the_pattern_values() {
         // The cached per-pixel path must return bit-identical values, in cached dimensions
         // and past them, for stratified counts and wrapped indices.
-        for kind in PatternKind::ALL {
-            let pat = Pattern { seed: 7, kind };
+        for (kind, isa) in PatternKind::ALL
+            .into_iter()
+            .flat_map(|k| ChunkIsa::available().into_iter().map(move |i| (k, i)))
+        {
+            let pat = Pattern { seed: 7, kind, isa };
             for pixel in [UVec2::new(0, 0), UVec2::new(13, 511)] {
                 let px = pat.pixel(pixel);
                 assert_eq!(px.pixel(), pixel);
                 for dim in [0u32, 3, 7, 8, 40] {
-                    for (index, count) in [(0u32, 1u32), (5, 16), (63, 64), (70, 64), (9, 37)] {
+                    for (index, count) in [
+                        (0u32, 1u32),
+                        (5, 16),
+                        (63, 64),
+                        (70, 64),
+                        (9, 37),
+                        (40_000, 1 << 16),
+                        (17, 1 << 18),
+                    ] {
                         assert_eq!(
                             px.sample_1d(dim, index, count).to_bits(),
                             pat.sample_1d(pixel, dim, index, count).to_bits(),
