@@ -522,11 +522,20 @@ impl FastStrata {
     fn chunk_2d(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
         let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
         let (jx, jy) = Self::jitters(set, base);
-        let sx = strata.map(|s| s & self.nx_mask);
-        let sy = strata.map(|s| s >> self.nx_log2);
+        // Plain loops, not `array::map` / `from_fn`: those were left as out-of-line calls,
+        // which the target_feature copies below cannot widen.
+        let (mut sx, mut sy) = ([0u32; CHUNK], [0u32; CHUNK]);
+        for k in 0..CHUNK {
+            sx[k] = strata[k] & self.nx_mask;
+            sy[k] = strata[k] >> self.nx_log2;
+        }
         let x = fixed_chunk(&sx, &jx, self.div_x, self.small_2d);
         let y = fixed_chunk(&sy, &jy, self.div_y, self.small_2d);
-        std::array::from_fn(|k| Vec2::new(x[k], y[k]))
+        let mut v = [Vec2::ZERO; CHUNK];
+        for k in 0..CHUNK {
+            v[k] = Vec2::new(x[k], y[k]);
+        }
+        v
     }
 
     /// [`FastStrata::chunk_1d`] on `isa`.
@@ -590,18 +599,22 @@ impl FastStrata {
 /// vectorises (the same values: the integer is the same and exact either way).
 #[inline(always)]
 fn fixed_chunk(strata: &[u32; CHUNK], j: &[u32; CHUNK], div: f32, small: bool) -> [f32; CHUNK] {
+    let mut out = [0.0f32; CHUNK];
     if small {
-        std::array::from_fn(|k| {
+        for k in 0..CHUNK {
             let v = ((strata[k] << 24) | j[k]) as i32 as f32 / div;
-            if v < ONE_MINUS_EPSILON {
+            out[k] = if v < ONE_MINUS_EPSILON {
                 v
             } else {
                 ONE_MINUS_EPSILON
-            }
-        })
+            };
+        }
     } else {
-        std::array::from_fn(|k| in_stratum_fixed(strata[k], j[k], div))
+        for k in 0..CHUNK {
+            out[k] = in_stratum_fixed(strata[k], j[k], div);
+        }
     }
+    out
 }
 
 /// 2^24: one in the 24-bit fixed point of the jitter.
