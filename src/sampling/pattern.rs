@@ -169,6 +169,9 @@ enum ChunkIsa {
 impl ChunkIsa {
     /// The widest one this CPU supports.
     fn detect() -> Self {
+        if std::env::var_os("PATSIMD_PORTABLE").is_some() {
+            return ChunkIsa::Portable;
+        }
         #[cfg(target_arch = "x86_64")]
         {
             if std::is_x86_feature_detected!("avx512f")
@@ -491,21 +494,16 @@ impl FastStrata {
         }
     }
 
-    /// The 24-bit jitters (x: low, y: high half) of indices `base..base + CHUNK` of `set`.
+    /// The full 64-bit jitter hashes of indices `base..base + CHUNK` of `set` (x: bits 8..32,
+    /// y: bits 40..64), in a plain loop over u64 lanes that vectorises whole.
     #[inline(always)]
-    fn jitters(set: &SetKeys, base: u32) -> ([u32; CHUNK], [u32; CHUNK]) {
-        let mut jx = [0u32; CHUNK];
-        let mut jy = [0u32; CHUNK];
-        for (k, (x, y)) in jx.iter_mut().zip(&mut jy).enumerate() {
-            let i = base.wrapping_add(k as u32);
-            let h = mix64(
-                set.jitter_fast
-                    .wrapping_add((i as u64).wrapping_mul(HASH_INIT)),
-            );
-            *x = h as u32 >> 8;
-            *y = (h >> 40) as u32;
+    fn jitter_hashes(set: &SetKeys, base: u32) -> [u64; CHUNK] {
+        let mut h = [0u64; CHUNK];
+        for (k, o) in h.iter_mut().enumerate() {
+            let i = base.wrapping_add(k as u32) as u64;
+            *o = mix64(set.jitter_fast.wrapping_add(i.wrapping_mul(HASH_INIT)));
         }
-        (jx, jy)
+        h
     }
 
     /// Stratified 1D samples `base..base + CHUNK` of `set` (those < count are the same f32s as
@@ -513,7 +511,11 @@ impl FastStrata {
     #[inline(always)]
     fn chunk_1d(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
         let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
-        let (jx, _) = Self::jitters(set, base);
+        let h = Self::jitter_hashes(set, base);
+        let mut jx = [0u32; CHUNK];
+        for (j, h) in jx.iter_mut().zip(&h) {
+            *j = *h as u32 >> 8;
+        }
         fixed_chunk(&strata, &jx, self.div_1d, self.small_1d)
     }
 
@@ -521,13 +523,16 @@ impl FastStrata {
     #[inline(always)]
     fn chunk_2d(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
         let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
-        let (jx, jy) = Self::jitters(set, base);
+        let h = Self::jitter_hashes(set, base);
         // Plain loops, not `array::map` / `from_fn`: those were left as out-of-line calls,
         // which the target_feature copies below cannot widen.
         let (mut sx, mut sy) = ([0u32; CHUNK], [0u32; CHUNK]);
+        let (mut jx, mut jy) = ([0u32; CHUNK], [0u32; CHUNK]);
         for k in 0..CHUNK {
             sx[k] = strata[k] & self.nx_mask;
             sy[k] = strata[k] >> self.nx_log2;
+            jx[k] = h[k] as u32 >> 8;
+            jy[k] = (h[k] >> 40) as u32;
         }
         let x = fixed_chunk(&sx, &jx, self.div_x, self.small_2d);
         let y = fixed_chunk(&sy, &jy, self.div_y, self.small_2d);
@@ -566,18 +571,51 @@ impl FastStrata {
         }
     }
 
-    /// [`FastStrata::chunk_1d`] compiled for AVX-512.
+    /// [`FastStrata::chunk_1d`] on AVX-512: power-of-two counts with small strata (the common
+    /// case) written with intrinsics, one 16-lane vector per step (compiled from the portable
+    /// loops, LLVM split the 16 lanes 8 + 4 + 2 + 1 + 1); the rest compiled for AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     fn chunk_1d_avx512(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
-        self.chunk_1d(set, base)
+        use std::arch::x86_64::*;
+        if !(self.dom.is_pow2() && self.small_1d) {
+            return self.chunk_1d(set, base);
+        }
+        let strata = set.perm.apply_16_pow2_avx512(base, &self.dom);
+        let (jx, _) = jitters_avx512(set, base);
+        let v = fixed_small_avx512(strata, jx, self.div_1d);
+        let mut out = [0.0f32; CHUNK];
+        // SAFETY: `out` is 16 f32 = 64 bytes, the width of the unaligned store.
+        unsafe { _mm512_storeu_ps(out.as_mut_ptr(), v) };
+        out
     }
 
-    /// [`FastStrata::chunk_2d`] compiled for AVX-512.
+    /// [`FastStrata::chunk_2d`] on AVX-512 (see [`FastStrata::chunk_1d_avx512`]).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     fn chunk_2d_avx512(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
-        self.chunk_2d(set, base)
+        use std::arch::x86_64::*;
+        if !(self.dom.is_pow2() && self.small_2d) {
+            return self.chunk_2d(set, base);
+        }
+        let strata = set.perm.apply_16_pow2_avx512(base, &self.dom);
+        let (jx, jy) = jitters_avx512(set, base);
+        let sx = _mm512_and_si512(strata, _mm512_set1_epi32(self.nx_mask as i32));
+        let sy = _mm512_srl_epi32(strata, _mm_cvtsi32_si128(self.nx_log2 as i32));
+        let x = fixed_small_avx512(sx, jx, self.div_x);
+        let y = fixed_small_avx512(sy, jy, self.div_y);
+        // Interleave to (x0, y0, x1, y1, ...): lanes ≥ 16 of the index pick from `y`.
+        let lo = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+        let hi = _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
+        let mut out = [Vec2::ZERO; CHUNK];
+        let p = out.as_mut_ptr() as *mut f32;
+        // SAFETY: `Vec2` is `repr(C)` (x, y), so `out` is 32 contiguous f32 = two 64-byte
+        // unaligned stores.
+        unsafe {
+            _mm512_storeu_ps(p, _mm512_permutex2var_ps(x, lo, y));
+            _mm512_storeu_ps(p.add(16), _mm512_permutex2var_ps(x, hi, y));
+        }
+        out
     }
 
     /// [`FastStrata::chunk_1d`] compiled for AVX2.
@@ -593,6 +631,55 @@ impl FastStrata {
     fn chunk_2d_avx2(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
         self.chunk_2d(set, base)
     }
+}
+
+/// The 24-bit jitters (x, y) of indices `base..base + 16` of `set` on AVX-512: the same
+/// hashes as [`FastStrata::jitter_hashes`], 8 u64 lanes at a time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+fn jitters_avx512(
+    set: &SetKeys,
+    base: u32,
+) -> (std::arch::x86_64::__m512i, std::arch::x86_64::__m512i) {
+    use super::hash::mix64_avx512;
+    use std::arch::x86_64::*;
+    let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    // u32 indices (wrapping, as the scalar `base.wrapping_add(k)`), then zero-extended.
+    let idx = _mm512_add_epi32(_mm512_set1_epi32(base as i32), lanes);
+    let mul = _mm512_set1_epi64(HASH_INIT as i64);
+    let add = _mm512_set1_epi64(set.jitter_fast as i64);
+    let hash = |i: __m256i| {
+        let i = _mm512_cvtepu32_epi64(i);
+        mix64_avx512(_mm512_add_epi64(add, _mm512_mullo_epi64(i, mul)))
+    };
+    let h0 = hash(_mm512_castsi512_si256(idx));
+    let h1 = hash(_mm512_extracti64x4_epi64::<1>(idx));
+    // Low u32 of each lane (truncation, as `h as u32`), 16 lanes in one vector.
+    let join = |a: __m512i, b: __m512i| {
+        _mm512_inserti64x4::<1>(
+            _mm512_castsi256_si512(_mm512_cvtepi64_epi32(a)),
+            _mm512_cvtepi64_epi32(b),
+        )
+    };
+    let jx = _mm512_srli_epi32::<8>(join(h0, h1));
+    let jy = join(_mm512_srli_epi64::<40>(h0), _mm512_srli_epi64::<40>(h1));
+    (jx, jy)
+}
+
+/// The `small` form of [`fixed_chunk`] on 16 lanes: (stratum << 24 | j) as i32 → f32 (round
+/// to nearest, as `as f32`), IEEE division, then `v < 1⁻ ? v : 1⁻`, which is exactly
+/// `vminps(v, 1⁻)` (it returns the second operand unless v < 1⁻).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn fixed_small_avx512(
+    strata: std::arch::x86_64::__m512i,
+    j: std::arch::x86_64::__m512i,
+    div: f32,
+) -> std::arch::x86_64::__m512 {
+    use std::arch::x86_64::*;
+    let fixed = _mm512_or_si512(_mm512_slli_epi32::<24>(strata), j);
+    let v = _mm512_div_ps(_mm512_cvtepi32_ps(fixed), _mm512_set1_ps(div));
+    _mm512_min_ps(v, _mm512_set1_ps(ONE_MINUS_EPSILON))
 }
 
 /// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form that
