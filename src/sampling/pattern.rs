@@ -414,13 +414,68 @@ impl SamplePattern for Pattern {
     }
 
     fn pixel(&self, pixel: UVec2) -> PixelSamples {
+        #[cfg(target_arch = "x86_64")]
+        if self.kind == PatternKind::Stratified && self.isa == ChunkIsa::Avx512 {
+            // SAFETY: `ChunkIsa::detect` returned Avx512 only if the CPU has these features.
+            return unsafe { self.pixel_stratified_avx512(pixel) };
+        }
         let prefix = self.pixel_hash(pixel);
         let dims: [u64; CACHED_DIMS] = std::array::from_fn(|d| hash_step(prefix, d as u64));
+        self.pixel_of_sets(
+            pixel,
+            std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_1D)),
+            std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_2D)),
+        )
+    }
+}
+
+impl Pattern {
+    /// [`SamplePattern::pixel`] of a `stratified` pattern on AVX-512: the keys of the 8 cached
+    /// dimensions are 8 u64 lanes, so every hash of a pixel's set keys is one vector op.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn pixel_stratified_avx512(&self, pixel: UVec2) -> PixelSamples {
+        use super::hash::{hash_step_avx512, mix64_avx512};
+        use std::arch::x86_64::*;
+        const _: () = assert!(CACHED_DIMS == 8, "one 8-lane vector of dimensions");
+        let prefix = _mm512_set1_epi64(self.pixel_hash(pixel) as i64);
+        let dims = hash_step_avx512(prefix, _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+        // The `stratified` arm of `SetKeys::new` for the 8 keys of one tag.
+        let sets = |tag: u64| {
+            let key = hash_step_avx512(dims, _mm512_set1_epi64(tag as i64));
+            let k = mix64_avx512(key);
+            let k2 = mix64_avx512(k);
+            let jitter = hash_step_avx512(key, _mm512_set1_epi64(TAG_JITTER as i64));
+            let mut lanes = [[0u64; CACHED_DIMS]; 4];
+            for (o, v) in lanes.iter_mut().zip([key, k, k2, jitter]) {
+                // SAFETY: `o` is 8 u64 = 64 bytes, the width of the unaligned store.
+                unsafe { _mm512_storeu_si512(o.as_mut_ptr() as *mut __m512i, v) };
+            }
+            let [key, k, k2, jitter] = lanes;
+            std::array::from_fn(|d| SetKeys {
+                perm: Permutation::from_mixed(k[d], k2[d]),
+                jitter: jitter[d],
+                jitter_fast: jitter[d].wrapping_add(HASH_INIT),
+                key: key[d],
+                ..Default::default()
+            })
+        };
+        self.pixel_of_sets(pixel, sets(TAG_1D), sets(TAG_2D))
+    }
+
+    /// The [`PixelSamples`] of `pixel` with these sets' keys and empty caches.
+    #[inline(always)]
+    fn pixel_of_sets(
+        &self,
+        pixel: UVec2,
+        sets_1d: [SetKeys; CACHED_DIMS],
+        sets_2d: [SetKeys; CACHED_DIMS],
+    ) -> PixelSamples {
         PixelSamples {
             pattern: *self,
             pixel,
-            sets_1d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_1D)),
-            sets_2d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_2D)),
+            sets_1d,
+            sets_2d,
             strata: Cell::default(),
             fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
             chunks_1d: Default::default(),

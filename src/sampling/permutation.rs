@@ -59,7 +59,13 @@ impl Permutation {
     #[inline]
     pub fn new(key: u64) -> Self {
         let k = super::hash::mix64(key);
-        let k2 = super::hash::mix64(k);
+        Self::from_mixed(k, super::hash::mix64(k))
+    }
+
+    /// [`Permutation::new`] from `k = mix64(key)` and `k2 = mix64(k)` (computed elsewhere,
+    /// e.g. 8 keys at a time on vectors).
+    #[inline]
+    pub fn from_mixed(k: u64, k2: u64) -> Self {
         let [k0, k1, k2, k3] = [k as u32, (k >> 32) as u32, k2 as u32, (k2 >> 32) as u32];
         Self {
             r: [
