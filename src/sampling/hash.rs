@@ -17,7 +17,7 @@ pub fn mix64(mut x: u64) -> u64 {
 /// [`mix64`] of 8 u64 lanes on AVX-512 (DQ: 64-bit multiply), lane for lane the same.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq")]
-pub fn mix64_avx512(x: std::arch::x86_64::__m512i) -> std::arch::x86_64::__m512i {
+pub(crate) fn mix64_avx512(x: std::arch::x86_64::__m512i) -> std::arch::x86_64::__m512i {
     use std::arch::x86_64::*;
     let x = _mm512_xor_si512(x, _mm512_srli_epi64::<30>(x));
     let x = _mm512_mullo_epi64(x, _mm512_set1_epi64(0xbf58_476d_1ce4_e5b9_u64 as i64));
@@ -29,7 +29,7 @@ pub fn mix64_avx512(x: std::arch::x86_64::__m512i) -> std::arch::x86_64::__m512i
 /// [`hash_step`] of 8 u64 lanes on AVX-512 (DQ), lane for lane the same.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq")]
-pub fn hash_step_avx512(
+pub(crate) fn hash_step_avx512(
     h: std::arch::x86_64::__m512i,
     k: std::arch::x86_64::__m512i,
 ) -> std::arch::x86_64::__m512i {

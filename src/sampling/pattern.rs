@@ -913,7 +913,9 @@ impl PixelSamples {
                 count,
                 general: |p: &Pattern| p.sample_1d(self.pixel, dim, index, count),
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_1d(kind, i, st),
-                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_1d_on(self.pattern.isa, set, base),
+                fast: |f: &FastStrata, set: &SetKeys, base| {
+                    f.chunk_1d_on(self.pattern.isa, set, base)
+                },
             },
         )
     }
@@ -941,7 +943,9 @@ impl PixelSamples {
                 count,
                 general: |p: &Pattern| p.sample_2d(self.pixel, dim, index, count),
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_2d(kind, i, st),
-                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_2d_on(self.pattern.isa, set, base),
+                fast: |f: &FastStrata, set: &SetKeys, base| {
+                    f.chunk_2d_on(self.pattern.isa, set, base)
+                },
             },
         )
     }

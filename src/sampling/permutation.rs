@@ -65,7 +65,7 @@ impl Permutation {
     /// [`Permutation::new`] from `k = mix64(key)` and `k2 = mix64(k)` (computed elsewhere,
     /// e.g. 8 keys at a time on vectors).
     #[inline]
-    pub fn from_mixed(k: u64, k2: u64) -> Self {
+    pub(crate) fn from_mixed(k: u64, k2: u64) -> Self {
         let [k0, k1, k2, k3] = [k as u32, (k >> 32) as u32, k2 as u32, (k2 >> 32) as u32];
         Self {
             r: [
@@ -134,7 +134,11 @@ impl Permutation {
     /// for a power-of-two n only (the caller checks [`PermDomain::is_pow2`]): the same rounds,
     /// lane for lane (u32 wrapping multiply, logical shifts by the same counts, masks).
     #[target_feature(enable = "avx512f")]
-    pub fn apply_16_pow2_avx512(&self, base: u32, dom: &PermDomain) -> std::arch::x86_64::__m512i {
+    pub(crate) fn apply_16_pow2_avx512(
+        &self,
+        base: u32,
+        dom: &PermDomain,
+    ) -> std::arch::x86_64::__m512i {
         use std::arch::x86_64::*;
         let mask = _mm512_set1_epi32(dom.mask as i32);
         // Shift counts < 32 (bits ≤ 32), as the scalar `>>`.
