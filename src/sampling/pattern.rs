@@ -169,9 +169,6 @@ enum ChunkIsa {
 impl ChunkIsa {
     /// The widest one this CPU supports.
     fn detect() -> Self {
-        if std::env::var_os("PATSIMD_PORTABLE").is_some() {
-            return ChunkIsa::Portable;
-        }
         #[cfg(target_arch = "x86_64")]
         {
             if std::is_x86_feature_detected!("avx512f")
