@@ -115,7 +115,8 @@ pub fn render(
                     let last = cam.n - 1;
                     let keep = cam.eye[last] + 1 < opts.spp;
                     let slot = cam.pixel[last] as usize;
-                    if keep {
+                    // `slot != 0`: a self-swap still copies the ~3.6 KB PixelSamples 3 times.
+                    if keep && slot != 0 {
                         pxs.swap(0, slot);
                         owner.swap(0, slot);
                     }

@@ -116,7 +116,7 @@ pub trait SamplePattern: Send + Sync {
 
 /// Make the pattern of `kind` with a global seed.
 pub fn make_pattern(kind: PatternKind, seed: u64) -> Box<dyn SamplePattern> {
-    Box::new(Pattern { seed, kind })
+    Box::new(Pattern::new(seed, kind))
 }
 
 /// Near-square factorisation nx × ny = count with nx the largest divisor ≤ √count (nx ≤ ny).
@@ -148,9 +148,64 @@ pub struct Pattern {
     pub seed: u64,
     /// Which pattern.
     pub kind: PatternKind,
+    /// The instruction set of the `stratified` chunk fills (detected once, in [`Pattern::new`]).
+    isa: ChunkIsa,
+}
+
+/// The instruction set a `stratified` chunk fill is compiled for: the default x86-64 target
+/// has SSE2 only (4 u32 lanes, no 64-bit vector multiply), so the same code is also compiled
+/// for AVX2 and AVX-512 (16 u32 lanes = one vector) and picked at run time. Every version
+/// computes the same values (integer ops, exact conversions, IEEE division, a compare-select).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ChunkIsa {
+    /// Whatever the build target has.
+    Portable,
+    /// x86-64 with AVX2.
+    Avx2,
+    /// x86-64 with AVX-512 F/BW/DQ/VL.
+    Avx512,
+}
+
+impl ChunkIsa {
+    /// The widest one this CPU supports.
+    fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx512f")
+                && std::is_x86_feature_detected!("avx512bw")
+                && std::is_x86_feature_detected!("avx512dq")
+                && std::is_x86_feature_detected!("avx512vl")
+            {
+                return ChunkIsa::Avx512;
+            }
+            if std::is_x86_feature_detected!("avx2") {
+                return ChunkIsa::Avx2;
+            }
+        }
+        ChunkIsa::Portable
+    }
+
+    /// Every version this CPU can run (for tests).
+    #[cfg(test)]
+    fn available() -> Vec<Self> {
+        let best = Self::detect();
+        [ChunkIsa::Portable, ChunkIsa::Avx2, ChunkIsa::Avx512]
+            .into_iter()
+            .filter(|&i| i as u8 <= best as u8)
+            .collect()
+    }
 }
 
 impl Pattern {
+    /// The pattern `kind` with global seed `seed`, its chunk fills on this CPU's widest vectors.
+    pub fn new(seed: u64, kind: PatternKind) -> Self {
+        Self {
+            seed,
+            kind,
+            isa: ChunkIsa::detect(),
+        }
+    }
+
     /// Hash state after (seed, pixel): the prefix shared by every dimension of the pixel.
     #[inline]
     fn pixel_hash(&self, pixel: UVec2) -> u64 {
@@ -356,13 +411,68 @@ impl SamplePattern for Pattern {
     }
 
     fn pixel(&self, pixel: UVec2) -> PixelSamples {
+        #[cfg(target_arch = "x86_64")]
+        if self.kind == PatternKind::Stratified && self.isa == ChunkIsa::Avx512 {
+            // SAFETY: `ChunkIsa::detect` returned Avx512 only if the CPU has these features.
+            return unsafe { self.pixel_stratified_avx512(pixel) };
+        }
         let prefix = self.pixel_hash(pixel);
         let dims: [u64; CACHED_DIMS] = std::array::from_fn(|d| hash_step(prefix, d as u64));
+        self.pixel_of_sets(
+            pixel,
+            std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_1D)),
+            std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_2D)),
+        )
+    }
+}
+
+impl Pattern {
+    /// [`SamplePattern::pixel`] of a `stratified` pattern on AVX-512: the keys of the 8 cached
+    /// dimensions are 8 u64 lanes, so every hash of a pixel's set keys is one vector op.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn pixel_stratified_avx512(&self, pixel: UVec2) -> PixelSamples {
+        use super::hash::{hash_step_avx512, mix64_avx512};
+        use std::arch::x86_64::*;
+        const _: () = assert!(CACHED_DIMS == 8, "one 8-lane vector of dimensions");
+        let prefix = _mm512_set1_epi64(self.pixel_hash(pixel) as i64);
+        let dims = hash_step_avx512(prefix, _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+        // The `stratified` arm of `SetKeys::new` for the 8 keys of one tag.
+        let sets = |tag: u64| {
+            let key = hash_step_avx512(dims, _mm512_set1_epi64(tag as i64));
+            let k = mix64_avx512(key);
+            let k2 = mix64_avx512(k);
+            let jitter = hash_step_avx512(key, _mm512_set1_epi64(TAG_JITTER as i64));
+            let mut lanes = [[0u64; CACHED_DIMS]; 4];
+            for (o, v) in lanes.iter_mut().zip([key, k, k2, jitter]) {
+                // SAFETY: `o` is 8 u64 = 64 bytes, the width of the unaligned store.
+                unsafe { _mm512_storeu_si512(o.as_mut_ptr() as *mut __m512i, v) };
+            }
+            let [key, k, k2, jitter] = lanes;
+            std::array::from_fn(|d| SetKeys {
+                perm: Permutation::from_mixed(k[d], k2[d]),
+                jitter: jitter[d],
+                jitter_fast: jitter[d].wrapping_add(HASH_INIT),
+                key: key[d],
+                ..Default::default()
+            })
+        };
+        self.pixel_of_sets(pixel, sets(TAG_1D), sets(TAG_2D))
+    }
+
+    /// The [`PixelSamples`] of `pixel` with these sets' keys and empty caches.
+    #[inline(always)]
+    fn pixel_of_sets(
+        &self,
+        pixel: UVec2,
+        sets_1d: [SetKeys; CACHED_DIMS],
+        sets_2d: [SetKeys; CACHED_DIMS],
+    ) -> PixelSamples {
         PixelSamples {
             pattern: *self,
             pixel,
-            sets_1d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_1D)),
-            sets_2d: std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_2D)),
+            sets_1d,
+            sets_2d,
             strata: Cell::default(),
             fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
             chunks_1d: Default::default(),
@@ -436,21 +546,16 @@ impl FastStrata {
         }
     }
 
-    /// The 24-bit jitters (x: low, y: high half) of indices `base..base + CHUNK` of `set`.
+    /// The full 64-bit jitter hashes of indices `base..base + CHUNK` of `set` (x: bits 8..32,
+    /// y: bits 40..64), in a plain loop over u64 lanes that vectorises whole.
     #[inline(always)]
-    fn jitters(set: &SetKeys, base: u32) -> ([u32; CHUNK], [u32; CHUNK]) {
-        let mut jx = [0u32; CHUNK];
-        let mut jy = [0u32; CHUNK];
-        for (k, (x, y)) in jx.iter_mut().zip(&mut jy).enumerate() {
-            let i = base.wrapping_add(k as u32);
-            let h = mix64(
-                set.jitter_fast
-                    .wrapping_add((i as u64).wrapping_mul(HASH_INIT)),
-            );
-            *x = h as u32 >> 8;
-            *y = (h >> 40) as u32;
+    fn jitter_hashes(set: &SetKeys, base: u32) -> [u64; CHUNK] {
+        let mut h = [0u64; CHUNK];
+        for (k, o) in h.iter_mut().enumerate() {
+            let i = base.wrapping_add(k as u32) as u64;
+            *o = mix64(set.jitter_fast.wrapping_add(i.wrapping_mul(HASH_INIT)));
         }
-        (jx, jy)
+        h
     }
 
     /// Stratified 1D samples `base..base + CHUNK` of `set` (those < count are the same f32s as
@@ -458,7 +563,11 @@ impl FastStrata {
     #[inline(always)]
     fn chunk_1d(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
         let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
-        let (jx, _) = Self::jitters(set, base);
+        let h = Self::jitter_hashes(set, base);
+        let mut jx = [0u32; CHUNK];
+        for (j, h) in jx.iter_mut().zip(&h) {
+            *j = *h as u32 >> 8;
+        }
         fixed_chunk(&strata, &jx, self.div_1d, self.small_1d)
     }
 
@@ -466,31 +575,185 @@ impl FastStrata {
     #[inline(always)]
     fn chunk_2d(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
         let strata: [u32; CHUNK] = set.perm.apply_many(base, &self.dom);
-        let (jx, jy) = Self::jitters(set, base);
-        let sx = strata.map(|s| s & self.nx_mask);
-        let sy = strata.map(|s| s >> self.nx_log2);
+        let h = Self::jitter_hashes(set, base);
+        // Plain loops, not `array::map` / `from_fn`: those were left as out-of-line calls,
+        // which the target_feature copies below cannot widen.
+        let (mut sx, mut sy) = ([0u32; CHUNK], [0u32; CHUNK]);
+        let (mut jx, mut jy) = ([0u32; CHUNK], [0u32; CHUNK]);
+        for k in 0..CHUNK {
+            sx[k] = strata[k] & self.nx_mask;
+            sy[k] = strata[k] >> self.nx_log2;
+            jx[k] = h[k] as u32 >> 8;
+            jy[k] = (h[k] >> 40) as u32;
+        }
         let x = fixed_chunk(&sx, &jx, self.div_x, self.small_2d);
         let y = fixed_chunk(&sy, &jy, self.div_y, self.small_2d);
-        std::array::from_fn(|k| Vec2::new(x[k], y[k]))
+        let mut v = [Vec2::ZERO; CHUNK];
+        for k in 0..CHUNK {
+            v[k] = Vec2::new(x[k], y[k]);
+        }
+        v
     }
+
+    /// [`FastStrata::chunk_1d`] on `isa`.
+    #[inline(always)]
+    fn chunk_1d_on(&self, isa: ChunkIsa, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `ChunkIsa::detect` returned Avx512 only if the CPU has these features.
+            ChunkIsa::Avx512 => unsafe { self.chunk_1d_avx512(set, base) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `ChunkIsa::detect` returned Avx2 (or better) only if the CPU has AVX2.
+            ChunkIsa::Avx2 => unsafe { self.chunk_1d_avx2(set, base) },
+            _ => self.chunk_1d(set, base),
+        }
+    }
+
+    /// [`FastStrata::chunk_2d`] on `isa`.
+    #[inline(always)]
+    fn chunk_2d_on(&self, isa: ChunkIsa, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `chunk_1d_on`.
+            ChunkIsa::Avx512 => unsafe { self.chunk_2d_avx512(set, base) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `chunk_1d_on`.
+            ChunkIsa::Avx2 => unsafe { self.chunk_2d_avx2(set, base) },
+            _ => self.chunk_2d(set, base),
+        }
+    }
+
+    /// [`FastStrata::chunk_1d`] on AVX-512: power-of-two counts with small strata (the common
+    /// case) written with intrinsics, one 16-lane vector per step (compiled from the portable
+    /// loops, LLVM split the 16 lanes 8 + 4 + 2 + 1 + 1); the rest compiled for AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn chunk_1d_avx512(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+        use std::arch::x86_64::*;
+        if !(self.dom.is_pow2() && self.small_1d) {
+            return self.chunk_1d(set, base);
+        }
+        let strata = set.perm.apply_16_pow2_avx512(base, &self.dom);
+        let (jx, _) = jitters_avx512(set, base);
+        let v = fixed_small_avx512(strata, jx, self.div_1d);
+        let mut out = [0.0f32; CHUNK];
+        // SAFETY: `out` is 16 f32 = 64 bytes, the width of the unaligned store.
+        unsafe { _mm512_storeu_ps(out.as_mut_ptr(), v) };
+        out
+    }
+
+    /// [`FastStrata::chunk_2d`] on AVX-512 (see [`FastStrata::chunk_1d_avx512`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn chunk_2d_avx512(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+        use std::arch::x86_64::*;
+        if !(self.dom.is_pow2() && self.small_2d) {
+            return self.chunk_2d(set, base);
+        }
+        let strata = set.perm.apply_16_pow2_avx512(base, &self.dom);
+        let (jx, jy) = jitters_avx512(set, base);
+        let sx = _mm512_and_si512(strata, _mm512_set1_epi32(self.nx_mask as i32));
+        let sy = _mm512_srl_epi32(strata, _mm_cvtsi32_si128(self.nx_log2 as i32));
+        let x = fixed_small_avx512(sx, jx, self.div_x);
+        let y = fixed_small_avx512(sy, jy, self.div_y);
+        // Interleave to (x0, y0, x1, y1, ...): lanes ≥ 16 of the index pick from `y`.
+        let lo = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+        let hi = _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
+        let mut out = [Vec2::ZERO; CHUNK];
+        let p = out.as_mut_ptr() as *mut f32;
+        // SAFETY: `Vec2` is `repr(C)` (x, y), so `out` is 32 contiguous f32 = two 64-byte
+        // unaligned stores.
+        unsafe {
+            _mm512_storeu_ps(p, _mm512_permutex2var_ps(x, lo, y));
+            _mm512_storeu_ps(p.add(16), _mm512_permutex2var_ps(x, hi, y));
+        }
+        out
+    }
+
+    /// [`FastStrata::chunk_1d`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn chunk_1d_avx2(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+        self.chunk_1d(set, base)
+    }
+
+    /// [`FastStrata::chunk_2d`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn chunk_2d_avx2(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+        self.chunk_2d(set, base)
+    }
+}
+
+/// The 24-bit jitters (x, y) of indices `base..base + 16` of `set` on AVX-512: the same
+/// hashes as [`FastStrata::jitter_hashes`], 8 u64 lanes at a time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+fn jitters_avx512(
+    set: &SetKeys,
+    base: u32,
+) -> (std::arch::x86_64::__m512i, std::arch::x86_64::__m512i) {
+    use super::hash::mix64_avx512;
+    use std::arch::x86_64::*;
+    let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    // u32 indices (wrapping, as the scalar `base.wrapping_add(k)`), then zero-extended.
+    let idx = _mm512_add_epi32(_mm512_set1_epi32(base as i32), lanes);
+    let mul = _mm512_set1_epi64(HASH_INIT as i64);
+    let add = _mm512_set1_epi64(set.jitter_fast as i64);
+    let hash = |i: __m256i| {
+        let i = _mm512_cvtepu32_epi64(i);
+        mix64_avx512(_mm512_add_epi64(add, _mm512_mullo_epi64(i, mul)))
+    };
+    let h0 = hash(_mm512_castsi512_si256(idx));
+    let h1 = hash(_mm512_extracti64x4_epi64::<1>(idx));
+    // Low u32 of each lane (truncation, as `h as u32`), 16 lanes in one vector.
+    let join = |a: __m512i, b: __m512i| {
+        _mm512_inserti64x4::<1>(
+            _mm512_castsi256_si512(_mm512_cvtepi64_epi32(a)),
+            _mm512_cvtepi64_epi32(b),
+        )
+    };
+    let jx = _mm512_srli_epi32::<8>(join(h0, h1));
+    let jy = join(_mm512_srli_epi64::<40>(h0), _mm512_srli_epi64::<40>(h1));
+    (jx, jy)
+}
+
+/// The `small` form of [`fixed_chunk`] on 16 lanes: (stratum << 24 | j) as i32 → f32 (round
+/// to nearest, as `as f32`), IEEE division, then `v < 1⁻ ? v : 1⁻`, which is exactly
+/// `vminps(v, 1⁻)` (it returns the second operand unless v < 1⁻).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn fixed_small_avx512(
+    strata: std::arch::x86_64::__m512i,
+    j: std::arch::x86_64::__m512i,
+    div: f32,
+) -> std::arch::x86_64::__m512 {
+    use std::arch::x86_64::*;
+    let fixed = _mm512_or_si512(_mm512_slli_epi32::<24>(strata), j);
+    let v = _mm512_div_ps(_mm512_cvtepi32_ps(fixed), _mm512_set1_ps(div));
+    _mm512_min_ps(v, _mm512_set1_ps(ONE_MINUS_EPSILON))
 }
 
 /// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form that
 /// vectorises (the same values: the integer is the same and exact either way).
 #[inline(always)]
 fn fixed_chunk(strata: &[u32; CHUNK], j: &[u32; CHUNK], div: f32, small: bool) -> [f32; CHUNK] {
+    let mut out = [0.0f32; CHUNK];
     if small {
-        std::array::from_fn(|k| {
+        for k in 0..CHUNK {
             let v = ((strata[k] << 24) | j[k]) as i32 as f32 / div;
-            if v < ONE_MINUS_EPSILON {
+            out[k] = if v < ONE_MINUS_EPSILON {
                 v
             } else {
                 ONE_MINUS_EPSILON
-            }
-        })
+            };
+        }
     } else {
-        std::array::from_fn(|k| in_stratum_fixed(strata[k], j[k], div))
+        for k in 0..CHUNK {
+            out[k] = in_stratum_fixed(strata[k], j[k], div);
+        }
     }
+    out
 }
 
 /// 2^24: one in the 24-bit fixed point of the jitter.
@@ -647,7 +910,9 @@ impl PixelSamples {
                 count,
                 general: |p: &Pattern| p.sample_1d(self.pixel, dim, index, count),
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_1d(kind, i, st),
-                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_1d(set, base),
+                fast: |f: &FastStrata, set: &SetKeys, base| {
+                    f.chunk_1d_on(self.pattern.isa, set, base)
+                },
             },
         )
     }
@@ -675,7 +940,9 @@ impl PixelSamples {
                 count,
                 general: |p: &Pattern| p.sample_2d(self.pixel, dim, index, count),
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_2d(kind, i, st),
-                fast: |f: &FastStrata, set: &SetKeys, base| f.chunk_2d(set, base),
+                fast: |f: &FastStrata, set: &SetKeys, base| {
+                    f.chunk_2d_on(self.pattern.isa, set, base)
+                },
             },
         )
     }
@@ -763,13 +1030,24 @@ mod tests {
     fn pixel_samples_equal_the_pattern_values() {
         // The cached per-pixel path must return bit-identical values, in cached dimensions
         // and past them, for stratified counts and wrapped indices.
-        for kind in PatternKind::ALL {
-            let pat = Pattern { seed: 7, kind };
+        for (kind, isa) in PatternKind::ALL
+            .into_iter()
+            .flat_map(|k| ChunkIsa::available().into_iter().map(move |i| (k, i)))
+        {
+            let pat = Pattern { seed: 7, kind, isa };
             for pixel in [UVec2::new(0, 0), UVec2::new(13, 511)] {
                 let px = pat.pixel(pixel);
                 assert_eq!(px.pixel(), pixel);
                 for dim in [0u32, 3, 7, 8, 40] {
-                    for (index, count) in [(0u32, 1u32), (5, 16), (63, 64), (70, 64), (9, 37)] {
+                    for (index, count) in [
+                        (0u32, 1u32),
+                        (5, 16),
+                        (63, 64),
+                        (70, 64),
+                        (9, 37),
+                        (40_000, 1 << 16),
+                        (17, 1 << 18),
+                    ] {
                         assert_eq!(
                             px.sample_1d(dim, index, count).to_bits(),
                             pat.sample_1d(pixel, dim, index, count).to_bits(),

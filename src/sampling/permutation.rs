@@ -59,7 +59,13 @@ impl Permutation {
     #[inline]
     pub fn new(key: u64) -> Self {
         let k = super::hash::mix64(key);
-        let k2 = super::hash::mix64(k);
+        Self::from_mixed(k, super::hash::mix64(k))
+    }
+
+    /// [`Permutation::new`] from `k = mix64(key)` and `k2 = mix64(k)` (computed elsewhere,
+    /// e.g. 8 keys at a time on vectors).
+    #[inline]
+    pub(crate) fn from_mixed(k: u64, k2: u64) -> Self {
         let [k0, k1, k2, k3] = [k as u32, (k >> 32) as u32, k2 as u32, (k2 >> 32) as u32];
         Self {
             r: [
@@ -107,7 +113,7 @@ impl Permutation {
     pub fn apply_many<const N: usize>(&self, base: u32, dom: &PermDomain) -> [u32; N] {
         let (p, d) = (*self, *dom);
         let mut out = [0u32; N];
-        if d.mask.wrapping_add(1) == d.n {
+        if d.is_pow2() {
             for (k, o) in out.iter_mut().enumerate() {
                 let i = base.wrapping_add(k as u32);
                 *o = round(round(round(i, &p.r[0], &d), &p.r[1], &d), &p.r[2], &d);
@@ -119,6 +125,37 @@ impl Permutation {
             }
         }
         out
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Permutation {
+    /// [`Permutation::apply_many`] of the 16 indices `base..base + 16` as one AVX-512 vector,
+    /// for a power-of-two n only (the caller checks [`PermDomain::is_pow2`]): the same rounds,
+    /// lane for lane (u32 wrapping multiply, logical shifts by the same counts, masks).
+    #[target_feature(enable = "avx512f")]
+    pub(crate) fn apply_16_pow2_avx512(
+        &self,
+        base: u32,
+        dom: &PermDomain,
+    ) -> std::arch::x86_64::__m512i {
+        use std::arch::x86_64::*;
+        let mask = _mm512_set1_epi32(dom.mask as i32);
+        // Shift counts < 32 (bits ≤ 32), as the scalar `>>`.
+        let s1 = _mm_cvtsi32_si128(dom.s1 as i32);
+        let s2 = _mm_cvtsi32_si128(dom.s2 as i32);
+        let fixed = _mm512_set1_epi32(0x2c1b_3c6d);
+        let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+        let mut i = _mm512_add_epi32(_mm512_set1_epi32(base as i32), lanes);
+        for r in &self.r {
+            i = _mm512_xor_si512(i, _mm512_set1_epi32(r.x as i32));
+            i = _mm512_and_si512(_mm512_mullo_epi32(i, _mm512_set1_epi32(r.m as i32)), mask);
+            i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s1));
+            i = _mm512_add_epi32(i, _mm512_set1_epi32(r.a as i32));
+            i = _mm512_and_si512(_mm512_mullo_epi32(i, fixed), mask);
+            i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s2));
+        }
+        i
     }
 }
 
@@ -180,6 +217,12 @@ impl PermDomain {
     #[inline]
     pub fn mask(&self) -> u32 {
         self.mask
+    }
+
+    /// Whether n is a power of two (no cycle-walking: every round stays inside [0, n)).
+    #[inline]
+    pub fn is_pow2(&self) -> bool {
+        self.mask.wrapping_add(1) == self.n
     }
 
     /// Never true: the domain holds at least one element.
