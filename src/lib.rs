@@ -14,6 +14,7 @@ pub mod camera;
 pub mod geometry;
 pub mod image;
 pub mod integrator;
+pub mod isa;
 pub mod lab;
 pub mod light_selection;
 pub mod lights;

@@ -9,9 +9,8 @@ mod geometry_support;
 
 use geometry_support::{brute_force_t, random_rays, soup_with_quadrics, triangle_soup};
 use glam::{UVec2, Vec2, Vec3};
-use penumbra::geometry::{
-    Backend, Geometry, MeshShading, PACKET, PacketIsa, Primitive, Ray, RayQuery,
-};
+use penumbra::geometry::{Backend, Geometry, MeshShading, PACKET, Primitive, Ray, RayQuery};
+use penumbra::isa::Isa;
 use penumbra::sampling::{PatternKind, make_pattern};
 use penumbra::scene::Scene;
 
@@ -20,12 +19,7 @@ const MASKS: [u32; 5] = [0xffff, 0xa5c3, 0x0001, 0x8000, 0x7ffe];
 
 /// Every vector backend of the packet kernels (those this CPU lacks resolve to a narrower one,
 /// so they are still run, and the supported ones are checked: see `isas_resolve`).
-const ISAS: [PacketIsa; 4] = [
-    PacketIsa::Auto,
-    PacketIsa::Portable,
-    PacketIsa::Avx2,
-    PacketIsa::Avx512,
-];
+const ISAS: [Isa; 3] = [Isa::Portable, Isa::Avx2, Isa::Avx512];
 
 /// Compares packet and scalar queries over `rays` in packets of 16 on every vector backend;
 /// returns the number of hits.
@@ -37,7 +31,7 @@ fn check(g: &Geometry, rays: &[Ray]) -> u32 {
 }
 
 /// [`check`] on one backend.
-fn check_on(g: &Geometry, rays: &[Ray], isa: PacketIsa) -> u32 {
+fn check_on(g: &Geometry, rays: &[Ray], isa: Isa) -> u32 {
     let mut hits = 0;
     for (k, chunk) in rays.chunks_exact(PACKET).enumerate() {
         let pk: [Ray; PACKET] = std::array::from_fn(|i| chunk[i]);
@@ -247,18 +241,6 @@ fn packets_match_scalar_queries_on_duplicated_triangles() {
         }
     }
     assert!(check(&g, &rays) > 2000);
-}
-
-#[test]
-fn isas_resolve_to_supported_backends() {
-    // Portable stays portable; the others never resolve to something wider than asked.
-    assert_eq!(PacketIsa::Portable.resolve(), PacketIsa::Portable);
-    assert_ne!(PacketIsa::Avx2.resolve(), PacketIsa::Avx512);
-    assert_ne!(PacketIsa::Auto.resolve(), PacketIsa::Auto);
-    #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512dq") {
-        assert_eq!(PacketIsa::Auto.resolve(), PacketIsa::Avx512);
-    }
 }
 
 #[test]

@@ -7,7 +7,7 @@
 //! its own best distance, so a ray's box verdicts are the scalar ones, and a leaf's triangles
 //! are tested against the rays that passed its box, each lane doing [`RayShear4`]'s f32
 //! operations. The kernels are generic over the 16-lane vector type of `simd16` (AVX-512,
-//! AVX2 or portable lane loops, picked at run time: [`PacketIsa`]).
+//! AVX2 or portable lane loops, picked at run time: [`Isa`]).
 //!
 //! Why the closest hit is the scalar one: a triangle (or quadric) test accepts a hit exactly
 //! when it is valid and its t is below the current best (the t_max pre-filter never rejects
@@ -26,6 +26,7 @@ use super::tri4::{RayShear4, TriPacket};
 use super::triangle::{RayShear, shear_axes};
 use super::wide::{Bary, LEAF, Node4, STACK, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
+use crate::isa::Isa;
 use std::mem::MaybeUninit;
 
 /// Rays per packet query.
@@ -43,13 +44,13 @@ impl Geometry {
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.intersect_packet_on(PacketIsa::Auto, rays, active, out);
+        self.intersect_packet_on(Isa::detect(), rays, active, out);
     }
 
     /// [`Self::intersect_packet`] on a chosen vector backend (for tests and benchmarks).
     pub fn intersect_packet_on(
         &self,
-        isa: PacketIsa,
+        isa: Isa,
         rays: &[Ray; PACKET],
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
@@ -96,11 +97,11 @@ impl Geometry {
     /// rays enter is finished by the scalar query of each (incoherent shadow rays, e.g. on
     /// `dense`, would otherwise make the packet visit the union of the rays' subtrees).
     pub fn occluded_packet(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
-        self.occluded_packet_on(PacketIsa::Auto, rays, active)
+        self.occluded_packet_on(Isa::detect(), rays, active)
     }
 
     /// [`Self::occluded_packet`] on a chosen vector backend (for tests and benchmarks).
-    pub fn occluded_packet_on(&self, isa: PacketIsa, rays: &[Ray; PACKET], active: u32) -> u32 {
+    pub fn occluded_packet_on(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
         let active = active & PACKET_MASK;
         let Some(bvh) = self.wide() else {
             return bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i);
@@ -464,52 +465,18 @@ fn still_open<S: Simd>(near: &Lanes, best: &Lanes, mask: u32) -> u32 {
     S::bits(S::le(S::load(near), S::load(best))) & mask
 }
 
-/// The vector backend of the packet kernels (what [`Geometry::intersect_packet_on`] runs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PacketIsa {
-    /// The best one this CPU supports.
-    Auto,
-    /// Portable lane loops (any CPU).
-    Portable,
-    /// Two 256-bit vectors per 16 lanes (x86-64 with AVX2).
-    Avx2,
-    /// One 512-bit vector per 16 lanes (x86-64 with AVX-512F/DQ).
-    Avx512,
-}
-
-impl PacketIsa {
-    /// The backend that runs for `self` on this CPU (`Auto` resolved; unsupported ones fall
-    /// back to the next narrower).
-    pub fn resolve(self) -> PacketIsa {
-        #[cfg(target_arch = "x86_64")]
-        {
-            let avx512 = std::is_x86_feature_detected!("avx512f")
-                && std::is_x86_feature_detected!("avx512dq");
-            let avx2 = std::is_x86_feature_detected!("avx2");
-            match self {
-                PacketIsa::Auto | PacketIsa::Avx512 if avx512 => return PacketIsa::Avx512,
-                PacketIsa::Auto | PacketIsa::Avx512 | PacketIsa::Avx2 if avx2 => {
-                    return PacketIsa::Avx2;
-                }
-                _ => {}
-            }
-        }
-        PacketIsa::Portable
-    }
-}
-
 impl WideBvh {
     /// The rays `active` that enter the box of the root's first child before their t_max, on
     /// backend `isa`; for a single-leaf tree, bit i is `!self.single_leaf_missed(ray i)` (the
     /// same operations on the same values: `SingleLeaf::hit` is lane 0 of `Node4::hit`).
-    pub(super) fn root_box_packet(&self, isa: PacketIsa, rays: &[Ray; PACKET], active: u32) -> u32 {
-        match isa.resolve() {
+    pub(super) fn root_box_packet(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
+        match isa.supported() {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
-            PacketIsa::Avx512 => unsafe { self.root_box_avx512(rays, active) },
+            // SAFETY: `supported` returned Avx512, so the CPU has AVX-512F and DQ.
+            Isa::Avx512 => unsafe { self.root_box_avx512(rays, active) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
-            PacketIsa::Avx2 => unsafe { self.root_box_avx2(rays, active) },
+            // SAFETY: `supported` returned Avx2, so the CPU has AVX2.
+            Isa::Avx2 => unsafe { self.root_box_avx2(rays, active) },
             _ => self.root_box_impl::<Portable>(rays, active),
         }
     }
@@ -551,19 +518,19 @@ impl WideBvh {
     /// is the hit distance of a non-triangle primitive if below `t_max`, else +∞.
     pub(super) fn closest_packet(
         &self,
-        isa: PacketIsa,
+        isa: Isa,
         rays: &[Ray; PACKET],
         active: u32,
         out: &mut [LaneHit; PACKET],
         other: impl FnMut(usize, &Ray, f32) -> f32,
     ) -> (u32, u32) {
-        match isa.resolve() {
+        match isa.supported() {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
-            PacketIsa::Avx512 => unsafe { self.closest_packet_avx512(rays, active, out, other) },
+            // SAFETY: `supported` returned Avx512, so the CPU has AVX-512F and DQ.
+            Isa::Avx512 => unsafe { self.closest_packet_avx512(rays, active, out, other) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
-            PacketIsa::Avx2 => unsafe { self.closest_packet_avx2(rays, active, out, other) },
+            // SAFETY: `supported` returned Avx2, so the CPU has AVX2.
+            Isa::Avx2 => unsafe { self.closest_packet_avx2(rays, active, out, other) },
             _ => self.closest_packet_impl::<Portable>(rays, active, out, other),
         }
     }
@@ -598,19 +565,19 @@ impl WideBvh {
     /// `other(id, ray)` tells whether non-triangle primitive `id` blocks `ray`.
     pub(super) fn any_packet(
         &self,
-        isa: PacketIsa,
+        isa: Isa,
         rays: &[Ray; PACKET],
         active: u32,
         sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
-        match isa.resolve() {
+        match isa.supported() {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `resolve` returned Avx512, so the CPU has AVX-512F and DQ.
-            PacketIsa::Avx512 => unsafe { self.any_packet_avx512(rays, active, sparse, other) },
+            // SAFETY: `supported` returned Avx512, so the CPU has AVX-512F and DQ.
+            Isa::Avx512 => unsafe { self.any_packet_avx512(rays, active, sparse, other) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `resolve` returned Avx2, so the CPU has AVX2.
-            PacketIsa::Avx2 => unsafe { self.any_packet_avx2(rays, active, sparse, other) },
+            // SAFETY: `supported` returned Avx2, so the CPU has AVX2.
+            Isa::Avx2 => unsafe { self.any_packet_avx2(rays, active, sparse, other) },
             _ => self.any_packet_impl::<Portable>(rays, active, sparse, other),
         }
     }

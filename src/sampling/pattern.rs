@@ -37,6 +37,7 @@ use super::ONE_MINUS_EPSILON;
 use super::error::SamplingError;
 use super::hash::{HASH_INIT, hash_keys, hash_step, mix64, uniform_pair};
 use super::permutation::{PermDomain, Permutation};
+use crate::isa::Isa;
 use std::cell::Cell;
 
 /// The pattern names accepted by `--pattern`.
@@ -148,52 +149,11 @@ pub struct Pattern {
     pub seed: u64,
     /// Which pattern.
     pub kind: PatternKind,
-    /// The instruction set of the `stratified` chunk fills (detected once, in [`Pattern::new`]).
-    isa: ChunkIsa,
-}
-
-/// The instruction set a `stratified` chunk fill is compiled for: the default x86-64 target
-/// has SSE2 only (4 u32 lanes, no 64-bit vector multiply), so the same code is also compiled
-/// for AVX2 and AVX-512 (16 u32 lanes = one vector) and picked at run time. Every version
-/// computes the same values (integer ops, exact conversions, IEEE division, a compare-select).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum ChunkIsa {
-    /// Whatever the build target has.
-    Portable,
-    /// x86-64 with AVX2.
-    Avx2,
-    /// x86-64 with AVX-512 F/BW/DQ/VL.
-    Avx512,
-}
-
-impl ChunkIsa {
-    /// The widest one this CPU supports.
-    fn detect() -> Self {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::is_x86_feature_detected!("avx512f")
-                && std::is_x86_feature_detected!("avx512bw")
-                && std::is_x86_feature_detected!("avx512dq")
-                && std::is_x86_feature_detected!("avx512vl")
-            {
-                return ChunkIsa::Avx512;
-            }
-            if std::is_x86_feature_detected!("avx2") {
-                return ChunkIsa::Avx2;
-            }
-        }
-        ChunkIsa::Portable
-    }
-
-    /// Every version this CPU can run (for tests).
-    #[cfg(test)]
-    fn available() -> Vec<Self> {
-        let best = Self::detect();
-        [ChunkIsa::Portable, ChunkIsa::Avx2, ChunkIsa::Avx512]
-            .into_iter()
-            .filter(|&i| i as u8 <= best as u8)
-            .collect()
-    }
+    /// The instruction set of the `stratified` chunk fills, detected once in [`Pattern::new`]:
+    /// the default x86-64 target has SSE2 only (4 u32 lanes, no 64-bit vector multiply), so
+    /// they are also compiled for AVX2 and AVX-512 (16 u32 lanes = one vector), with the same
+    /// values (integer ops, exact conversions, IEEE division, a compare-select).
+    isa: Isa,
 }
 
 impl Pattern {
@@ -202,7 +162,7 @@ impl Pattern {
         Self {
             seed,
             kind,
-            isa: ChunkIsa::detect(),
+            isa: Isa::detect(),
         }
     }
 
@@ -412,8 +372,8 @@ impl SamplePattern for Pattern {
 
     fn pixel(&self, pixel: UVec2) -> PixelSamples {
         #[cfg(target_arch = "x86_64")]
-        if self.kind == PatternKind::Stratified && self.isa == ChunkIsa::Avx512 {
-            // SAFETY: `ChunkIsa::detect` returned Avx512 only if the CPU has these features.
+        if self.kind == PatternKind::Stratified && self.isa == Isa::Avx512 {
+            // SAFETY: `Isa::detect` returned Avx512 only if the CPU has these features.
             return unsafe { self.pixel_stratified_avx512(pixel) };
         }
         let prefix = self.pixel_hash(pixel);
@@ -597,28 +557,29 @@ impl FastStrata {
 
     /// [`FastStrata::chunk_1d`] on `isa`.
     #[inline(always)]
-    fn chunk_1d_on(&self, isa: ChunkIsa, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+    fn chunk_1d_on(&self, isa: Isa, set: &SetKeys, base: u32) -> [f32; CHUNK] {
         match isa {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `ChunkIsa::detect` returned Avx512 only if the CPU has these features.
-            ChunkIsa::Avx512 => unsafe { self.chunk_1d_avx512(set, base) },
+            // SAFETY: `isa` is `Pattern::isa` (from `Isa::detect`) or, in tests, one of
+            // `Isa::available`: a set this CPU runs, here AVX-512 F/BW/DQ/VL.
+            Isa::Avx512 => unsafe { self.chunk_1d_avx512(set, base) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `ChunkIsa::detect` returned Avx2 (or better) only if the CPU has AVX2.
-            ChunkIsa::Avx2 => unsafe { self.chunk_1d_avx2(set, base) },
+            // SAFETY: as above, a set this CPU runs: AVX2.
+            Isa::Avx2 => unsafe { self.chunk_1d_avx2(set, base) },
             _ => self.chunk_1d(set, base),
         }
     }
 
     /// [`FastStrata::chunk_2d`] on `isa`.
     #[inline(always)]
-    fn chunk_2d_on(&self, isa: ChunkIsa, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+    fn chunk_2d_on(&self, isa: Isa, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as in `chunk_1d_on`.
-            ChunkIsa::Avx512 => unsafe { self.chunk_2d_avx512(set, base) },
+            Isa::Avx512 => unsafe { self.chunk_2d_avx512(set, base) },
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as in `chunk_1d_on`.
-            ChunkIsa::Avx2 => unsafe { self.chunk_2d_avx2(set, base) },
+            Isa::Avx2 => unsafe { self.chunk_2d_avx2(set, base) },
             _ => self.chunk_2d(set, base),
         }
     }
@@ -1032,7 +993,7 @@ mod tests {
         // and past them, for stratified counts and wrapped indices.
         for (kind, isa) in PatternKind::ALL
             .into_iter()
-            .flat_map(|k| ChunkIsa::available().into_iter().map(move |i| (k, i)))
+            .flat_map(|k| Isa::available().into_iter().map(move |i| (k, i)))
         {
             let pat = Pattern { seed: 7, kind, isa };
             for pixel in [UVec2::new(0, 0), UVec2::new(13, 511)] {
