@@ -10,8 +10,8 @@ use glam::{Mat4, Vec2, Vec3};
 use lights_support::{check, chi2_light, hit_disk, hit_quad, hit_triangle, v2};
 use penumbra::geometry::Transform;
 use penumbra::lights::{
-    DiskLight, EnvMapLight, Light, LightSampleContext, LightSource, QuadLight, SamplingMode,
-    SphereLight, TriangleLight,
+    DiskLight, Emitter, EnvMapLight, Light, LightSampleContext, LightSource, QuadLight,
+    SamplingMode, SphereLight, TriangleLight,
 };
 use penumbra::material::texture::ImageRgb;
 use penumbra::sampling::Frame;

@@ -10,8 +10,9 @@ use glam::{DVec3, Mat4, Vec3};
 use lights_support::{check_estimate, irradiance};
 use penumbra::geometry::Transform;
 use penumbra::lights::{
-    DiskLight, DistantLight, EnvMapLight, Light, LightSampleContext, LightSource, PointLight,
-    QuadLight, SamplingMode, SphereLight, SpotLight, TriangleLight, UniformInfiniteLight,
+    DiskLight, DistantLight, Emitter, EnvMapLight, Light, LightSampleContext, LightSource,
+    PointLight, QuadLight, SamplingMode, SphereLight, SpotLight, TriangleLight,
+    UniformInfiniteLight,
 };
 use penumbra::material::texture::ImageRgb;
 use std::f64::consts::PI;

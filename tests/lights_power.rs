@@ -8,8 +8,9 @@ use glam::{Mat4, Vec2, Vec3};
 use lights_support::check_estimate;
 use penumbra::geometry::Transform;
 use penumbra::lights::{
-    DiskLight, DistantLight, EnvMapLight, Light, LightSampleContext, LightSource, PointLight,
-    QuadLight, SamplingMode, SphereLight, SpotLight, TriangleLight, UniformInfiniteLight,
+    DiskLight, DistantLight, Emitter, EnvMapLight, Light, LightSampleContext, LightSource,
+    PointLight, QuadLight, SamplingMode, SphereLight, SpotLight, TriangleLight,
+    UniformInfiniteLight,
 };
 use penumbra::luminance;
 use penumbra::material::texture::ImageRgb;

@@ -12,7 +12,7 @@ use crate::bsdf::{Bsdf, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::{Geometry, PACKET, Ray, SurfaceHit};
 use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
-use crate::lights::{LightSampleContext, LightSource, SamplingMode};
+use crate::lights::{Emitter, LightSampleContext, LightSource, SamplingMode};
 use crate::sampling::{Frame, PixelSamples, SamplePattern, balance_heuristic, power_heuristic};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};

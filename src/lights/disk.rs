@@ -5,8 +5,9 @@
 //! because `pdf_li` ignores the mode in the same way.
 
 use super::{
-    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
-    area_to_solid_angle, diffuse_power, is_positive, planar_radiance, sees_emitting_side,
+    Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode,
+    area_sample, area_to_solid_angle, diffuse_power, is_positive, planar_radiance,
+    sees_emitting_side,
 };
 use crate::Rgb;
 use crate::sampling::{Frame, concentric_disk};
@@ -72,24 +73,6 @@ impl LightSource for DiskLight {
         area_sample(ctx.p, p_light, self.frame.n, 1.0 / self.area(), self.l)
     }
 
-    fn pdf_li(
-        &self,
-        ctx: &LightSampleContext,
-        _wi: Vec3,
-        p_light: Vec3,
-        _n_light: Vec3,
-        _mode: SamplingMode,
-    ) -> f32 {
-        if !self.faces(ctx.p) {
-            return 0.0;
-        }
-        area_to_solid_angle(1.0 / self.area(), ctx.p, p_light, self.frame.n)
-    }
-
-    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        planar_radiance(self.frame.n, self.l, self.two_sided, w)
-    }
-
     fn power(&self) -> f32 {
         diffuse_power(self.l, self.area(), self.two_sided)
     }
@@ -111,5 +94,25 @@ impl LightSource for DiskLight {
             cos_theta_e: 0.0,
             two_sided: self.two_sided,
         })
+    }
+}
+
+impl Emitter for DiskLight {
+    fn pdf_li(
+        &self,
+        ctx: &LightSampleContext,
+        _wi: Vec3,
+        p_light: Vec3,
+        _n_light: Vec3,
+        _mode: SamplingMode,
+    ) -> f32 {
+        if !self.faces(ctx.p) {
+            return 0.0;
+        }
+        area_to_solid_angle(1.0 / self.area(), ctx.p, p_light, self.frame.n)
+    }
+
+    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
+        planar_radiance(self.frame.n, self.l, self.two_sided, w)
     }
 }

@@ -55,15 +55,6 @@ impl LightSource for DistantLight {
         })
     }
 
-    /// Zero: no sampled direction hits a delta direction.
-    fn pdf_li(&self, _: &LightSampleContext, _: Vec3, _: Vec3, _: Vec3, _: SamplingMode) -> f32 {
-        0.0
-    }
-
-    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, _w: Vec3) -> Rgb {
-        Rgb::ZERO
-    }
-
     /// Power through the scene's bounding disk, π r² L.
     fn power(&self) -> f32 {
         PI * self.scene_radius * self.scene_radius * luminance(self.l)

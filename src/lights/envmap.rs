@@ -12,7 +12,7 @@
 
 use super::distant::DEFAULT_SCENE_RADIUS;
 use super::{
-    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, far_point,
+    Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, far_point,
     is_positive,
 };
 use crate::material::texture::ImageRgb;
@@ -206,6 +206,17 @@ impl LightSource for EnvMapLight {
         })
     }
 
+    /// Flux entering the scene's bounding sphere, 4πr² · π · mean L (pbrt-v4).
+    fn power(&self) -> f32 {
+        4.0 * PI * PI * self.scene_radius * self.scene_radius * self.mean_luminance
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        None
+    }
+}
+
+impl Emitter for EnvMapLight {
     fn pdf_li(
         &self,
         _ctx: &LightSampleContext,
@@ -223,14 +234,5 @@ impl LightSource for EnvMapLight {
 
     fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
         self.lookup(self.direction_to_uv(w).0)
-    }
-
-    /// Flux entering the scene's bounding sphere, 4πr² · π · mean L (pbrt-v4).
-    fn power(&self) -> f32 {
-        4.0 * PI * PI * self.scene_radius * self.scene_radius * self.mean_luminance
-    }
-
-    fn bounds(&self) -> Option<LightBounds> {
-        None
     }
 }

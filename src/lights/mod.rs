@@ -70,6 +70,17 @@ pub trait LightSource {
         u: Vec2,
         mode: SamplingMode,
     ) -> Option<LightLiSample>;
+    /// Total emitted power Φ (luminance, W-equivalent) — for power-proportional selection.
+    fn power(&self) -> f32;
+    /// Bounds for light-BVH selection; `None` for infinite lights (sampled separately).
+    fn bounds(&self) -> Option<LightBounds>;
+}
+
+/// What the lights that rays can reach (area and infinite lights) add to [`LightSource`]: the
+/// radiance a ray finds on them and the pdf with which `sample_li` draws a direction. Delta
+/// lights (point, spot, distant) have neither — no ray hits them — so only [`Light`] answers
+/// for them (zero), and a new area light cannot inherit a silent zero.
+pub trait Emitter: LightSource {
     /// Solid-angle pdf that `sample_li` would draw direction `wi` which hits the light at
     /// `p_light` with light normal `n_light` (for infinite lights, only `wi` matters).
     fn pdf_li(
@@ -81,12 +92,8 @@ pub trait LightSource {
         mode: SamplingMode,
     ) -> f32;
     /// Emitted radiance leaving the light's surface at `p` with normal `n` in direction `w`
-    /// (area lights), or arriving from direction -`w` (infinite lights). Zero for delta lights.
+    /// (area lights), or arriving from direction -`w` (infinite lights).
     fn radiance(&self, p: Vec3, n: Vec3, uv: Vec2, w: Vec3) -> Rgb;
-    /// Total emitted power Φ (luminance, W-equivalent) — for power-proportional selection.
-    fn power(&self) -> f32;
-    /// Bounds for light-BVH selection; `None` for infinite lights (sampled separately).
-    fn bounds(&self) -> Option<LightBounds>;
 }
 
 /// Convert an area pdf at a point `p_light` with normal `n_light`, seen from `p`, to a
@@ -212,6 +219,31 @@ impl LightSource for Light {
     ) -> Option<LightLiSample> {
         dispatch!(self, l => l.sample_li(ctx, u, mode))
     }
+    fn power(&self) -> f32 {
+        dispatch!(self, l => l.power())
+    }
+    fn bounds(&self) -> Option<LightBounds> {
+        dispatch!(self, l => l.bounds())
+    }
+}
+
+/// [`dispatch!`] over the lights that are [`Emitter`]s; `$delta` for point, spot and distant
+/// lights, which no ray can hit.
+macro_rules! dispatch_emitter {
+    ($self:expr, $l:ident => $body:expr, $delta:expr) => {
+        match $self {
+            Light::Triangle($l) => $body,
+            Light::Quad($l) => $body,
+            Light::Sphere($l) => $body,
+            Light::Disk($l) => $body,
+            Light::UniformInfinite($l) => $body,
+            Light::EnvMap($l) => $body,
+            Light::Point(_) | Light::Spot(_) | Light::Distant(_) => $delta,
+        }
+    };
+}
+
+impl Emitter for Light {
     #[inline]
     fn pdf_li(
         &self,
@@ -221,17 +253,11 @@ impl LightSource for Light {
         n_light: Vec3,
         mode: SamplingMode,
     ) -> f32 {
-        dispatch!(self, l => l.pdf_li(ctx, wi, p_light, n_light, mode))
+        dispatch_emitter!(self, l => l.pdf_li(ctx, wi, p_light, n_light, mode), 0.0)
     }
     #[inline]
     fn radiance(&self, p: Vec3, n: Vec3, uv: Vec2, w: Vec3) -> Rgb {
-        dispatch!(self, l => l.radiance(p, n, uv, w))
-    }
-    fn power(&self) -> f32 {
-        dispatch!(self, l => l.power())
-    }
-    fn bounds(&self) -> Option<LightBounds> {
-        dispatch!(self, l => l.bounds())
+        dispatch_emitter!(self, l => l.radiance(p, n, uv, w), Rgb::ZERO)
     }
 }
 

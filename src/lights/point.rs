@@ -45,15 +45,6 @@ impl LightSource for PointLight {
         })
     }
 
-    /// Zero: no sampled direction can hit a point.
-    fn pdf_li(&self, _: &LightSampleContext, _: Vec3, _: Vec3, _: Vec3, _: SamplingMode) -> f32 {
-        0.0
-    }
-
-    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, _w: Vec3) -> Rgb {
-        Rgb::ZERO
-    }
-
     fn power(&self) -> f32 {
         4.0 * PI * luminance(self.intensity)
     }

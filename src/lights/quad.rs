@@ -3,8 +3,8 @@
 //! [`crate::sampling::SphericalRectangle`]) when the edges are perpendicular.
 
 use super::{
-    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
-    diffuse_power, is_positive, planar_pdf_li, planar_radiance, sees_emitting_side,
+    Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode,
+    area_sample, diffuse_power, is_positive, planar_pdf_li, planar_radiance, sees_emitting_side,
     solid_angle_sample, spherical_ok, triangle_solid_angle,
 };
 use crate::Rgb;
@@ -122,28 +122,6 @@ impl LightSource for QuadLight {
         }
     }
 
-    fn pdf_li(
-        &self,
-        ctx: &LightSampleContext,
-        _wi: Vec3,
-        p_light: Vec3,
-        _n_light: Vec3,
-        mode: SamplingMode,
-    ) -> f32 {
-        planar_pdf_li(
-            self.faces(ctx.p),
-            || self.spherical_omega(ctx.p, mode),
-            self.area,
-            ctx.p,
-            p_light,
-            self.n,
-        )
-    }
-
-    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        planar_radiance(self.n, self.l, self.two_sided, w)
-    }
-
     fn power(&self) -> f32 {
         diffuse_power(self.l, self.area, self.two_sided)
     }
@@ -166,5 +144,29 @@ impl LightSource for QuadLight {
             cos_theta_e: 0.0,
             two_sided: self.two_sided,
         })
+    }
+}
+
+impl Emitter for QuadLight {
+    fn pdf_li(
+        &self,
+        ctx: &LightSampleContext,
+        _wi: Vec3,
+        p_light: Vec3,
+        _n_light: Vec3,
+        mode: SamplingMode,
+    ) -> f32 {
+        planar_pdf_li(
+            self.faces(ctx.p),
+            || self.spherical_omega(ctx.p, mode),
+            self.area,
+            ctx.p,
+            p_light,
+            self.n,
+        )
+    }
+
+    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
+        planar_radiance(self.n, self.l, self.two_sided, w)
     }
 }

@@ -5,8 +5,8 @@
 //! area sampling is used in both modes.
 
 use super::{
-    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
-    area_to_solid_angle, is_positive, solid_angle_sample,
+    Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode,
+    area_sample, area_to_solid_angle, is_positive, solid_angle_sample,
 };
 use crate::sampling::{Frame, uniform_cone_sin2, uniform_cone_sin2_pdf, uniform_sphere};
 use crate::{Rgb, luminance};
@@ -128,6 +128,26 @@ impl LightSource for SphereLight {
         }
     }
 
+    fn power(&self) -> f32 {
+        luminance(self.l) * PI * 4.0 * PI * self.radius * self.radius
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        let r = Vec3::splat(self.radius);
+        Some(LightBounds {
+            min: self.center - r,
+            max: self.center + r,
+            w: Vec3::Z,
+            phi: self.power(),
+            // Normals point everywhere.
+            cos_theta_o: -1.0,
+            cos_theta_e: 0.0,
+            two_sided: false,
+        })
+    }
+}
+
+impl Emitter for SphereLight {
     /// The hit point is recomputed from `wi` (first visible intersection), so `p_light` and
     /// `n_light` are not needed and a caller's rounding cannot make the pdf inconsistent.
     fn pdf_li(
@@ -160,23 +180,5 @@ impl LightSource for SphereLight {
         } else {
             Rgb::ZERO
         }
-    }
-
-    fn power(&self) -> f32 {
-        luminance(self.l) * PI * 4.0 * PI * self.radius * self.radius
-    }
-
-    fn bounds(&self) -> Option<LightBounds> {
-        let r = Vec3::splat(self.radius);
-        Some(LightBounds {
-            min: self.center - r,
-            max: self.center + r,
-            w: Vec3::Z,
-            phi: self.power(),
-            // Normals point everywhere.
-            cos_theta_o: -1.0,
-            cos_theta_e: 0.0,
-            two_sided: false,
-        })
     }
 }

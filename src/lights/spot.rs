@@ -100,15 +100,6 @@ impl LightSource for SpotLight {
         })
     }
 
-    /// Zero: no sampled direction can hit a point.
-    fn pdf_li(&self, _: &LightSampleContext, _: Vec3, _: Vec3, _: Vec3, _: SamplingMode) -> f32 {
-        0.0
-    }
-
-    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, _w: Vec3) -> Rgb {
-        Rgb::ZERO
-    }
-
     /// ∫ I(ω) dω: full intensity over the inner cap, and the smoothstep integrates to half the
     /// band's solid angle (it is symmetric about its midpoint in cos θ) — pbrt-v4's formula.
     fn power(&self) -> f32 {

@@ -2,8 +2,8 @@
 //! (Arvo's spherical triangle, [`crate::sampling::SphericalTriangle`]).
 
 use super::{
-    LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, area_sample,
-    diffuse_power, is_positive, planar_pdf_li, planar_radiance, sees_emitting_side,
+    Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode,
+    area_sample, diffuse_power, is_positive, planar_pdf_li, planar_radiance, sees_emitting_side,
     solid_angle_sample, spherical_ok, triangle_solid_angle,
 };
 use crate::Rgb;
@@ -98,6 +98,26 @@ impl LightSource for TriangleLight {
         area_sample(ctx.p, p_light, self.n, 1.0 / self.area, self.l)
     }
 
+    fn power(&self) -> f32 {
+        diffuse_power(self.l, self.area, self.two_sided)
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        let min = self.p[0].min(self.p[1]).min(self.p[2]);
+        let max = self.p[0].max(self.p[1]).max(self.p[2]);
+        Some(LightBounds {
+            min,
+            max,
+            w: self.n,
+            phi: self.power(),
+            cos_theta_o: 1.0,
+            cos_theta_e: 0.0,
+            two_sided: self.two_sided,
+        })
+    }
+}
+
+impl Emitter for TriangleLight {
     fn pdf_li(
         &self,
         ctx: &LightSampleContext,
@@ -118,23 +138,5 @@ impl LightSource for TriangleLight {
 
     fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
         planar_radiance(self.n, self.l, self.two_sided, w)
-    }
-
-    fn power(&self) -> f32 {
-        diffuse_power(self.l, self.area, self.two_sided)
-    }
-
-    fn bounds(&self) -> Option<LightBounds> {
-        let min = self.p[0].min(self.p[1]).min(self.p[2]);
-        let max = self.p[0].max(self.p[1]).max(self.p[2]);
-        Some(LightBounds {
-            min,
-            max,
-            w: self.n,
-            phi: self.power(),
-            cos_theta_o: 1.0,
-            cos_theta_e: 0.0,
-            two_sided: self.two_sided,
-        })
     }
 }

@@ -2,7 +2,9 @@
 //! uniformly over the sphere.
 
 use super::distant::DEFAULT_SCENE_RADIUS;
-use super::{LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, far_point};
+use super::{
+    Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode, far_point,
+};
 use crate::sampling::{uniform_sphere, uniform_sphere_pdf};
 use crate::{Rgb, luminance};
 use glam::{Vec2, Vec3};
@@ -53,14 +55,6 @@ impl LightSource for UniformInfiniteLight {
         })
     }
 
-    fn pdf_li(&self, _: &LightSampleContext, _: Vec3, _: Vec3, _: Vec3, _: SamplingMode) -> f32 {
-        uniform_sphere_pdf()
-    }
-
-    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, _w: Vec3) -> Rgb {
-        self.l
-    }
-
     /// Flux entering the scene's bounding sphere, 4πr² · πL (pbrt-v4): on the same scale as
     /// a distant light's π r² L, which enters through the sphere's cross-section.
     fn power(&self) -> f32 {
@@ -69,5 +63,15 @@ impl LightSource for UniformInfiniteLight {
 
     fn bounds(&self) -> Option<LightBounds> {
         None
+    }
+}
+
+impl Emitter for UniformInfiniteLight {
+    fn pdf_li(&self, _: &LightSampleContext, _: Vec3, _: Vec3, _: Vec3, _: SamplingMode) -> f32 {
+        uniform_sphere_pdf()
+    }
+
+    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, _w: Vec3) -> Rgb {
+        self.l
     }
 }

@@ -5,7 +5,7 @@
 #![allow(dead_code)]
 
 use glam::{DVec3, Vec2, Vec3};
-use penumbra::lights::{Light, LightSampleContext, LightSource, SamplingMode};
+use penumbra::lights::{Emitter, Light, LightSampleContext, LightSource, SamplingMode};
 use penumbra::sampling::Frame;
 use penumbra::sampling::chi2::{Chi2Config, Chi2Result, chi2_directions, chi2_points};
 use penumbra::sampling::hash::{next_f32, pcg_from_keys};
