@@ -442,8 +442,8 @@ impl Pattern {
 }
 
 /// The shape of a `stratified` sample set of `count` points in the integer form of the
-/// [`PixelSamples`] fast path; only usable (`valid`) for counts whose grid has a power-of-two
-/// width and at most 2^24 strata (where the fixed-point arithmetic below is exact).
+/// [`PixelSamples`] fast path; only usable (`valid`) for counts of at most 2^24 strata (where
+/// the fixed-point arithmetic and the f32 cell split below are exact).
 #[derive(Clone, Copy, Debug)]
 struct FastStrata {
     /// The `count` argument this was made for; `u64::MAX` (no u32 count) marks an empty slot.
@@ -452,9 +452,11 @@ struct FastStrata {
     valid: bool,
     /// Permutation domain [0, count).
     dom: PermDomain,
-    /// nx − 1 (nx a power of two).
+    /// Grid width nx.
+    nx: u32,
+    /// nx − 1 (used when nx is a power of two).
     nx_mask: u32,
-    /// log2(nx).
+    /// log2(nx) when nx is a power of two, else `u32::MAX` (the cell split then divides).
     nx_log2: u32,
     /// count · 2^24, nx · 2^24, ny · 2^24 (exact in f32): the divisors of a stratum index
     /// with its 24-bit jitter appended as fraction bits.
@@ -473,6 +475,7 @@ impl FastStrata {
         key: u64::MAX,
         valid: false,
         dom: PermDomain::ONE,
+        nx: 1,
         nx_mask: 0,
         nx_log2: 0,
         div_1d: FIX_ONE,
@@ -485,7 +488,7 @@ impl FastStrata {
     /// The fast form of `count` (`valid` if it has one).
     fn new(count: u32) -> Self {
         let st = Strata::new(count);
-        if st.nx_log2 == u32::MAX || st.count > 1 << 24 {
+        if st.count > 1 << 24 {
             return Self {
                 key: count as u64,
                 ..Self::NONE
@@ -495,14 +498,21 @@ impl FastStrata {
             key: count as u64,
             valid: true,
             dom: st.dom,
+            nx: st.nx,
             nx_mask: st.nx - 1,
             nx_log2: st.nx_log2,
             div_1d: st.count as f32 * FIX_ONE,
             div_x: st.nx as f32 * FIX_ONE,
             div_y: st.ny as f32 * FIX_ONE,
-            // Bounds of every computed index, including the unspecified ones past `count`.
+            // Bounds of every computed index, including the unspecified ones past `count`
+            // (below 2^bits for a power-of-two domain, below n otherwise).
             small_1d: st.dom.mask() < 1 << 7,
-            small_2d: st.nx - 1 < 1 << 7 && st.dom.mask() >> st.nx_log2 < 1 << 7,
+            small_2d: st.nx - 1 < 1 << 7
+                && if st.dom.is_pow2() {
+                    st.dom.mask() >> st.nx_log2 < 1 << 7
+                } else {
+                    (st.count - 1) / st.nx < 1 << 7
+                },
         }
     }
 
@@ -540,9 +550,17 @@ impl FastStrata {
         // which the target_feature copies below cannot widen.
         let (mut sx, mut sy) = ([0u32; CHUNK], [0u32; CHUNK]);
         let (mut jx, mut jy) = ([0u32; CHUNK], [0u32; CHUNK]);
+        if self.nx_log2 != u32::MAX {
+            for k in 0..CHUNK {
+                sx[k] = strata[k] & self.nx_mask;
+                sy[k] = strata[k] >> self.nx_log2;
+            }
+        } else {
+            for k in 0..CHUNK {
+                (sx[k], sy[k]) = split_f32(strata[k], self.nx);
+            }
+        }
         for k in 0..CHUNK {
-            sx[k] = strata[k] & self.nx_mask;
-            sy[k] = strata[k] >> self.nx_log2;
             jx[k] = h[k] as u32 >> 8;
             jy[k] = (h[k] >> 40) as u32;
         }
@@ -584,17 +602,18 @@ impl FastStrata {
         }
     }
 
-    /// [`FastStrata::chunk_1d`] on AVX-512: power-of-two counts with small strata (the common
-    /// case) written with intrinsics, one 16-lane vector per step (compiled from the portable
-    /// loops, LLVM split the 16 lanes 8 + 4 + 2 + 1 + 1); the rest compiled for AVX-512.
+    /// [`FastStrata::chunk_1d`] on AVX-512: counts with small strata (the common case, any
+    /// count since the permutation cycle-walks on lane masks) written with intrinsics, one
+    /// 16-lane vector per step (compiled from the portable loops, LLVM split the 16 lanes
+    /// 8 + 4 + 2 + 1 + 1); the rest compiled for AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     fn chunk_1d_avx512(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
         use std::arch::x86_64::*;
-        if !(self.dom.is_pow2() && self.small_1d) {
+        if !self.small_1d {
             return self.chunk_1d(set, base);
         }
-        let strata = set.perm.apply_16_pow2_avx512(base, &self.dom);
+        let strata = set.perm.apply_16_avx512(base, &self.dom);
         let (jx, _) = jitters_avx512(set, base);
         let v = fixed_small_avx512(strata, jx, self.div_1d);
         let mut out = [0.0f32; CHUNK];
@@ -608,13 +627,25 @@ impl FastStrata {
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     fn chunk_2d_avx512(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
         use std::arch::x86_64::*;
-        if !(self.dom.is_pow2() && self.small_2d) {
+        if !self.small_2d {
             return self.chunk_2d(set, base);
         }
-        let strata = set.perm.apply_16_pow2_avx512(base, &self.dom);
+        let strata = set.perm.apply_16_avx512(base, &self.dom);
         let (jx, jy) = jitters_avx512(set, base);
-        let sx = _mm512_and_si512(strata, _mm512_set1_epi32(self.nx_mask as i32));
-        let sy = _mm512_srl_epi32(strata, _mm_cvtsi32_si128(self.nx_log2 as i32));
+        let (sx, sy) = if self.nx_log2 != u32::MAX {
+            (
+                _mm512_and_si512(strata, _mm512_set1_epi32(self.nx_mask as i32)),
+                _mm512_srl_epi32(strata, _mm_cvtsi32_si128(self.nx_log2 as i32)),
+            )
+        } else {
+            // `split_f32` on 16 lanes (exact conversions, IEEE division, truncation).
+            let nx = _mm512_set1_epi32(self.nx as i32);
+            let q = _mm512_cvttps_epu32(_mm512_div_ps(
+                _mm512_cvtepi32_ps(strata),
+                _mm512_cvtepi32_ps(nx),
+            ));
+            (_mm512_sub_epi32(strata, _mm512_mullo_epi32(q, nx)), q)
+        };
         let x = fixed_small_avx512(sx, jx, self.div_x);
         let y = fixed_small_avx512(sy, jy, self.div_y);
         // Interleave to (x0, y0, x1, y1, ...): lanes ≥ 16 of the index pick from `y`.
@@ -693,6 +724,16 @@ fn fixed_small_avx512(
     let fixed = _mm512_or_si512(_mm512_slli_epi32::<24>(strata), j);
     let v = _mm512_div_ps(_mm512_cvtepi32_ps(fixed), _mm512_set1_ps(div));
     _mm512_min_ps(v, _mm512_set1_ps(ONE_MINUS_EPSILON))
+}
+
+/// (s mod nx, s / nx) for s, nx < 2^24 through an f32 division, which vectorises (a u32
+/// division does not). Exact: s and nx convert exactly; if nx divides s the quotient q is
+/// exact, else s/nx = q + r/nx lies at least 1/nx below q + 1 while half an ulp of it is at
+/// most 2^-24 · s/nx < 1/nx, so the rounded quotient stays in [q, q + 1) and truncates to q.
+#[inline(always)]
+fn split_f32(s: u32, nx: u32) -> (u32, u32) {
+    let q = (s as f32 / nx as f32) as u32;
+    (s - q * nx, q)
 }
 
 /// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form that

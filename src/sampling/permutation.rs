@@ -107,21 +107,30 @@ impl Permutation {
 
 impl Permutation {
     /// The images of the `N` consecutive indices `base..base + N` (each < n), computed in one
-    /// loop that the compiler can vectorise when n is a power of two (no cycle-walking).
+    /// loop that the compiler can vectorise: for a power of two n (no cycle-walking) the three
+    /// rounds once; otherwise every lane walks its cycle until all lanes are inside [0, n)
+    /// (lanes already inside keep their value, so each is the scalar [`Permutation::apply_wrapped`]).
     /// Entries for indices ≥ n (when base + N > n) are unspecified.
     #[inline(always)]
     pub fn apply_many<const N: usize>(&self, base: u32, dom: &PermDomain) -> [u32; N] {
         let (p, d) = (*self, *dom);
+        let rounds = |i: u32| round(round(round(i, &p.r[0], &d), &p.r[1], &d), &p.r[2], &d);
         let mut out = [0u32; N];
         if d.is_pow2() {
             for (k, o) in out.iter_mut().enumerate() {
-                let i = base.wrapping_add(k as u32);
-                *o = round(round(round(i, &p.r[0], &d), &p.r[1], &d), &p.r[2], &d);
+                *o = rounds(base.wrapping_add(k as u32));
             }
         } else {
-            let len = d.n.saturating_sub(base).min(N as u32) as usize;
-            for (k, o) in out.iter_mut().enumerate().take(len) {
-                *o = p.apply_wrapped(base + k as u32, &d);
+            for (k, o) in out.iter_mut().enumerate() {
+                let i = base.wrapping_add(k as u32);
+                // Indices ≥ n start from 0 instead: a cycle of [n, 2^bits) alone would never end.
+                *o = rounds(if i < d.n { i } else { 0 });
+            }
+            while out.iter().any(|&o| o >= d.n) {
+                for o in out.iter_mut() {
+                    let r = rounds(*o);
+                    *o = if *o >= d.n { r } else { *o };
+                }
             }
         }
         out
@@ -130,32 +139,50 @@ impl Permutation {
 
 #[cfg(target_arch = "x86_64")]
 impl Permutation {
-    /// [`Permutation::apply_many`] of the 16 indices `base..base + 16` as one AVX-512 vector,
-    /// for a power-of-two n only (the caller checks [`PermDomain::is_pow2`]): the same rounds,
-    /// lane for lane (u32 wrapping multiply, logical shifts by the same counts, masks).
+    /// [`Permutation::apply_many`] of the 16 indices `base..base + 16` as one AVX-512 vector:
+    /// the same rounds, lane for lane (u32 wrapping multiply, logical shifts by the same
+    /// counts, masks); for a non-power-of-two n, lanes outside [0, n) walk on under a lane mask
+    /// until every lane is inside (indices ≥ n start from 0, as in `apply_many`).
     #[target_feature(enable = "avx512f")]
-    pub(crate) fn apply_16_pow2_avx512(
-        &self,
-        base: u32,
-        dom: &PermDomain,
-    ) -> std::arch::x86_64::__m512i {
+    pub(crate) fn apply_16_avx512(&self, base: u32, dom: &PermDomain) -> std::arch::x86_64::__m512i {
         use std::arch::x86_64::*;
         let mask = _mm512_set1_epi32(dom.mask as i32);
         // Shift counts < 32 (bits ≤ 32), as the scalar `>>`.
         let s1 = _mm_cvtsi32_si128(dom.s1 as i32);
         let s2 = _mm_cvtsi32_si128(dom.s2 as i32);
         let fixed = _mm512_set1_epi32(0x2c1b_3c6d);
+        let keys = self.r.map(|r| {
+            (
+                _mm512_set1_epi32(r.x as i32),
+                _mm512_set1_epi32(r.m as i32),
+                _mm512_set1_epi32(r.a as i32),
+            )
+        });
+        let rounds = |mut i: __m512i| {
+            for (x, m, a) in keys {
+                i = _mm512_xor_si512(i, x);
+                i = _mm512_and_si512(_mm512_mullo_epi32(i, m), mask);
+                i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s1));
+                i = _mm512_add_epi32(i, a);
+                i = _mm512_and_si512(_mm512_mullo_epi32(i, fixed), mask);
+                i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s2));
+            }
+            i
+        };
         let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-        let mut i = _mm512_add_epi32(_mm512_set1_epi32(base as i32), lanes);
-        for r in &self.r {
-            i = _mm512_xor_si512(i, _mm512_set1_epi32(r.x as i32));
-            i = _mm512_and_si512(_mm512_mullo_epi32(i, _mm512_set1_epi32(r.m as i32)), mask);
-            i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s1));
-            i = _mm512_add_epi32(i, _mm512_set1_epi32(r.a as i32));
-            i = _mm512_and_si512(_mm512_mullo_epi32(i, fixed), mask);
-            i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s2));
+        let idx = _mm512_add_epi32(_mm512_set1_epi32(base as i32), lanes);
+        if dom.is_pow2() {
+            return rounds(idx);
         }
-        i
+        let n = _mm512_set1_epi32(dom.n as i32);
+        let mut i = rounds(_mm512_maskz_mov_epi32(_mm512_cmplt_epu32_mask(idx, n), idx));
+        loop {
+            let out = _mm512_cmpge_epu32_mask(i, n);
+            if out == 0 {
+                return i;
+            }
+            i = _mm512_mask_mov_epi32(i, out, rounds(i));
+        }
     }
 }
 
