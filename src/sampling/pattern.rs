@@ -1067,4 +1067,52 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn non_power_of_two_chunks_equal_the_pattern_values() {
+        // Every index of non-power-of-two counts through the chunk fills (cycle-walking
+        // permutation, divided cell split), on each instruction set: small and large strata,
+        // grids with a power-of-two width (12), square (100, 400), strip (7, 37) and wide (262:
+        // 2 × 131 rows) shapes, up to the 2^24 limit of the fast form and past it.
+        for isa in Isa::available() {
+            let pat = Pattern {
+                seed: 11,
+                kind: PatternKind::Stratified,
+                isa,
+            };
+            for pixel in [UVec2::new(1, 2), UVec2::new(300, 7)] {
+                let px = pat.pixel(pixel);
+                for count in [
+                    3u32,
+                    7,
+                    12,
+                    37,
+                    100,
+                    262,
+                    400,
+                    1000,
+                    (1 << 24) - 3,
+                    (1 << 24) + 3,
+                ] {
+                    let first = if count > 5000 { count - 40 } else { 0 };
+                    for index in (first..count).chain([0, 17, count - 1]) {
+                        for dim in [0u32, 5] {
+                            assert_eq!(
+                                px.sample_1d(dim, index, count).to_bits(),
+                                pat.sample_1d(pixel, dim, index, count).to_bits(),
+                                "{isa:?} 1d count {count} index {index}"
+                            );
+                            assert_eq!(
+                                px.sample_2d(dim, index, count).to_array().map(f32::to_bits),
+                                pat.sample_2d(pixel, dim, index, count)
+                                    .to_array()
+                                    .map(f32::to_bits),
+                                "{isa:?} 2d count {count} index {index}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
