@@ -144,7 +144,11 @@ impl Permutation {
     /// counts, masks); for a non-power-of-two n, lanes outside [0, n) walk on under a lane mask
     /// until every lane is inside (indices ≥ n start from 0, as in `apply_many`).
     #[target_feature(enable = "avx512f")]
-    pub(crate) fn apply_16_avx512(&self, base: u32, dom: &PermDomain) -> std::arch::x86_64::__m512i {
+    pub(crate) fn apply_16_avx512(
+        &self,
+        base: u32,
+        dom: &PermDomain,
+    ) -> std::arch::x86_64::__m512i {
         use std::arch::x86_64::*;
         let mask = _mm512_set1_epi32(dom.mask as i32);
         // Shift counts < 32 (bits ≤ 32), as the scalar `>>`.
