@@ -602,20 +602,20 @@ impl FastStrata {
         }
     }
 
-    /// [`FastStrata::chunk_1d`] on AVX-512: counts with small strata (the common case, any
-    /// count since the permutation cycle-walks on lane masks) written with intrinsics, one
-    /// 16-lane vector per step (compiled from the portable loops, LLVM split the 16 lanes
-    /// 8 + 4 + 2 + 1 + 1); the rest compiled for AVX-512.
+    /// [`FastStrata::chunk_1d`] on AVX-512, written with intrinsics, one 16-lane vector per
+    /// step (compiled from the portable loops, LLVM split the 16 lanes 8 + 4 + 2 + 1 + 1); any
+    /// count, since the permutation cycle-walks on lane masks.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     fn chunk_1d_avx512(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
         use std::arch::x86_64::*;
-        if !self.small_1d {
-            return self.chunk_1d(set, base);
-        }
         let strata = set.perm.apply_16_avx512(base, &self.dom);
         let (jx, _) = jitters_avx512(set, base);
-        let v = fixed_small_avx512(strata, jx, self.div_1d);
+        let v = if self.small_1d {
+            fixed_small_avx512(strata, jx, self.div_1d)
+        } else {
+            fixed_wide_avx512(strata, jx, self.div_1d)
+        };
         let mut out = [0.0f32; CHUNK];
         // SAFETY: `out` is 16 f32 = 64 bytes, the width of the unaligned store.
         unsafe { _mm512_storeu_ps(out.as_mut_ptr(), v) };
@@ -734,6 +734,31 @@ fn fixed_small_avx512(
 fn split_f32(s: u32, nx: u32) -> (u32, u32) {
     let q = (s as f32 / nx as f32) as u32;
     (s - q * nx, q)
+}
+
+/// The general form of [`fixed_chunk`] on 16 lanes, for strata ≥ 2^7: (stratum << 24 | j) in
+/// 8 i64 lanes → f32 (round to nearest, as the scalar `as i64 as f32`), IEEE division, then
+/// the same `vminps` as [`fixed_small_avx512`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq")]
+fn fixed_wide_avx512(
+    strata: std::arch::x86_64::__m512i,
+    j: std::arch::x86_64::__m512i,
+    div: f32,
+) -> std::arch::x86_64::__m512 {
+    use std::arch::x86_64::*;
+    let half = |s: __m256i, j: __m256i| {
+        let s = _mm512_slli_epi64::<24>(_mm512_cvtepu32_epi64(s));
+        _mm512_cvtepi64_ps(_mm512_or_si512(s, _mm512_cvtepu32_epi64(j)))
+    };
+    let lo = half(_mm512_castsi512_si256(strata), _mm512_castsi512_si256(j));
+    let hi = half(
+        _mm512_extracti64x4_epi64::<1>(strata),
+        _mm512_extracti64x4_epi64::<1>(j),
+    );
+    let fixed = _mm512_insertf32x8::<1>(_mm512_castps256_ps512(lo), hi);
+    let v = _mm512_div_ps(fixed, _mm512_set1_ps(div));
+    _mm512_min_ps(v, _mm512_set1_ps(ONE_MINUS_EPSILON))
 }
 
 /// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form that
