@@ -8,6 +8,7 @@ use super::tree2::Tree2;
 use super::triangle::{RayShear, barycentric_error};
 use super::wide::{Bary, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
+use crate::isa::Isa;
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
@@ -88,6 +89,8 @@ pub struct Geometry {
     bounds: (Vec3, Vec3),
     /// Wall time of the BVH build.
     pub build_time: Duration,
+    /// Vector instruction set of the packet queries, detected once here rather than per query.
+    pub(super) isa: Isa,
 }
 
 impl Geometry {
@@ -164,6 +167,7 @@ impl Geometry {
             accel,
             bounds,
             build_time: start.elapsed(),
+            isa: Isa::detect(),
         }
     }
 

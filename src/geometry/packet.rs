@@ -44,11 +44,23 @@ impl Geometry {
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.intersect_packet_on(Isa::detect(), rays, active, out);
+        self.intersect_packet_with(self.isa, rays, active, out);
     }
 
-    /// [`Self::intersect_packet`] on a chosen vector backend (for tests and benchmarks).
+    /// [`Self::intersect_packet`] on a chosen vector backend (for tests and benchmarks; one
+    /// this CPU does not run falls back to the widest it does).
     pub fn intersect_packet_on(
+        &self,
+        isa: Isa,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+    ) {
+        self.intersect_packet_with(isa.supported(), rays, active, out);
+    }
+
+    /// [`Self::intersect_packet`] on `isa`, a set this CPU runs.
+    fn intersect_packet_with(
         &self,
         isa: Isa,
         rays: &[Ray; PACKET],
@@ -97,11 +109,17 @@ impl Geometry {
     /// rays enter is finished by the scalar query of each (incoherent shadow rays, e.g. on
     /// `dense`, would otherwise make the packet visit the union of the rays' subtrees).
     pub fn occluded_packet(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
-        self.occluded_packet_on(Isa::detect(), rays, active)
+        self.occluded_packet_with(self.isa, rays, active)
     }
 
-    /// [`Self::occluded_packet`] on a chosen vector backend (for tests and benchmarks).
+    /// [`Self::occluded_packet`] on a chosen vector backend (for tests and benchmarks; one
+    /// this CPU does not run falls back to the widest it does).
     pub fn occluded_packet_on(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
+        self.occluded_packet_with(isa.supported(), rays, active)
+    }
+
+    /// [`Self::occluded_packet`] on `isa`, a set this CPU runs.
+    fn occluded_packet_with(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
         let active = active & PACKET_MASK;
         let Some(bvh) = self.wide() else {
             return bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i);
@@ -467,15 +485,15 @@ fn still_open<S: Simd>(near: &Lanes, best: &Lanes, mask: u32) -> u32 {
 
 impl WideBvh {
     /// The rays `active` that enter the box of the root's first child before their t_max, on
-    /// backend `isa`; for a single-leaf tree, bit i is `!self.single_leaf_missed(ray i)` (the
+    /// backend `isa` (one this CPU runs); for a single-leaf tree, bit i is `!self.single_leaf_missed(ray i)` (the
     /// same operations on the same values: `SingleLeaf::hit` is lane 0 of `Node4::hit`).
     pub(super) fn root_box_packet(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
-        match isa.supported() {
+        match isa {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `supported` returned Avx512, so the CPU has AVX-512F and DQ.
+            // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
             Isa::Avx512 => unsafe { self.root_box_avx512(rays, active) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `supported` returned Avx2, so the CPU has AVX2.
+            // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.root_box_avx2(rays, active) },
             _ => self.root_box_impl::<Portable>(rays, active),
         }
@@ -512,7 +530,7 @@ impl WideBvh {
 }
 
 impl WideBvh {
-    /// Closest hits of the rays `active` on backend `isa`: writes `out[i]` for each ray i in
+    /// Closest hits of the rays `active` on backend `isa` (one this CPU runs): writes `out[i]` for each ray i in
     /// the returned hit mask; the second mask flags rays with another primitive hit at exactly
     /// their best t (the caller redoes those with the scalar query). `other(id, ray, t_max)`
     /// is the hit distance of a non-triangle primitive if below `t_max`, else +∞.
@@ -524,12 +542,12 @@ impl WideBvh {
         out: &mut [LaneHit; PACKET],
         other: impl FnMut(usize, &Ray, f32) -> f32,
     ) -> (u32, u32) {
-        match isa.supported() {
+        match isa {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `supported` returned Avx512, so the CPU has AVX-512F and DQ.
+            // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
             Isa::Avx512 => unsafe { self.closest_packet_avx512(rays, active, out, other) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `supported` returned Avx2, so the CPU has AVX2.
+            // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.closest_packet_avx2(rays, active, out, other) },
             _ => self.closest_packet_impl::<Portable>(rays, active, out, other),
         }
@@ -561,7 +579,8 @@ impl WideBvh {
         self.closest_packet_impl::<Avx2>(rays, active, out, other)
     }
 
-    /// Mask of the rays `active` that something blocks in (0, t_max), on backend `isa`;
+    /// Mask of the rays `active` that something blocks in (0, t_max), on backend `isa` (one
+    /// this CPU runs);
     /// `other(id, ray)` tells whether non-triangle primitive `id` blocks `ray`.
     pub(super) fn any_packet(
         &self,
@@ -571,12 +590,12 @@ impl WideBvh {
         sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
-        match isa.supported() {
+        match isa {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `supported` returned Avx512, so the CPU has AVX-512F and DQ.
+            // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
             Isa::Avx512 => unsafe { self.any_packet_avx512(rays, active, sparse, other) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `supported` returned Avx2, so the CPU has AVX2.
+            // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.any_packet_avx2(rays, active, sparse, other) },
             _ => self.any_packet_impl::<Portable>(rays, active, sparse, other),
         }
