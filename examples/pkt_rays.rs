@@ -8,7 +8,7 @@
 
 use glam::{UVec2, Vec2};
 use penumbra::geometry::{Geometry, PACKET, Ray, RayQuery};
-use penumbra::sampling::hash::uniform_pair;
+use penumbra::sampling::{PatternKind, make_pattern, uniform_triangle_point};
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
 use std::hint::black_box;
@@ -82,7 +82,8 @@ fn main() -> anyhow::Result<()> {
     let g = &scene.geometry;
     let lights = &scene.emitters;
     let cam = scene.camera.rays(UVec2::splat(res));
-    let strata = (spp as f32).sqrt().ceil() as u32;
+    // The renderer's own pattern: stratified pixel jitter, random points on the emitters.
+    let pattern = make_pattern(PatternKind::Stratified, 1);
     let (mut n_cam, mut n_shadow) = (0u64, 0u64);
     let mut time = [Duration::ZERO; 4];
     let mut sums = [0u64; 4];
@@ -91,13 +92,11 @@ fn main() -> anyhow::Result<()> {
         let mut cam_pks: Vec<Packet> = Vec::new();
         let mut shadow_pks: Vec<Packet> = Vec::new();
         for x in 0..res {
-            let key = (y as u64) << 32 | x as u64;
+            let px = pattern.pixel(UVec2::new(x, y));
             for s0 in (0..spp).step_by(PACKET) {
                 let rays: [Ray; PACKET] = std::array::from_fn(|i| {
                     let s = s0 + i as u32;
-                    let (u, v) = uniform_pair(key, s);
-                    let cell = Vec2::new((s % strata) as f32, (s / strata) as f32);
-                    let j = (cell + Vec2::new(u, v)) / strata as f32;
+                    let j = px.sample_2d(0, s, spp);
                     cam.generate(Vec2::new(x as f32, y as f32) + j)
                 });
                 let active = if spp - s0 >= PACKET as u32 {
@@ -112,18 +111,12 @@ fn main() -> anyhow::Result<()> {
                     let Some(h) = (active & (1 << i) != 0).then(|| g.intersect(r)).flatten() else {
                         continue;
                     };
-                    let (u, v) = uniform_pair(key ^ 0x5bd1_e995, s0 + i as u32);
-                    let Some(p) =
-                        lights.primitive(((u * 7919.0) as usize % lights.len().max(1)) as u32)
-                    else {
+                    let pick = px.sample_1d(1, s0 + i as u32, spp);
+                    let Some(p) = lights.primitive((pick * lights.len() as f32) as u32) else {
                         continue;
                     };
-                    let (a, b) = if u + v > 1.0 {
-                        (1.0 - u, 1.0 - v)
-                    } else {
-                        (u, v)
-                    };
-                    let target = p.p[0] + (p.p[1] - p.p[0]) * a + (p.p[2] - p.p[0]) * b;
+                    let u = px.sample_2d(2, s0 + i as u32, spp);
+                    let target = uniform_triangle_point(u, p.p[0], p.p[1], p.p[2]);
                     let o = h.spawn_origin(target - h.p);
                     shadow[i] = Ray {
                         o,
