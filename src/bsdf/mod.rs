@@ -53,6 +53,11 @@ pub trait Bxdf {
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample>;
     /// Density of `sample` at wi.
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// `(f(wo, wi), pdf(wo, wi))` together: MIS light sampling needs both for the same pair.
+    #[inline]
+    fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        (self.f(wo, wi), self.pdf(wo, wi))
+    }
     /// True if every lobe is a delta (mirror, smooth glass): light sampling cannot help.
     fn is_delta(&self) -> bool {
         false
@@ -208,6 +213,12 @@ impl Bxdf for Bsdf {
     #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         dispatch!(self, b => b.pdf(wo, wi))
+    }
+    /// One dispatch for both: one call instead of two saves a call and a match per light
+    /// sample.
+    #[inline]
+    fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        dispatch!(self, b => (b.f(wo, wi), b.pdf(wo, wi)))
     }
     #[inline]
     fn is_delta(&self) -> bool {

@@ -94,6 +94,12 @@ pub struct Geometry {
 }
 
 impl Geometry {
+    /// The vector instruction set detected when this geometry was built (what its packet
+    /// queries, and the integrator's lane kernels, run on).
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
     /// Build the default BVH over `prims` (reordered internally so the BVH's leaf order is the
     /// storage order: one indirection less per intersection test).
     pub fn new(prims: Vec<Primitive>, meshes: Vec<MeshShading>, quadrics: Vec<Quadric>) -> Self {

@@ -6,14 +6,15 @@
 //! surface on the viewer's side (reflection only), so their MIS combination stays unbiased even
 //! where shading normals disagree with the geometry.
 
+use super::lanes::{DiffuseBsdfLanes, Receivers, TriangleLightLanes};
 use super::{MisHeuristic, Strategy};
 use crate::Rgb;
-use crate::bsdf::{Bsdf, Bxdf, LobeSampling};
+use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::{Geometry, PACKET, Ray, SurfaceHit};
 use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
-use crate::lights::{Emitter, LightSampleContext, LightSource, SamplingMode};
-use crate::sampling::{Frame, PixelSamples, SamplePattern, balance_heuristic, power_heuristic};
+use crate::lights::{Emitter, Light, LightLiSample, LightSampleContext, LightSource, SamplingMode};
+use crate::sampling::{Frame, PixelSamples, SamplePattern};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 
@@ -30,6 +31,8 @@ pub const DIM_BSDF: u32 = 4;
 
 /// Shadow rays stop this fraction short of the light point so they do not hit the light itself.
 const SHADOW_EPSILON: f32 = 1e-4;
+/// The `t_max` of every shadow ray (its direction spans origin to light point).
+pub(super) const SHADOW_T_MAX: f32 = 1.0 - SHADOW_EPSILON;
 
 /// One estimator configured for one render.
 pub struct DirectLighting<'a> {
@@ -145,12 +148,26 @@ impl CameraPacket {
 
 /// A sampled BSDF direction as a ray, before what it reaches is known.
 #[derive(Clone, Copy)]
-struct BsdfRay {
-    ray: Ray,
+pub(super) struct BsdfRay {
+    pub(super) ray: Ray,
     /// f·cos / pdf.
-    weight: Rgb,
-    pdf: f32,
-    delta: bool,
+    pub(super) weight: Rgb,
+    pub(super) pdf: f32,
+    pub(super) delta: bool,
+}
+
+impl BsdfRay {
+    /// A placeholder for lanes without a ray.
+    pub(super) const NONE: BsdfRay = BsdfRay {
+        ray: Ray {
+            o: Vec3::ZERO,
+            d: Vec3::ZERO,
+            t_max: 0.0,
+        },
+        weight: Rgb::ZERO,
+        pdf: 0.0,
+        delta: false,
+    };
 }
 
 /// The BSDF rays of a packet's lanes (bit k of `active`: lane k has one).
@@ -232,6 +249,9 @@ pub struct PacketScratch {
     light: Pending,
     bsdf: Pending,
     sampled: Sampled,
+    rx: Receivers,
+    tri_lanes: TriangleLightLanes,
+    bsdf_lanes: DiffuseBsdfLanes,
 }
 
 impl Default for PacketScratch {
@@ -252,6 +272,9 @@ impl PacketScratch {
             light: Pending::new(idle),
             bsdf: Pending::new(idle),
             sampled: Sampled::new(idle),
+            rx: Receivers::new(),
+            tri_lanes: TriangleLightLanes::new(),
+            bsdf_lanes: DiffuseBsdfLanes::new(),
         }
     }
 }
@@ -322,14 +345,6 @@ impl<'a> DirectLighting<'a> {
         }
     }
 
-    #[inline]
-    fn heuristic(&self, f_pdf: f32, g_pdf: f32) -> f32 {
-        match self.mis {
-            MisHeuristic::Power => power_heuristic(1.0, f_pdf, 1.0, g_pdf),
-            MisHeuristic::Balance => balance_heuristic(1.0, f_pdf, 1.0, g_pdf),
-        }
-    }
-
     /// Radiance along camera ray `ray` for eye sample `eye` of the pixel whose samples are `px`
     /// (from [`SamplePattern::pixel`]); also returns the number of rays traced. A packet of one
     /// lane: the same numbers as that lane of any [`Self::li_packet`].
@@ -362,6 +377,9 @@ impl<'a> DirectLighting<'a> {
             light,
             bsdf,
             sampled,
+            rx,
+            tri_lanes,
+            bsdf_lanes,
         } = scratch;
         let n = cam.n;
         let m = self.shadow_rays.max(1);
@@ -399,6 +417,18 @@ impl<'a> DirectLighting<'a> {
                 Some(hit) => self.shade(hit, ray, &mut lanes[k]),
             };
         }
+        // Diffuse receivers go to the lane kernels (their light samples when triangle lights
+        // are sampled by area, and their BSDF rays).
+        rx.diffuse = 0;
+        for k in 0..n {
+            if let (Some(lane), Some(hit)) = (&lanes[k], &hits[k])
+                && let Bsdf::Lambert(b) = &lane.bsdf
+            {
+                rx.load(k, b, hit, lane.ctx.n, &lane.frame, lane.wo_local);
+            }
+        }
+        let isa = scene.geometry.isa();
+        let area = self.mode() == SamplingMode::Area;
         let uniform = if use_light {
             self.selector.uniform_count()
         } else {
@@ -410,20 +440,58 @@ impl<'a> DirectLighting<'a> {
             light.active = 0;
             bsdf.active = 0;
             sampled.active = 0;
+            tri_lanes.active = 0;
+            bsdf_lanes.active = 0;
             for k in 0..n {
                 let Some(lane) = &lanes[k] else { continue };
                 let Some(hit) = &hits[k] else { continue };
                 let sh = lane.view(hit, uniform);
                 let d = if j == 0 { first[k] } else { draws(k, j) };
-                if use_light && let Some((r, v)) = self.light_sample(&sh, &d, mis) {
-                    light.set(k, r, v);
-                    rays += 1;
+                let diffuse = rx.diffuse >> k & 1 != 0;
+                if use_light && let Some(sel) = self.select(&sh, d.light_select) {
+                    match &scene.lights[sel.index as usize] {
+                        Light::Triangle(tri) if diffuse && area => {
+                            tri_lanes.load(k, tri, sel.pmf, d.light)
+                        }
+                        _ => {
+                            if let Some((r, v)) = self.light_sample(&sh, sel, d.light, mis) {
+                                light.set(k, r, v);
+                                rays += 1;
+                            }
+                        }
+                    }
                 }
-                if use_bsdf && let Some(b) = self.bsdf_ray(&sh, &d) {
-                    // One logical ray whatever comes of it: an emitter query, then maybe a
-                    // visibility test.
-                    rays += 1;
-                    sampled.set(k, b);
+                if use_bsdf {
+                    if diffuse {
+                        bsdf_lanes.load(k, d.bsdf);
+                    } else if let Some(b) = self.bsdf_ray(&sh, &d) {
+                        // One logical ray whatever comes of it: an emitter query, then maybe a
+                        // visibility test.
+                        rays += 1;
+                        sampled.set(k, b);
+                    }
+                }
+            }
+            if tri_lanes.active != 0 {
+                tri_lanes.run(rx, mis.then_some(self.mis), isa);
+                for k in 0..n {
+                    if tri_lanes.active >> k & 1 != 0
+                        && let Some((r, v)) = tri_lanes.result(k)
+                    {
+                        light.set(k, r, v);
+                        rays += 1;
+                    }
+                }
+            }
+            if bsdf_lanes.active != 0 {
+                bsdf_lanes.run(rx, isa);
+                for k in 0..n {
+                    if bsdf_lanes.active >> k & 1 != 0
+                        && let Some(b) = bsdf_lanes.result(k)
+                    {
+                        rays += 1;
+                        sampled.set(k, b);
+                    }
                 }
             }
             if sampled.active != 0 {
@@ -512,39 +580,37 @@ impl<'a> DirectLighting<'a> {
             .sum()
     }
 
-    /// One light-sampling estimate f·Li·cos / (pmf·pdf), MIS-weighted when `mis`: the shadow
-    /// ray it needs and its value if that ray is clear (`None` when it is zero anyway).
-    fn light_sample(&self, sh: &Shading, d: &Draws, mis: bool) -> Option<(Ray, Rgb)> {
-        let sel = match sh.uniform {
-            Some(count) => UniformSelector::pick(count, d.light_select),
-            None => self.selector.sample(&sh.shading_point(), d.light_select),
-        };
-        let SelectedLight { index, pmf } = sel?;
-        let light = &self.scene.lights[index as usize];
-        let ls = light.sample_li(sh.ctx, d.light, self.mode())?;
-        if !(ls.pdf > 0.0) || pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(sh.ctx.n) <= 0.0 {
-            return None;
+    /// The light picked for a light sample with selection number `u` (uniform selection
+    /// inline, any other through the selector).
+    #[inline(always)]
+    fn select(&self, sh: &Shading, u: f32) -> Option<SelectedLight> {
+        match sh.uniform {
+            Some(count) => UniformSelector::pick(count, u),
+            None => self.selector.sample(&sh.shading_point(), u),
         }
-        let wi_local = sh.frame.to_local(ls.wi);
-        // Under MIS the BSDF pdf is needed too: one dispatch evaluates both (for the few
-        // occluded samples it is wasted, cheaper than a second call for all the others).
-        let weigh = mis && !ls.delta;
-        let (f, bsdf_pdf) = if weigh {
-            sh.bsdf.f_pdf(sh.wo_local, wi_local)
-        } else {
-            (sh.bsdf.f(sh.wo_local, wi_local), 0.0)
-        };
-        let f = f * wi_local.z.abs();
-        if f == Rgb::ZERO {
-            return None;
-        }
-        let pdf = pmf * ls.pdf;
-        let w = if weigh {
-            self.heuristic(pdf, bsdf_pdf)
-        } else {
-            1.0
-        };
-        Some((shadow_ray(sh.hit, ls.p_light), f * ls.li * (w / pdf)))
+    }
+
+    /// One light-sampling estimate of light `sel`, MIS-weighted when `mis`: the shadow ray it
+    /// needs and its value if that ray is clear (`None` when it is zero anyway).
+    fn light_sample(
+        &self,
+        sh: &Shading,
+        sel: SelectedLight,
+        u: Vec2,
+        mis: bool,
+    ) -> Option<(Ray, Rgb)> {
+        let light = &self.scene.lights[sel.index as usize];
+        let ls = light.sample_li(sh.ctx, u, self.mode())?;
+        light_estimate(
+            &ls,
+            sel.pmf,
+            sh.bsdf,
+            &sh.frame,
+            sh.wo_local,
+            sh.ctx,
+            sh.hit,
+            mis.then_some(self.mis),
+        )
     }
 
     /// The first half of one BSDF-sampling estimate f·cos·Le / pdf: the sampled ray and its
@@ -556,25 +622,7 @@ impl<'a> DirectLighting<'a> {
             Bsdf::Lambert(b) => b.sample(sh.wo_local, d.lobe, d.bsdf),
             other => other.sample(sh.wo_local, d.lobe, d.bsdf),
         }?;
-        if !(bs.pdf > 0.0) {
-            return None;
-        }
-        let wi = sh.frame.to_world(bs.wi).normalize();
-        // Only specular transmission (smooth glass) may leave below the geometric surface;
-        // every other sample there is rejected exactly as light sampling rejects it.
-        if wi.dot(sh.ctx.n) <= 0.0 && !bs.delta {
-            return None;
-        }
-        let weight = bs.f * (bs.wi.z.abs() / bs.pdf);
-        if weight == Rgb::ZERO || !weight.is_finite() {
-            return None;
-        }
-        Some(BsdfRay {
-            ray: Ray::new(sh.hit.spawn_origin(wi), wi),
-            weight,
-            pdf: bs.pdf,
-            delta: bs.delta,
-        })
+        bsdf_ray_of(&bs, &sh.frame, sh.ctx.n, sh.hit)
     }
 
     /// The second half: given the nearest emitter `hit` along the sampled ray (a BVH of
@@ -631,8 +679,80 @@ impl<'a> DirectLighting<'a> {
         // Rare (emitter hits only): the plain virtual call, whatever the selector.
         let pdf_l = self.selector.pmf(&sh.shading_point(), light)
             * self.scene.lights[light as usize].pdf_li(sh.ctx, b.ray.d, p, n, self.mode());
-        self.heuristic(b.pdf, pdf_l)
+        self.mis.weight(b.pdf, pdf_l)
     }
+}
+
+/// The light-sampling estimate f·Li·cos / (pmf·pdf) of light sample `ls` (its light picked
+/// with probability `pmf`) at a receiver with BSDF `bsdf`, shading `frame`, local `wo_local`,
+/// context `ctx` and hit `hit`, weighted by heuristic `mis` against BSDF sampling when given:
+/// the shadow ray it needs and its value if that ray is clear. One definition for the per-lane
+/// path and the lane kernels, so both compute the same bits.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn light_estimate(
+    ls: &LightLiSample,
+    pmf: f32,
+    bsdf: &impl Bxdf,
+    frame: &Frame,
+    wo_local: Vec3,
+    ctx: &LightSampleContext,
+    hit: &SurfaceHit,
+    mis: Option<MisHeuristic>,
+) -> Option<(Ray, Rgb)> {
+    if !(ls.pdf > 0.0) || pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(ctx.n) <= 0.0 {
+        return None;
+    }
+    let wi_local = frame.to_local(ls.wi);
+    // Under MIS the BSDF pdf is needed too: one dispatch evaluates both (for the few
+    // occluded samples it is wasted, cheaper than a second call for all the others).
+    let weigh = if ls.delta { None } else { mis };
+    let (f, bsdf_pdf) = if weigh.is_some() {
+        bsdf.f_pdf(wo_local, wi_local)
+    } else {
+        (bsdf.f(wo_local, wi_local), 0.0)
+    };
+    let f = f * wi_local.z.abs();
+    if f == Rgb::ZERO {
+        return None;
+    }
+    let pdf = pmf * ls.pdf;
+    let w = match weigh {
+        Some(h) => h.weight(pdf, bsdf_pdf),
+        None => 1.0,
+    };
+    Some((shadow_ray(hit, ls.p_light), f * ls.li * (w / pdf)))
+}
+
+/// BSDF sample `bs` (local frame `frame`) at `hit`, whose geometric normal facing the viewer
+/// is `n`, as a ray with its weight f·cos / pdf; `None` when the estimate is zero without
+/// tracing it. Shared by the per-lane path and the lane kernels.
+#[inline(always)]
+pub(super) fn bsdf_ray_of(
+    bs: &BsdfSample,
+    frame: &Frame,
+    n: Vec3,
+    hit: &SurfaceHit,
+) -> Option<BsdfRay> {
+    if !(bs.pdf > 0.0) {
+        return None;
+    }
+    let wi = frame.to_world(bs.wi).normalize();
+    // Only specular transmission (smooth glass) may leave below the geometric surface;
+    // every other sample there is rejected exactly as light sampling rejects it.
+    if wi.dot(n) <= 0.0 && !bs.delta {
+        return None;
+    }
+    let weight = bs.f * (bs.wi.z.abs() / bs.pdf);
+    if weight == Rgb::ZERO || !weight.is_finite() {
+        return None;
+    }
+    Some(BsdfRay {
+        ray: Ray::new(hit.spawn_origin(wi), wi),
+        weight,
+        pdf: bs.pdf,
+        delta: bs.delta,
+    })
 }
 
 /// A shadow ray from `hit` to just short of `target`: offset at the origin by the hit's error
@@ -643,6 +763,6 @@ pub fn shadow_ray(hit: &SurfaceHit, target: Vec3) -> Ray {
     Ray {
         o,
         d: target - o,
-        t_max: 1.0 - SHADOW_EPSILON,
+        t_max: SHADOW_T_MAX,
     }
 }

@@ -6,12 +6,13 @@
 
 pub mod direct;
 pub mod film;
+mod lanes;
 pub mod render;
 
 pub use render::{RenderStats, render};
 
 use crate::bsdf::LobeSampling;
-use crate::sampling::PatternKind;
+use crate::sampling::{PatternKind, balance_heuristic, power_heuristic};
 use std::fmt;
 use std::str::FromStr;
 
@@ -73,6 +74,18 @@ pub enum MisHeuristic {
     Power,
     /// Balance heuristic.
     Balance,
+}
+
+impl MisHeuristic {
+    /// Weight of a sample of pdf `f_pdf` combined with one other technique of pdf `g_pdf`
+    /// (one sample each).
+    #[inline]
+    pub fn weight(self, f_pdf: f32, g_pdf: f32) -> f32 {
+        match self {
+            MisHeuristic::Power => power_heuristic(1.0, f_pdf, 1.0, g_pdf),
+            MisHeuristic::Balance => balance_heuristic(1.0, f_pdf, 1.0, g_pdf),
+        }
+    }
 }
 
 impl FromStr for MisHeuristic {

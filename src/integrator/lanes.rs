@@ -1,0 +1,389 @@
+//! Structure-of-arrays kernels for the packet estimator's commonest case: a Lambertian
+//! receiver lit by an area-sampled triangle light, and its cosine-sampled BSDF rays.
+//!
+//! Lane by lane these run the very functions the per-lane path runs (the triangle's
+//! `sample_li`, [`light_estimate`], the Lambertian `sample`, [`bsdf_ray_of`]), so each lane's
+//! bits are the per-lane path's. What changes is the layout: each input and output is an array
+//! over the packet's lanes, so the loop over lanes compiles to 16-wide (AVX-512), 8-wide (AVX2)
+//! or 4-wide (SSE2) vector code instead of one lane at a time, whose chains of square roots
+//! and divisions left the CPU waiting.
+
+use super::MisHeuristic;
+use super::direct::{BsdfRay, bsdf_ray_of, light_estimate};
+use crate::Rgb;
+use crate::bsdf::{Bxdf, Lambert, LobeSampling};
+use crate::geometry::{PACKET, Ray, SurfaceHit};
+use crate::isa::Isa;
+use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
+use crate::sampling::Frame;
+use glam::{Vec2, Vec3};
+
+/// One f32 per lane.
+type Lanes = [f32; PACKET];
+
+/// One `Vec3` per lane, as three coordinate arrays (contiguous across lanes).
+#[derive(Clone, Copy)]
+struct V3 {
+    x: Lanes,
+    y: Lanes,
+    z: Lanes,
+}
+
+impl V3 {
+    const ZERO: V3 = V3 {
+        x: [0.0; PACKET],
+        y: [0.0; PACKET],
+        z: [0.0; PACKET],
+    };
+
+    #[inline(always)]
+    fn get(&self, k: usize) -> Vec3 {
+        Vec3::new(self.x[k], self.y[k], self.z[k])
+    }
+
+    #[inline(always)]
+    fn set(&mut self, k: usize, v: Vec3) {
+        self.x[k] = v.x;
+        self.y[k] = v.y;
+        self.z[k] = v.z;
+    }
+}
+
+/// The diffuse receivers of a packet: the shading state both kernels read, loaded once per
+/// camera hit. Bit k of `diffuse` marks lane k as loaded.
+#[derive(Clone, Copy)]
+pub(super) struct Receivers {
+    /// Lanes whose receiver is Lambertian with cosine sampling (loaded below).
+    pub(super) diffuse: u32,
+    p: V3,
+    ng: V3,
+    p_error: Lanes,
+    /// Geometric normal facing the viewer (the light-sample context's).
+    n: V3,
+    s: V3,
+    t: V3,
+    sn: V3,
+    /// z of the local outgoing direction (all a Lambertian BSDF reads of it).
+    wo_z: Lanes,
+    albedo: V3,
+}
+
+impl Receivers {
+    /// No lanes loaded.
+    pub(super) fn new() -> Self {
+        Self {
+            diffuse: 0,
+            p: V3::ZERO,
+            ng: V3::ZERO,
+            p_error: [0.0; PACKET],
+            n: V3::ZERO,
+            s: V3::ZERO,
+            t: V3::ZERO,
+            sn: V3::ZERO,
+            wo_z: [0.0; PACKET],
+            albedo: V3::ZERO,
+        }
+    }
+
+    /// Load lane k if its BSDF `b` is one the kernels evaluate (Lambertian, not sampled
+    /// uniformly); returns whether it did.
+    #[inline]
+    pub(super) fn load(
+        &mut self,
+        k: usize,
+        b: &Lambert,
+        hit: &SurfaceHit,
+        n: Vec3,
+        frame: &Frame,
+        wo_local: Vec3,
+    ) -> bool {
+        if b.sampling == LobeSampling::Uniform {
+            return false;
+        }
+        self.diffuse |= 1 << k;
+        self.p.set(k, hit.p);
+        self.ng.set(k, hit.ng);
+        self.p_error[k] = hit.p_error;
+        self.n.set(k, n);
+        self.s.set(k, frame.s);
+        self.t.set(k, frame.t);
+        self.sn.set(k, frame.n);
+        self.wo_z[k] = wo_local.z;
+        self.albedo.set(k, b.r);
+        true
+    }
+
+    /// Lane k's hit, context, frame, local wo and BSDF as the per-lane path has them (fields
+    /// the estimators do not read are left zero).
+    #[inline(always)]
+    fn lane(&self, k: usize) -> (SurfaceHit, LightSampleContext, Frame, Vec3, Lambert) {
+        let hit = SurfaceHit {
+            t: 0.0,
+            p: self.p.get(k),
+            ng: self.ng.get(k),
+            ns: Vec3::ZERO,
+            uv: Vec2::ZERO,
+            p_error: self.p_error[k],
+            prim: 0,
+            material: 0,
+            light: 0,
+        };
+        let ctx = LightSampleContext {
+            p: hit.p,
+            n: self.n.get(k),
+        };
+        let frame = Frame {
+            s: self.s.get(k),
+            t: self.t.get(k),
+            n: self.sn.get(k),
+        };
+        // Importance and cosine sampling coincide for a Lambertian BSDF.
+        let lambert = Lambert {
+            r: self.albedo.get(k),
+            sampling: LobeSampling::Importance,
+        };
+        (hit, ctx, frame, Vec3::new(0.0, 0.0, self.wo_z[k]), lambert)
+    }
+}
+
+/// Light samples of triangle lights drawn by area for diffuse receivers: bit k of `active`
+/// marks lane k as loaded; after [`Self::run`], `ok` says which lanes have an estimate.
+pub(super) struct TriangleLightLanes {
+    /// Loaded lanes.
+    pub(super) active: u32,
+    u: [Lanes; 2],
+    pmf: Lanes,
+    v: [V3; 3],
+    n: V3,
+    area: Lanes,
+    l: V3,
+    two_sided: [bool; PACKET],
+    ok: [bool; PACKET],
+    o: V3,
+    d: V3,
+    value: V3,
+}
+
+impl TriangleLightLanes {
+    /// No lanes loaded.
+    pub(super) fn new() -> Self {
+        Self {
+            active: 0,
+            u: [[0.0; PACKET]; 2],
+            pmf: [0.0; PACKET],
+            v: [V3::ZERO; 3],
+            n: V3::ZERO,
+            area: [0.0; PACKET],
+            l: V3::ZERO,
+            two_sided: [false; PACKET],
+            ok: [false; PACKET],
+            o: V3::ZERO,
+            d: V3::ZERO,
+            value: V3::ZERO,
+        }
+    }
+
+    /// Load lane k: light `tri` picked with probability `pmf`, sampled with `u`.
+    #[inline]
+    pub(super) fn load(&mut self, k: usize, tri: &TriangleLight, pmf: f32, u: Vec2) {
+        self.active |= 1 << k;
+        self.u[0][k] = u.x;
+        self.u[1][k] = u.y;
+        self.pmf[k] = pmf;
+        for (v, p) in self.v.iter_mut().zip(tri.p) {
+            v.set(k, p);
+        }
+        self.n.set(k, tri.n);
+        self.area[k] = tri.area;
+        self.l.set(k, tri.l);
+        self.two_sided[k] = tri.two_sided;
+    }
+
+    /// Every lane's estimate (loaded or not: the others' are ignored), MIS-weighted by `mis`
+    /// when given, on instruction set `isa`.
+    pub(super) fn run(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, isa: Isa) {
+        match (isa, mis) {
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, m) => {
+                // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
+                unsafe { self.run_avx512(rx, m) }
+            }
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, m) => {
+                // SAFETY: as above.
+                unsafe { self.run_avx2(rx, m) }
+            }
+            (_, None) => self.body(rx, None),
+            (_, Some(MisHeuristic::Power)) => self.body(rx, Some(MisHeuristic::Power)),
+            (_, Some(MisHeuristic::Balance)) => self.body(rx, Some(MisHeuristic::Balance)),
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    unsafe fn run_avx512(&mut self, rx: &Receivers, mis: Option<MisHeuristic>) {
+        match mis {
+            None => self.body(rx, None),
+            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power)),
+            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance)),
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn run_avx2(&mut self, rx: &Receivers, mis: Option<MisHeuristic>) {
+        match mis {
+            None => self.body(rx, None),
+            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power)),
+            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance)),
+        }
+    }
+
+    /// The lane loop; inlined into each caller with `mis` a constant.
+    #[inline(always)]
+    fn body(&mut self, rx: &Receivers, mis: Option<MisHeuristic>) {
+        for k in 0..PACKET {
+            let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
+            let tri = TriangleLight {
+                p: [self.v[0].get(k), self.v[1].get(k), self.v[2].get(k)],
+                n: self.n.get(k),
+                area: self.area[k],
+                l: self.l.get(k),
+                two_sided: self.two_sided[k],
+            };
+            let u = Vec2::new(self.u[0][k], self.u[1][k]);
+            let est = tri.sample_li(&ctx, u, SamplingMode::Area).and_then(|ls| {
+                light_estimate(
+                    &ls,
+                    self.pmf[k],
+                    &lambert,
+                    &frame,
+                    wo_local,
+                    &ctx,
+                    &hit,
+                    mis,
+                )
+            });
+            let (ok, ray, value) = match est {
+                Some((ray, value)) => (true, ray, value),
+                None => (false, Ray::new(Vec3::ZERO, Vec3::ZERO), Rgb::ZERO),
+            };
+            self.ok[k] = ok;
+            self.o.set(k, ray.o);
+            self.d.set(k, ray.d);
+            self.value.set(k, value);
+        }
+    }
+
+    /// Lane k's shadow ray and value, if it has an estimate (valid after [`Self::run`]).
+    #[inline]
+    pub(super) fn result(&self, k: usize) -> Option<(Ray, Rgb)> {
+        self.ok[k].then(|| {
+            (
+                Ray {
+                    o: self.o.get(k),
+                    d: self.d.get(k),
+                    t_max: super::direct::SHADOW_T_MAX,
+                },
+                self.value.get(k),
+            )
+        })
+    }
+}
+
+/// Cosine-sampled BSDF rays of diffuse receivers (every lane of [`Receivers::diffuse`] that is
+/// loaded here with its draw): after [`Self::run`], `ok` says which lanes have a ray.
+pub(super) struct DiffuseBsdfLanes {
+    /// Loaded lanes.
+    pub(super) active: u32,
+    u: [Lanes; 2],
+    ok: [bool; PACKET],
+    o: V3,
+    d: V3,
+    weight: V3,
+    pdf: Lanes,
+}
+
+impl DiffuseBsdfLanes {
+    /// No lanes loaded.
+    pub(super) fn new() -> Self {
+        Self {
+            active: 0,
+            u: [[0.0; PACKET]; 2],
+            ok: [false; PACKET],
+            o: V3::ZERO,
+            d: V3::ZERO,
+            weight: V3::ZERO,
+            pdf: [0.0; PACKET],
+        }
+    }
+
+    /// Load lane k with direction draw `u`.
+    #[inline]
+    pub(super) fn load(&mut self, k: usize, u: Vec2) {
+        self.active |= 1 << k;
+        self.u[0][k] = u.x;
+        self.u[1][k] = u.y;
+    }
+
+    /// Every lane's ray (loaded or not: the others' are ignored) on instruction set `isa`.
+    pub(super) fn run(&mut self, rx: &Receivers, isa: Isa) {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => {
+                // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
+                unsafe { self.run_avx512(rx) }
+            }
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => {
+                // SAFETY: as above.
+                unsafe { self.run_avx2(rx) }
+            }
+            _ => self.body(rx),
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    unsafe fn run_avx512(&mut self, rx: &Receivers) {
+        self.body(rx)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn run_avx2(&mut self, rx: &Receivers) {
+        self.body(rx)
+    }
+
+    /// The lane loop.
+    #[inline(always)]
+    fn body(&mut self, rx: &Receivers) {
+        for k in 0..PACKET {
+            let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
+            let u = Vec2::new(self.u[0][k], self.u[1][k]);
+            let b = lambert
+                .sample(wo_local, 0.0, u)
+                .and_then(|bs| bsdf_ray_of(&bs, &frame, ctx.n, &hit));
+            let (ok, b) = match b {
+                Some(b) => (true, b),
+                None => (false, BsdfRay::NONE),
+            };
+            self.ok[k] = ok;
+            self.o.set(k, b.ray.o);
+            self.d.set(k, b.ray.d);
+            self.weight.set(k, b.weight);
+            self.pdf[k] = b.pdf;
+        }
+    }
+
+    /// Lane k's BSDF ray, if it has one (valid after [`Self::run`]).
+    #[inline]
+    pub(super) fn result(&self, k: usize) -> Option<BsdfRay> {
+        self.ok[k].then(|| BsdfRay {
+            ray: Ray::new(self.o.get(k), self.d.get(k)),
+            weight: self.weight.get(k),
+            pdf: self.pdf[k],
+            delta: false,
+        })
+    }
+}
