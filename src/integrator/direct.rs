@@ -389,19 +389,23 @@ impl<'a> DirectLighting<'a> {
             Strategy::Bsdf => (false, true),
             Strategy::Mis => (true, true),
         };
-        let draws = |k: usize, j: u32| {
-            Draws::new(
-                &pxs[cam.pixel[k] as usize],
-                cam.eye[k] * m + j,
-                count,
-                use_light,
-                use_bsdf,
-            )
-        };
+        // A macro, not a closure: the closure was outlined and returned the draws through
+        // memory, and reading them back stalled on store forwarding.
+        macro_rules! draws {
+            ($k:expr, $j:expr) => {
+                Draws::new(
+                    &pxs[cam.pixel[$k] as usize],
+                    cam.eye[$k] * m + $j,
+                    count,
+                    use_light,
+                    use_bsdf,
+                )
+            };
+        }
         // The first sample's draws are pure arithmetic that does not depend on the hits:
         // issued before the camera rays' traversal, they overlap with its memory-bound work.
         for (k, d) in first.iter_mut().enumerate().take(n) {
-            *d = draws(k, 0);
+            *d = draws!(k, 0);
         }
         scene
             .geometry
@@ -446,7 +450,7 @@ impl<'a> DirectLighting<'a> {
                 let Some(lane) = &lanes[k] else { continue };
                 let Some(hit) = &hits[k] else { continue };
                 let sh = lane.view(hit, uniform);
-                let d = if j == 0 { first[k] } else { draws(k, j) };
+                let d = if j == 0 { first[k] } else { draws!(k, j) };
                 let diffuse = rx.diffuse >> k & 1 != 0;
                 if use_light && let Some(sel) = self.select(&sh, d.light_select) {
                     match &scene.lights[sel.index as usize] {
