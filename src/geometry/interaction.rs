@@ -1,5 +1,6 @@
 //! What a closest-hit query returns.
 
+use crate::sampling::Frame;
 use glam::{Vec2, Vec3};
 
 /// Sentinel for "no area light attached".
@@ -43,6 +44,41 @@ impl SurfaceHit {
             self.p + off
         } else {
             self.p - off
+        }
+    }
+}
+
+/// How a hit is seen along a ray: the set-up every estimator does before sampling there.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingGeometry {
+    /// Unit direction toward the viewer.
+    pub wo: Vec3,
+    /// The ray arrives on the side the geometric normal points to.
+    pub front: bool,
+    /// Geometric normal flipped toward the viewer.
+    pub n: Vec3,
+    /// Shading frame around the shading normal flipped toward the viewer.
+    pub frame: Frame,
+    /// `wo` in `frame`.
+    pub wo_local: Vec3,
+}
+
+impl ShadingGeometry {
+    /// The shading geometry of a hit with geometric normal `ng` and shading normal `ns` seen
+    /// along ray direction `d`.
+    #[inline(always)]
+    pub fn new(d: Vec3, ng: Vec3, ns: Vec3) -> Self {
+        let wo = -d.normalize();
+        let front = d.dot(ng) < 0.0;
+        let n = if front { ng } else { -ng };
+        let ns = if ns.dot(wo) < 0.0 { -ns } else { ns };
+        let frame = Frame::from_normal(ns);
+        Self {
+            wo,
+            front,
+            n,
+            frame,
+            wo_local: frame.to_local(wo),
         }
     }
 }

@@ -16,7 +16,7 @@ pub mod triangle;
 pub mod wide;
 
 pub use accel::{Backend, Geometry, MeshShading, PrimKind, Primitive};
-pub use interaction::SurfaceHit;
+pub use interaction::{ShadingGeometry, SurfaceHit};
 pub use packet::PACKET;
 pub use quadric::{Quadric, QuadricKind};
 pub use ray::{Ray, random_query_rays};

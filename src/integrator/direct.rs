@@ -279,28 +279,31 @@ impl PacketScratch {
     }
 }
 
-/// The shading state of a camera-ray hit, owned per lane of a packet.
+/// The per-lane part of a camera-ray hit's shading state (the geometry is in [`Receivers`]).
 struct LaneShading {
     bsdf: Bsdf,
     /// The hit point and the geometric normal flipped toward the viewer.
     ctx: LightSampleContext,
-    frame: Frame,
-    wo_local: Vec3,
-    /// World-space direction toward the viewer.
-    wo: Vec3,
 }
 
 impl LaneShading {
-    /// The borrowed view the per-sample estimators take.
+    /// The view the per-sample estimators take of lane `k`.
     #[inline]
-    fn view<'a>(&'a self, hit: &'a SurfaceHit, uniform: Option<u32>) -> Shading<'a> {
+    fn view<'a>(
+        &'a self,
+        k: usize,
+        hit: &'a SurfaceHit,
+        rx: &Receivers,
+        uniform: Option<u32>,
+    ) -> Shading<'a> {
+        let g = rx.geometry(k);
         Shading {
             hit,
             bsdf: &self.bsdf,
             ctx: &self.ctx,
-            frame: self.frame,
-            wo_local: self.wo_local,
-            wo: self.wo,
+            frame: g.frame,
+            wo_local: g.wo_local,
+            wo: g.wo,
             uniform,
         }
     }
@@ -411,27 +414,26 @@ impl<'a> DirectLighting<'a> {
             .geometry
             .intersect_packet(&cam.ray, cam.active(), hits);
         let mut rays = n as u64;
+        let isa = scene.geometry.isa();
+        // The hits' shading geometry for all lanes at once, then each lane's emission and
+        // BSDF; Lambertian receivers go to the lane kernels (their light samples when triangle
+        // lights are sampled by area, and their BSDF rays).
         for k in 0..n {
-            let ray = &cam.ray[k];
+            if let Some(hit) = &hits[k] {
+                rx.stage(k, hit, cam.ray[k].d);
+            }
+        }
+        rx.shade(isa);
+        rx.diffuse = 0;
+        for k in 0..n {
             out[k] = match &hits[k] {
                 None => {
                     lanes[k] = None;
-                    self.escaped(ray.d)
+                    self.escaped(cam.ray[k].d)
                 }
-                Some(hit) => self.shade(hit, ray, &mut lanes[k]),
+                Some(hit) => self.shade(k, hit, rx, &mut lanes[k]),
             };
         }
-        // Diffuse receivers go to the lane kernels (their light samples when triangle lights
-        // are sampled by area, and their BSDF rays).
-        rx.diffuse = 0;
-        for k in 0..n {
-            if let (Some(lane), Some(hit)) = (&lanes[k], &hits[k])
-                && let Bsdf::Lambert(b) = &lane.bsdf
-            {
-                rx.load(k, b, hit, lane.ctx.n, &lane.frame, lane.wo_local);
-            }
-        }
-        let isa = scene.geometry.isa();
         let area = self.mode() == SamplingMode::Area;
         let uniform = if use_light {
             self.selector.uniform_count()
@@ -449,7 +451,7 @@ impl<'a> DirectLighting<'a> {
             for k in 0..n {
                 let Some(lane) = &lanes[k] else { continue };
                 let Some(hit) = &hits[k] else { continue };
-                let sh = lane.view(hit, uniform);
+                let sh = lane.view(k, hit, rx, uniform);
                 let d = if j == 0 { first[k] } else { draws!(k, j) };
                 let diffuse = rx.diffuse >> k & 1 != 0;
                 if use_light && let Some(sel) = self.select(&sh, d.light_select) {
@@ -511,7 +513,9 @@ impl<'a> DirectLighting<'a> {
                     };
                     let b = &sampled.lanes[k];
                     let hit = emitter_hits[k].as_ref();
-                    if let Some((r, v)) = self.bsdf_gather(&lane.view(at, uniform), b, hit, mis) {
+                    if let Some((r, v)) =
+                        self.bsdf_gather(&lane.view(k, at, rx, uniform), b, hit, mis)
+                    {
                         bsdf.set(k, r, v);
                     }
                 }
@@ -537,40 +541,48 @@ impl<'a> DirectLighting<'a> {
         rays
     }
 
-    /// Emitted radiance at camera hit `hit` of `ray`; its shading state (if it has a material)
-    /// goes to `lane`, built in place: returned, the state was copied twice (stalling on
-    /// store forwarding).
+    /// Emitted radiance at camera hit `hit` of lane `k` (its shading geometry in `rx`); its
+    /// BSDF and light-sample context (if it has a material) go to `lane`, and a Lambertian
+    /// BSDF marks the lane diffuse in `rx`.
     #[inline(always)]
-    fn shade(&self, hit: &SurfaceHit, ray: &Ray, lane: &mut Option<LaneShading>) -> Rgb {
+    fn shade(
+        &self,
+        k: usize,
+        hit: &SurfaceHit,
+        rx: &mut Receivers,
+        lane: &mut Option<LaneShading>,
+    ) -> Rgb {
         let scene = self.scene;
-        let wo = -ray.d.normalize();
+        let g = rx.geometry(k);
         let mut l = Rgb::ZERO;
         if hit.light != NO_LIGHT {
-            l += scene.lights[hit.light as usize].radiance(hit.p, hit.ng, hit.uv, wo);
+            l += scene.lights[hit.light as usize].radiance(hit.p, hit.ng, hit.uv, g.wo);
         }
-        let front = ray.d.dot(hit.ng) < 0.0;
-        let ng = if front { hit.ng } else { -hit.ng };
-        let ns = if hit.ns.dot(wo) < 0.0 {
-            -hit.ns
-        } else {
-            hit.ns
-        };
-        let frame = Frame::from_normal(ns);
         let Some(material) = scene.materials.get(hit.material as usize) else {
             *lane = None;
             return l;
         };
-        let mut bsdf = material.bsdf(hit, front);
+        // The BSDF is stored straight into the lane: a diffuse one from registers, any other
+        // by the out-of-line constructor. (Both paths through one local, the copy out of it
+        // read 16-byte pieces before the smaller stores that wrote them had landed: a
+        // store-forwarding stall on every hit.)
+        let ctx = LightSampleContext { p: hit.p, n: g.n };
+        let lane = match material.lambert(hit) {
+            Some(b) => lane.insert(LaneShading {
+                bsdf: Bsdf::Lambert(b),
+                ctx,
+            }),
+            None => lane.insert(LaneShading {
+                bsdf: material.bsdf(hit, g.front),
+                ctx,
+            }),
+        };
         if self.bsdf_sampling != LobeSampling::Importance {
-            bsdf.set_sampling(self.bsdf_sampling);
+            lane.bsdf.set_sampling(self.bsdf_sampling);
         }
-        *lane = Some(LaneShading {
-            bsdf,
-            ctx: LightSampleContext { p: hit.p, n: ng },
-            wo_local: frame.to_local(wo),
-            frame,
-            wo,
-        });
+        if let Bsdf::Lambert(b) = &lane.bsdf {
+            rx.set_diffuse(k, b);
+        }
         l
     }
 

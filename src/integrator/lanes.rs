@@ -12,7 +12,7 @@ use super::MisHeuristic;
 use super::direct::{BsdfRay, bsdf_ray_of, light_estimate};
 use crate::Rgb;
 use crate::bsdf::{Bxdf, Lambert, LobeSampling};
-use crate::geometry::{PACKET, Ray, SurfaceHit};
+use crate::geometry::{PACKET, Ray, ShadingGeometry, SurfaceHit};
 use crate::isa::Isa;
 use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
 use crate::sampling::Frame;
@@ -49,22 +49,27 @@ impl V3 {
     }
 }
 
-/// The diffuse receivers of a packet: the shading state both kernels read, loaded once per
-/// camera hit. Bit k of `diffuse` marks lane k as loaded.
+/// The receivers of a packet: each hit's shading geometry (computed for all lanes at once by
+/// [`Self::shade`]) and, for the Lambertian ones, what the kernels read. Bit k of `diffuse`
+/// marks lane k as a Lambertian receiver.
 #[derive(Clone, Copy)]
 pub(super) struct Receivers {
-    /// Lanes whose receiver is Lambertian with cosine sampling (loaded below).
+    /// Lanes whose receiver is Lambertian with cosine sampling.
     pub(super) diffuse: u32,
     p: V3,
     ng: V3,
     p_error: Lanes,
+    /// Shading normal and ray direction (inputs of [`Self::shade`]).
+    ns: V3,
+    d: V3,
+    wo: V3,
+    front: [bool; PACKET],
     /// Geometric normal facing the viewer (the light-sample context's).
     n: V3,
     s: V3,
     t: V3,
     sn: V3,
-    /// z of the local outgoing direction (all a Lambertian BSDF reads of it).
-    wo_z: Lanes,
+    wo_local: V3,
     albedo: V3,
 }
 
@@ -76,41 +81,96 @@ impl Receivers {
             p: V3::ZERO,
             ng: V3::ZERO,
             p_error: [0.0; PACKET],
+            ns: V3::ZERO,
+            d: V3::ZERO,
+            wo: V3::ZERO,
+            front: [false; PACKET],
             n: V3::ZERO,
             s: V3::ZERO,
             t: V3::ZERO,
             sn: V3::ZERO,
-            wo_z: [0.0; PACKET],
+            wo_local: V3::ZERO,
             albedo: V3::ZERO,
         }
     }
 
-    /// Load lane k if its BSDF `b` is one the kernels evaluate (Lambertian, not sampled
-    /// uniformly); returns whether it did.
+    /// Stage lane k: `hit` seen along ray direction `d`.
     #[inline]
-    pub(super) fn load(
-        &mut self,
-        k: usize,
-        b: &Lambert,
-        hit: &SurfaceHit,
-        n: Vec3,
-        frame: &Frame,
-        wo_local: Vec3,
-    ) -> bool {
-        if b.sampling == LobeSampling::Uniform {
-            return false;
-        }
-        self.diffuse |= 1 << k;
+    pub(super) fn stage(&mut self, k: usize, hit: &SurfaceHit, d: Vec3) {
         self.p.set(k, hit.p);
         self.ng.set(k, hit.ng);
         self.p_error[k] = hit.p_error;
-        self.n.set(k, n);
-        self.s.set(k, frame.s);
-        self.t.set(k, frame.t);
-        self.sn.set(k, frame.n);
-        self.wo_z[k] = wo_local.z;
-        self.albedo.set(k, b.r);
-        true
+        self.ns.set(k, hit.ns);
+        self.d.set(k, d);
+    }
+
+    /// Every lane's [`ShadingGeometry`] (staged or not: the others' are ignored), on `isa`.
+    pub(super) fn shade(&mut self, isa: Isa) {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => {
+                // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
+                unsafe { self.shade_avx512() }
+            }
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => {
+                // SAFETY: as above.
+                unsafe { self.shade_avx2() }
+            }
+            _ => self.shade_body(),
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    unsafe fn shade_avx512(&mut self) {
+        self.shade_body()
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn shade_avx2(&mut self) {
+        self.shade_body()
+    }
+
+    #[inline(always)]
+    fn shade_body(&mut self) {
+        for k in 0..PACKET {
+            let g = ShadingGeometry::new(self.d.get(k), self.ng.get(k), self.ns.get(k));
+            self.wo.set(k, g.wo);
+            self.front[k] = g.front;
+            self.n.set(k, g.n);
+            self.s.set(k, g.frame.s);
+            self.t.set(k, g.frame.t);
+            self.sn.set(k, g.frame.n);
+            self.wo_local.set(k, g.wo_local);
+        }
+    }
+
+    /// Lane k's shading geometry (valid after [`Self::shade`]).
+    #[inline(always)]
+    pub(super) fn geometry(&self, k: usize) -> ShadingGeometry {
+        ShadingGeometry {
+            wo: self.wo.get(k),
+            front: self.front[k],
+            n: self.n.get(k),
+            frame: Frame {
+                s: self.s.get(k),
+                t: self.t.get(k),
+                n: self.sn.get(k),
+            },
+            wo_local: self.wo_local.get(k),
+        }
+    }
+
+    /// Mark lane k as diffuse if its BSDF `b` is one the kernels evaluate (Lambertian, not
+    /// sampled uniformly).
+    #[inline]
+    pub(super) fn set_diffuse(&mut self, k: usize, b: &Lambert) {
+        if b.sampling != LobeSampling::Uniform {
+            self.diffuse |= 1 << k;
+            self.albedo.set(k, b.r);
+        }
     }
 
     /// Lane k's hit, context, frame, local wo and BSDF as the per-lane path has them (fields
@@ -142,7 +202,7 @@ impl Receivers {
             r: self.albedo.get(k),
             sampling: LobeSampling::Importance,
         };
-        (hit, ctx, frame, Vec3::new(0.0, 0.0, self.wo_z[k]), lambert)
+        (hit, ctx, frame, self.wo_local.get(k), lambert)
     }
 }
 

@@ -6,7 +6,7 @@
 //! gathered in pixel order, so the passes are deterministic under any thread schedule.
 
 use crate::bsdf::{Bsdf, Bxdf};
-use crate::geometry::{Ray, RayQuery, SurfaceHit};
+use crate::geometry::{Ray, RayQuery, ShadingGeometry, SurfaceHit};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode};
 use crate::luminance;
 use crate::sampling::Frame;
@@ -52,23 +52,15 @@ pub fn eye_hit(scene: &Scene, res: UVec2, pixel: u32, rng: &mut Pcg32) -> Option
     let ray = scene.camera.generate_ray(p_raster, res);
     let hit = scene.geometry.intersect(&ray)?;
     let material = scene.materials.get(hit.material as usize)?;
-    let wo = -ray.d.normalize();
-    let front = ray.d.dot(hit.ng) < 0.0;
-    let ng = if front { hit.ng } else { -hit.ng };
-    let ns = if hit.ns.dot(wo) < 0.0 {
-        -hit.ns
-    } else {
-        hit.ns
-    };
-    let frame = Frame::from_normal(ns);
+    let g = ShadingGeometry::new(ray.d, hit.ng, hit.ns);
     Some(EyeHit {
-        bsdf: material.bsdf(&hit, front),
-        wo_local: frame.to_local(wo),
-        frame,
+        bsdf: material.bsdf(&hit, g.front),
+        wo_local: g.wo_local,
+        frame: g.frame,
         sp: ShadingPoint {
             p: hit.p,
-            n: ng,
-            wo,
+            n: g.n,
+            wo: g.wo,
         },
         hit,
     })

@@ -63,10 +63,8 @@ pub enum Material {
 /// The Lambertian BSDF of a `diffuse` material (reflectance clamped to [0, 1]); inlined into the
 /// hot path of [`Material::bsdf`] and shared with its general arm.
 #[inline(always)]
-fn diffuse(reflectance: &Texture, hit: &SurfaceHit) -> Bsdf {
-    Bsdf::Lambert(Lambert::new(
-        reflectance.eval(hit.uv).clamp(Rgb::ZERO, Rgb::ONE),
-    ))
+fn diffuse(reflectance: &Texture, hit: &SurfaceHit) -> Lambert {
+    Lambert::new(reflectance.eval(hit.uv).clamp(Rgb::ZERO, Rgb::ONE))
 }
 
 impl Material {
@@ -76,9 +74,20 @@ impl Material {
     pub fn bsdf(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
         // The diffuse case (most surfaces of most scenes) is built inline at the hit, without
         // a call that returns the BSDF through memory; every other material goes out of line.
+        match self.lambert(hit) {
+            Some(b) => Bsdf::Lambert(b),
+            None => self.bsdf_general(hit, front),
+        }
+    }
+
+    /// The Lambertian BSDF of a diffuse material at `hit` (`None` for other materials):
+    /// small enough to come back in registers, so a caller can store it straight where it
+    /// goes.
+    #[inline]
+    pub fn lambert(&self, hit: &SurfaceHit) -> Option<Lambert> {
         match self {
-            Material::Diffuse { reflectance } => diffuse(reflectance, hit),
-            _ => self.bsdf_general(hit, front),
+            Material::Diffuse { reflectance } => Some(diffuse(reflectance, hit)),
+            _ => None,
         }
     }
 
@@ -86,7 +95,7 @@ impl Material {
     #[inline(never)]
     fn bsdf_general(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
         match self {
-            Material::Diffuse { reflectance } => diffuse(reflectance, hit),
+            Material::Diffuse { reflectance } => Bsdf::Lambert(diffuse(reflectance, hit)),
             Material::Phong { kd, ks, n } => Bsdf::Phong(Phong::clamped(kd.eval(hit.uv), *ks, *n)),
             Material::Conductor {
                 eta,
