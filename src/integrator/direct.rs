@@ -418,9 +418,9 @@ impl<'a> DirectLighting<'a> {
         // The hits' shading geometry for all lanes at once, then each lane's emission and
         // BSDF; Lambertian receivers go to the lane kernels (their light samples when triangle
         // lights are sampled by area, and their BSDF rays).
-        for k in 0..n {
-            if let Some(hit) = &hits[k] {
-                rx.stage(k, hit, cam.ray[k].d);
+        for (k, (hit, ray)) in hits.iter().zip(&cam.ray).enumerate().take(n) {
+            if let Some(hit) = hit {
+                rx.stage(k, hit, ray.d);
             }
         }
         rx.shade(isa);
