@@ -170,33 +170,48 @@ impl BsdfRay {
     };
 }
 
-/// The BSDF rays of a packet's lanes (bit k of `active`: lane k has one).
+/// The BSDF rays of a packet's lanes (bit k of `active`: lane k has one), field by field: the
+/// rays go to the emitter query as they are, and the rest is read only for lanes that reach
+/// an emitter.
 struct Sampled {
     active: u32,
     ray: [Ray; PACKET],
-    lanes: [BsdfRay; PACKET],
+    weight: [Rgb; PACKET],
+    pdf: [f32; PACKET],
+    /// Bit k: lane k's sample is from a delta lobe.
+    delta: u32,
 }
 
 impl Sampled {
     fn new(idle: Ray) -> Self {
-        let none = BsdfRay {
-            ray: idle,
-            weight: Rgb::ZERO,
-            pdf: 0.0,
-            delta: false,
-        };
         Self {
             active: 0,
             ray: [idle; PACKET],
-            lanes: [none; PACKET],
+            weight: [Rgb::ZERO; PACKET],
+            pdf: [0.0; PACKET],
+            delta: 0,
         }
     }
 
+    /// Give lane k the ray `b`.
     #[inline]
-    fn set(&mut self, k: usize, b: BsdfRay) {
+    fn set(&mut self, k: usize, b: &BsdfRay) {
         self.active |= 1 << k;
         self.ray[k] = b.ray;
-        self.lanes[k] = b;
+        self.weight[k] = b.weight;
+        self.pdf[k] = b.pdf;
+        self.delta = self.delta & !(1 << k) | (b.delta as u32) << k;
+    }
+
+    /// Lane k's ray.
+    #[inline]
+    fn get(&self, k: usize) -> BsdfRay {
+        BsdfRay {
+            ray: self.ray[k],
+            weight: self.weight[k],
+            pdf: self.pdf[k],
+            delta: self.delta >> k & 1 != 0,
+        }
     }
 }
 
@@ -289,13 +304,7 @@ struct LaneShading {
 impl LaneShading {
     /// The view the per-sample estimators take of lane `k`.
     #[inline]
-    fn view<'a>(
-        &'a self,
-        k: usize,
-        hit: &'a SurfaceHit,
-        rx: &Receivers,
-        uniform: Option<u32>,
-    ) -> Shading<'a> {
+    fn view<'a>(&'a self, k: usize, hit: &'a SurfaceHit, rx: &Receivers) -> Shading<'a> {
         let g = rx.geometry(k);
         Shading {
             hit,
@@ -304,7 +313,6 @@ impl LaneShading {
             frame: g.frame,
             wo_local: g.wo_local,
             wo: g.wo,
-            uniform,
         }
     }
 }
@@ -322,8 +330,6 @@ struct Shading<'h> {
     wo_local: Vec3,
     /// World-space direction toward the viewer (for selectors that need a [`ShadingPoint`]).
     wo: Vec3,
-    /// `Some(n)` when light selection is uniform over `n` lights (picked inline).
-    uniform: Option<u32>,
 }
 
 impl Shading<'_> {
@@ -451,16 +457,25 @@ impl<'a> DirectLighting<'a> {
             for k in 0..n {
                 let Some(lane) = &lanes[k] else { continue };
                 let Some(hit) = &hits[k] else { continue };
-                let sh = lane.view(k, hit, rx, uniform);
+                // The per-lane view is built only where a per-lane path needs it: the kernels'
+                // lanes (diffuse receivers, uniform selection) read the receivers' arrays.
+                let view = || lane.view(k, hit, rx);
                 let d = if j == 0 { first[k] } else { draws!(k, j) };
                 let diffuse = rx.diffuse >> k & 1 != 0;
-                if use_light && let Some(sel) = self.select(&sh, d.light_select) {
-                    match &scene.lights[sel.index as usize] {
-                        Light::Triangle(tri) if diffuse && area => {
+                if use_light {
+                    let sel = match uniform {
+                        Some(count) => UniformSelector::pick(count, d.light_select),
+                        None => self
+                            .selector
+                            .sample(&view().shading_point(), d.light_select),
+                    };
+                    match sel.map(|sel| (sel, &scene.lights[sel.index as usize])) {
+                        None => {}
+                        Some((sel, Light::Triangle(tri))) if diffuse && area => {
                             tri_lanes.load(k, tri, sel.pmf, d.light)
                         }
-                        _ => {
-                            if let Some((r, v)) = self.light_sample(&sh, sel, d.light, mis) {
+                        Some((sel, _)) => {
+                            if let Some((r, v)) = self.light_sample(&view(), sel, d.light, mis) {
                                 light.set(k, r, v);
                                 rays += 1;
                             }
@@ -470,11 +485,11 @@ impl<'a> DirectLighting<'a> {
                 if use_bsdf {
                     if diffuse {
                         bsdf_lanes.load(k, d.bsdf);
-                    } else if let Some(b) = self.bsdf_ray(&sh, &d) {
+                    } else if let Some(b) = self.bsdf_ray(&view(), &d) {
                         // One logical ray whatever comes of it: an emitter query, then maybe a
                         // visibility test.
                         rays += 1;
-                        sampled.set(k, b);
+                        sampled.set(k, &b);
                     }
                 }
             }
@@ -496,7 +511,7 @@ impl<'a> DirectLighting<'a> {
                         && let Some(b) = bsdf_lanes.result(k)
                     {
                         rays += 1;
-                        sampled.set(k, b);
+                        sampled.set(k, &b);
                     }
                 }
             }
@@ -508,14 +523,16 @@ impl<'a> DirectLighting<'a> {
                     if sampled.active >> k & 1 == 0 {
                         continue;
                     }
+                    let hit = emitter_hits[k].as_ref();
+                    // Most BSDF rays reach no light: nothing to gather, no view to build.
+                    if hit.is_none() && scene.infinite_lights.is_empty() {
+                        continue;
+                    }
                     let (Some(lane), Some(at)) = (&lanes[k], &hits[k]) else {
                         continue;
                     };
-                    let b = &sampled.lanes[k];
-                    let hit = emitter_hits[k].as_ref();
-                    if let Some((r, v)) =
-                        self.bsdf_gather(&lane.view(k, at, rx, uniform), b, hit, mis)
-                    {
+                    let b = sampled.get(k);
+                    if let Some((r, v)) = self.bsdf_gather(&lane.view(k, at, rx), &b, hit, mis) {
                         bsdf.set(k, r, v);
                     }
                 }
@@ -594,16 +611,6 @@ impl<'a> DirectLighting<'a> {
             .iter()
             .map(|&i| self.scene.lights[i as usize].radiance(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, w))
             .sum()
-    }
-
-    /// The light picked for a light sample with selection number `u` (uniform selection
-    /// inline, any other through the selector).
-    #[inline(always)]
-    fn select(&self, sh: &Shading, u: f32) -> Option<SelectedLight> {
-        match sh.uniform {
-            Some(count) => UniformSelector::pick(count, u),
-            None => self.selector.sample(&sh.shading_point(), u),
-        }
     }
 
     /// One light-sampling estimate of light `sel`, MIS-weighted when `mis`: the shadow ray it
