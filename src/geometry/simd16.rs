@@ -65,6 +65,13 @@ pub(super) trait Simd: Copy {
     fn xor(a: Self::M, b: Self::M) -> Self::M;
     /// One bit per lane (bit i = lane i).
     fn bits(m: Self::M) -> u32;
+    /// Lanes whose bit patterns are equal (integer compare: ids kept in f32 lanes).
+    fn eq_bits(a: Self::F, b: Self::F) -> Self::M;
+    /// The bit pattern plus one in lanes `m` (`next_up` of a non-negative finite value),
+    /// `a` elsewhere.
+    fn inc_bits(m: Self::M, a: Self::F) -> Self::F;
+    /// The mask with lane i set where bit i of `b` is (the inverse of [`Simd::bits`]).
+    fn mask(b: u32) -> Self::M;
 }
 
 /// [`Simd::rays`] by scalar moves.
@@ -234,6 +241,34 @@ impl Simd for Portable {
         m.iter()
             .enumerate()
             .fold(0, |b, (i, &m)| b | (m >> 31) << i)
+    }
+    #[inline(always)]
+    fn eq_bits(a: PV, b: PV) -> Self::M {
+        let mut m = [0; LANES];
+        for i in 0..LANES {
+            m[i] = if a.0[i].to_bits() == b.0[i].to_bits() {
+                !0
+            } else {
+                0
+            };
+        }
+        m
+    }
+    #[inline(always)]
+    fn inc_bits(m: Self::M, a: PV) -> PV {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = f32::from_bits(a.0[i].to_bits().wrapping_add(m[i] >> 31));
+        }
+        PV(r)
+    }
+    #[inline(always)]
+    fn mask(b: u32) -> Self::M {
+        let mut m = [0; LANES];
+        for i in 0..LANES {
+            m[i] = 0u32.wrapping_sub(b >> i & 1);
+        }
+        m
     }
 }
 
@@ -448,6 +483,44 @@ mod x86 {
                 (_mm256_movemask_ps(m.0) as u32) | (_mm256_movemask_ps(m.1) as u32) << (LANES / 2)
             }
         }
+        #[inline(always)]
+        fn eq_bits(a: A2, b: A2) -> A2 {
+            // SAFETY: AVX2 is available (see the module docs).
+            unsafe {
+                let (a0, a1) = (_mm256_castps_si256(a.0), _mm256_castps_si256(a.1));
+                let (b0, b1) = (_mm256_castps_si256(b.0), _mm256_castps_si256(b.1));
+                A2(
+                    _mm256_castsi256_ps(_mm256_cmpeq_epi32(a0, b0)),
+                    _mm256_castsi256_ps(_mm256_cmpeq_epi32(a1, b1)),
+                )
+            }
+        }
+        #[inline(always)]
+        fn inc_bits(m: A2, a: A2) -> A2 {
+            // SAFETY: AVX2 is available (see the module docs).
+            let up = unsafe {
+                let one = _mm256_set1_epi32(1);
+                let (a0, a1) = (_mm256_castps_si256(a.0), _mm256_castps_si256(a.1));
+                A2(
+                    _mm256_castsi256_ps(_mm256_add_epi32(a0, one)),
+                    _mm256_castsi256_ps(_mm256_add_epi32(a1, one)),
+                )
+            };
+            Self::select(m, up, a)
+        }
+        #[inline(always)]
+        fn mask(b: u32) -> A2 {
+            // SAFETY: AVX2 is available (see the module docs).
+            unsafe {
+                let lo = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+                let hi = _mm256_slli_epi32::<8>(lo);
+                let v = _mm256_set1_epi32(b as i32);
+                A2(
+                    _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(v, lo), lo)),
+                    _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(v, hi), hi)),
+                )
+            }
+        }
     }
 
     impl Simd for Avx512 {
@@ -575,6 +648,24 @@ mod x86 {
         fn bits(m: __mmask16) -> u32 {
             m as u32
         }
+        #[inline(always)]
+        fn eq_bits(a: A5, b: A5) -> __mmask16 {
+            // SAFETY: AVX-512F is available (see the module docs).
+            unsafe { _mm512_cmpeq_epi32_mask(_mm512_castps_si512(a.0), _mm512_castps_si512(b.0)) }
+        }
+        #[inline(always)]
+        fn inc_bits(m: __mmask16, a: A5) -> A5 {
+            // SAFETY: AVX-512F is available (see the module docs).
+            unsafe {
+                let x = _mm512_castps_si512(a.0);
+                let y = _mm512_mask_add_epi32(x, m, x, _mm512_set1_epi32(1));
+                A5(_mm512_castsi512_ps(y))
+            }
+        }
+        #[inline(always)]
+        fn mask(b: u32) -> __mmask16 {
+            b as __mmask16
+        }
     }
 }
 
@@ -640,7 +731,15 @@ mod tests {
             for f in values {
                 v.extend(lane_bits::<S>(f));
             }
-            let masks = [S::lt(x, y), S::le(x, y), S::eq(x, y), S::sign(x)];
+            v.extend(lane_bits::<S>(S::inc_bits(S::lt(x, y), x)));
+            let masks = [
+                S::lt(x, y),
+                S::le(x, y),
+                S::eq(x, y),
+                S::sign(x),
+                S::eq_bits(x, y),
+                S::mask(0x8421 << round),
+            ];
             let (m0, m1) = (masks[0], masks[2]);
             let combos = [
                 S::and(m0, m1),
@@ -666,7 +765,7 @@ mod tests {
     fn portable_lanes_are_the_scalar_operations() {
         let (a, b) = rows(1);
         let r = results::<Portable>();
-        let per_round = 9 * LANES + 8;
+        let per_round = 10 * LANES + 10;
         for i in 0..LANES {
             let (x, y) = (a[i], b[i]);
             let at = |k: usize| r[per_round + k * LANES + i];
@@ -677,6 +776,8 @@ mod tests {
             assert_eq!(at(5), canon(if x > y { x } else { y }));
             assert_eq!(at(6), canon(1.0f32.copysign(x)));
             assert_eq!(at(7), canon(x.abs()));
+            let up = f32::from_bits(x.to_bits().wrapping_add(1));
+            assert_eq!(at(9), canon(if x < y { up } else { x }));
         }
     }
 
