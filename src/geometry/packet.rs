@@ -36,22 +36,22 @@ pub const PACKET: usize = 16;
 /// rare scalar steps, exact-zero redos and quadrics, update single lanes).
 pub(super) struct PacketHits {
     /// Best hit distance so far per ray (its t_max at first, −∞ in inactive lanes).
-    t: Lanes,
+    pub(super) t: Lanes,
     /// `up(t)`: the bound of the tests, so that hits at exactly the best t are seen.
     tm: Lanes,
     /// Leaf-order id of each ray's best hit, as f32 bit patterns (compared as integers).
-    id: Lanes,
+    pub(super) id: Lanes,
     /// The best hit's edge functions (after [`PacketHits::finish`]: its barycentrics).
     /// Scalar-redo and quadric hits store their barycentrics here with `inv` = 1, whose
     /// product is exact.
-    b: [Lanes; 3],
+    pub(super) b: [Lanes; 3],
     /// The best hit's reciprocal determinant: barycentric k = b[k] · inv (the products of
     /// `RayShear4::closest`, formed once per ray at the end).
     inv: Lanes,
     /// Rays with a hit.
-    found: u32,
+    pub(super) found: u32,
     /// Rays with another primitive hit at exactly their best t (redone by the scalar query).
-    ties: u32,
+    pub(super) ties: u32,
 }
 
 impl PacketHits {
@@ -141,10 +141,7 @@ impl Geometry {
             self.quadric_t_outlined(id, ray.o, ray.d, t_max)
         });
         let ties = hits.ties;
-        for i in bits(hits.found & !ties) {
-            let (id, t, b) = hits.hit(i);
-            out[i] = Some(self.surface_hit(id, &rays[i], t, b));
-        }
+        self.hit_records(isa, rays, &hits, hits.found & !ties, out);
         for i in bits(ties) {
             out[i] = self.intersect(&rays[i]);
         }
@@ -187,7 +184,7 @@ const PACKET_MASK: u32 = ((1u64 << PACKET) - 1) as u32;
 
 /// Indices of the set bits of `m`, lowest first.
 #[inline(always)]
-fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+pub(super) fn bits(mut m: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         if m == 0 {
             return None;

@@ -34,6 +34,8 @@ pub(super) trait Simd: Copy {
     fn store(v: Self::F, a: &mut Lanes);
     /// Lane-wise IEEE quotient.
     fn div(a: Self::F, b: Self::F) -> Self::F;
+    /// Lane-wise IEEE square root.
+    fn sqrt(a: Self::F) -> Self::F;
     /// The rays' origins, directions and t_max transposed to lanes: `[o.x, o.y, o.z, d.x,
     /// d.y, d.z, t_max]`.
     fn rays(rays: &[Ray; LANES]) -> [Self::F; 7];
@@ -163,6 +165,14 @@ impl Simd for Portable {
     #[inline(always)]
     fn div(a: PV, b: PV) -> PV {
         a / b
+    }
+    #[inline(always)]
+    fn sqrt(a: PV) -> PV {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = a.0[i].sqrt();
+        }
+        PV(r)
     }
     #[inline(always)]
     fn rays(rays: &[Ray; LANES]) -> [PV; 7] {
@@ -380,6 +390,11 @@ mod x86 {
             halves!(_mm256_div_ps, a, b)
         }
         #[inline(always)]
+        fn sqrt(a: A2) -> A2 {
+            // SAFETY: AVX2 is available (see the module docs).
+            unsafe { A2(_mm256_sqrt_ps(a.0), _mm256_sqrt_ps(a.1)) }
+        }
+        #[inline(always)]
         fn rays(rays: &[Ray; LANES]) -> [A2; 7] {
             let base = rays.as_ptr() as *const f32;
             // SAFETY: AVX2 is available; every gathered address is ray i's field at byte
@@ -547,6 +562,11 @@ mod x86 {
             unsafe { A5(_mm512_div_ps(a.0, b.0)) }
         }
         #[inline(always)]
+        fn sqrt(a: A5) -> A5 {
+            // SAFETY: AVX-512F is available (see the module docs).
+            unsafe { A5(_mm512_sqrt_ps(a.0)) }
+        }
+        #[inline(always)]
         fn rays(rays: &[Ray; LANES]) -> [A5; 7] {
             let base = rays.as_ptr() as *const f32;
             // SAFETY: AVX-512F is available; every gathered address is ray i's field at byte
@@ -708,7 +728,13 @@ mod tests {
 
     /// `x`'s bits, with every NaN as `f32::NAN` (see [`lane_bits`]).
     fn canon(x: f32) -> u32 {
-        if x.is_nan() { f32::NAN } else { x }.to_bits()
+        // On the bits: a float select of NaNs could be folded to `x` (NaN payloads are
+        // unspecified to LLVM).
+        if x.is_nan() {
+            f32::NAN.to_bits()
+        } else {
+            x.to_bits()
+        }
     }
 
     /// Every operation of backend `S` on the special values, as bit patterns.
@@ -722,6 +748,7 @@ mod tests {
                 x - y,
                 x * y,
                 S::div(x, y),
+                S::sqrt(x),
                 S::min(x, y),
                 S::max(x, y),
                 S::sign_one(x),
@@ -765,19 +792,20 @@ mod tests {
     fn portable_lanes_are_the_scalar_operations() {
         let (a, b) = rows(1);
         let r = results::<Portable>();
-        let per_round = 10 * LANES + 10;
+        let per_round = 11 * LANES + 10;
         for i in 0..LANES {
             let (x, y) = (a[i], b[i]);
             let at = |k: usize| r[per_round + k * LANES + i];
             assert_eq!(at(0), canon(x + y));
             assert_eq!(at(3), canon(x / y));
+            assert_eq!(at(4), canon(x.sqrt()));
             // SSE semantics: the second operand unless the first is strictly smaller/larger.
-            assert_eq!(at(4), canon(if x < y { x } else { y }));
-            assert_eq!(at(5), canon(if x > y { x } else { y }));
-            assert_eq!(at(6), canon(1.0f32.copysign(x)));
-            assert_eq!(at(7), canon(x.abs()));
+            assert_eq!(at(5), canon(if x < y { x } else { y }));
+            assert_eq!(at(6), canon(if x > y { x } else { y }));
+            assert_eq!(at(7), canon(1.0f32.copysign(x)));
+            assert_eq!(at(8), canon(x.abs()));
             let up = f32::from_bits(x.to_bits().wrapping_add(1));
-            assert_eq!(at(9), canon(if x < y { up } else { x }));
+            assert_eq!(at(10), canon(if x < y { up } else { x }));
         }
     }
 
