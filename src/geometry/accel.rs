@@ -515,26 +515,31 @@ impl Geometry {
             None => [b[1] + b[2], b[2]],
         };
         let p_error = err[0] * S::abs(ng[0]) + err[1] * S::abs(ng[1]) + err[2] * S::abs(ng[2]);
-        let mut a = [[0.0f32; PACKET]; 12];
-        let rows = [
-            pos[0], pos[1], pos[2], ng[0], ng[1], ng[2], ns[0], ns[1], ns[2], uv[0], uv[1], p_error,
-        ];
-        for (k, r) in rows.into_iter().enumerate() {
-            S::store(r, &mut a[k]);
-        }
-        for i in bits(group) {
-            let i = i & (PACKET - 1);
-            out[i] = Some(SurfaceHit {
-                t: hits.t[i],
-                p: Vec3::new(a[0][i], a[1][i], a[2][i]),
-                ng: Vec3::new(a[3][i], a[4][i], a[5][i]),
-                ns: Vec3::new(a[6][i], a[7][i], a[8][i]),
-                uv: Vec2::new(a[9][i], a[10][i]),
-                p_error: a[11][i],
-                prim: id as u32,
-                material: p.material,
-                light: p.light,
-            });
+        // The fields in `SurfaceHit`'s order, transposed to one row per ray.
+        let rows = S::transpose([
+            S::load(&hits.t),
+            pos[0],
+            pos[1],
+            pos[2],
+            ng[0],
+            ng[1],
+            ng[2],
+            ns[0],
+            ns[1],
+            ns[2],
+            uv[0],
+            uv[1],
+            p_error,
+            sp(f32::from_bits(id as u32)),
+            sp(f32::from_bits(p.material)),
+            sp(f32::from_bits(p.light)),
+        ]);
+        for i in 0..PACKET {
+            if group >> i & 1 != 0 {
+                let mut rec = [0.0f32; PACKET];
+                S::store(rows[i], &mut rec);
+                out[i] = Some(SurfaceHit::from_lanes(rec));
+            }
         }
     }
 }

@@ -74,6 +74,20 @@ pub(super) trait Simd: Copy {
     fn inc_bits(m: Self::M, a: Self::F) -> Self::F;
     /// The mask with lane i set where bit i of `b` is (the inverse of [`Simd::bits`]).
     fn mask(b: u32) -> Self::M;
+    /// The 16 × 16 transpose: lane k of result i is lane i of `rows[k]` (bits moved as is).
+    fn transpose(rows: [Self::F; LANES]) -> [Self::F; LANES];
+}
+
+/// [`Simd::transpose`] through memory, for the backends without a faster one.
+#[inline(always)]
+fn transpose_lanes(a: &[Lanes; LANES]) -> [Lanes; LANES] {
+    let mut t = [[0.0f32; LANES]; LANES];
+    for k in 0..LANES {
+        for i in 0..LANES {
+            t[i][k] = a[k][i];
+        }
+    }
+    t
 }
 
 /// [`Simd::rays`] by scalar moves.
@@ -280,6 +294,10 @@ impl Simd for Portable {
         }
         m
     }
+    #[inline(always)]
+    fn transpose(rows: [PV; LANES]) -> [PV; LANES] {
+        transpose_lanes(&rows.map(|r| r.0)).map(PV)
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -290,7 +308,7 @@ pub(super) use x86::{Avx2, Avx512};
 /// after `is_x86_feature_detected!`, which is what the `SAFETY` comments below rely on.
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::{LANES, Lanes, Ray, Simd};
+    use super::{LANES, Lanes, Ray, Simd, transpose_lanes};
     use std::arch::x86_64::*;
     use std::mem::{offset_of, size_of};
 
@@ -536,6 +554,19 @@ mod x86 {
                 )
             }
         }
+        #[inline(always)]
+        fn transpose(rows: [A2; LANES]) -> [A2; LANES] {
+            let mut a = [[0.0f32; LANES]; LANES];
+            for k in 0..LANES {
+                Self::store(rows[k], &mut a[k]);
+            }
+            let t = transpose_lanes(&a);
+            let mut out = [Self::splat(0.0); LANES];
+            for i in 0..LANES {
+                out[i] = Self::load(&t[i]);
+            }
+            out
+        }
     }
 
     impl Simd for Avx512 {
@@ -686,6 +717,50 @@ mod x86 {
         fn mask(b: u32) -> __mmask16 {
             b as __mmask16
         }
+        #[inline(always)]
+        fn transpose(rows: [A5; LANES]) -> [A5; LANES] {
+            // SAFETY: AVX-512F is available (see the module docs).
+            unsafe {
+                let mut r = [_mm512_setzero_ps(); LANES];
+                for k in 0..LANES {
+                    r[k] = rows[k].0;
+                }
+                // 2 × 2 blocks of floats within each 128-bit lane, then of pairs: u[4j + m]
+                // holds, in 128-bit lane L, element 4L + m of rows 4j..4j + 3.
+                let mut t = [_mm512_setzero_ps(); LANES];
+                for j in 0..8 {
+                    t[2 * j] = _mm512_unpacklo_ps(r[2 * j], r[2 * j + 1]);
+                    t[2 * j + 1] = _mm512_unpackhi_ps(r[2 * j], r[2 * j + 1]);
+                }
+                let mut u = [_mm512_setzero_ps(); LANES];
+                for j in 0..4 {
+                    let (a, b) = (_mm512_castps_pd(t[4 * j]), _mm512_castps_pd(t[4 * j + 2]));
+                    let (c, d) = (
+                        _mm512_castps_pd(t[4 * j + 1]),
+                        _mm512_castps_pd(t[4 * j + 3]),
+                    );
+                    u[4 * j] = _mm512_castpd_ps(_mm512_unpacklo_pd(a, b));
+                    u[4 * j + 1] = _mm512_castpd_ps(_mm512_unpackhi_pd(a, b));
+                    u[4 * j + 2] = _mm512_castpd_ps(_mm512_unpacklo_pd(c, d));
+                    u[4 * j + 3] = _mm512_castpd_ps(_mm512_unpackhi_pd(c, d));
+                }
+                // Then the 128-bit lanes: result 4L + m gathers lane L of u[m], u[4 + m],
+                // u[8 + m], u[12 + m].
+                let mut out = [A5(_mm512_setzero_ps()); LANES];
+                for m in 0..4 {
+                    let (a, b, c, d) = (u[m], u[4 + m], u[8 + m], u[12 + m]);
+                    let v0 = _mm512_shuffle_f32x4::<0x44>(a, b);
+                    let v1 = _mm512_shuffle_f32x4::<0xee>(a, b);
+                    let v2 = _mm512_shuffle_f32x4::<0x44>(c, d);
+                    let v3 = _mm512_shuffle_f32x4::<0xee>(c, d);
+                    out[m] = A5(_mm512_shuffle_f32x4::<0x88>(v0, v2));
+                    out[4 + m] = A5(_mm512_shuffle_f32x4::<0xdd>(v0, v2));
+                    out[8 + m] = A5(_mm512_shuffle_f32x4::<0x88>(v1, v3));
+                    out[12 + m] = A5(_mm512_shuffle_f32x4::<0xdd>(v1, v3));
+                }
+                out
+            }
+        }
     }
 }
 
@@ -776,6 +851,11 @@ mod tests {
             ];
             v.extend(masks.iter().chain(&combos).map(|&m| S::bits(m)));
         }
+        let rows: [S::F; LANES] =
+            std::array::from_fn(|k| S::load(&std::array::from_fn(|i| (k * LANES + i) as f32)));
+        for f in S::transpose(rows) {
+            v.extend(lane_bits::<S>(f));
+        }
         let rays: [Ray; LANES] = std::array::from_fn(|i| Ray {
             o: Vec3::new(i as f32, -(i as f32), 0.5),
             d: Vec3::new(1.0, i as f32 * 0.25, -2.0),
@@ -806,6 +886,13 @@ mod tests {
             assert_eq!(at(8), canon(x.abs()));
             let up = f32::from_bits(x.to_bits().wrapping_add(1));
             assert_eq!(at(10), canon(if x < y { up } else { x }));
+        }
+        // The transpose follows the four rounds: result i, lane k = row k, lane i = 16k + i.
+        let t = &r[4 * per_round..];
+        for i in 0..LANES {
+            for k in 0..LANES {
+                assert_eq!(t[i * LANES + k], ((k * LANES + i) as f32).to_bits());
+            }
         }
     }
 
