@@ -599,35 +599,24 @@ mod x86 {
         }
         #[inline(always)]
         fn rays(rays: &[Ray; LANES]) -> [A5; 7] {
+            // Ray i's seven floats as row i (masked loads: nothing past the ray is read),
+            // transposed: field k of every ray is then row FIELDS[k] / 4. Shuffles instead of
+            // seven gathers, which are slow on some CPUs (Zen 4).
+            const RAY_FLOATS: usize = size_of::<Ray>() / 4;
+            const _: () = assert!(size_of::<Ray>() == 28 && RAY_FLOATS == 7);
             let base = rays.as_ptr() as *const f32;
-            // SAFETY: AVX-512F is available; every gathered address is ray i's field at byte
-            // offset ray_offset(i) + FIELDS[k] < size_of_val(rays), inside the array.
-            unsafe {
-                let idx = _mm512_setr_epi32(
-                    ray_offset(0),
-                    ray_offset(1),
-                    ray_offset(2),
-                    ray_offset(3),
-                    ray_offset(4),
-                    ray_offset(5),
-                    ray_offset(6),
-                    ray_offset(7),
-                    ray_offset(8),
-                    ray_offset(9),
-                    ray_offset(10),
-                    ray_offset(11),
-                    ray_offset(12),
-                    ray_offset(13),
-                    ray_offset(14),
-                    ray_offset(15),
-                );
-                let mut out = [A5(_mm512_setzero_ps()); 7];
-                for k in 0..7 {
-                    let idx = _mm512_add_epi32(idx, _mm512_set1_epi32(FIELDS[k] as i32));
-                    out[k] = A5(_mm512_i32gather_ps::<1>(idx, base));
-                }
-                out
+            let mut rows = [Self::splat(0.0); LANES];
+            for i in 0..LANES {
+                // SAFETY: AVX-512F is available; lanes 0..7 lie in ray i (28 bytes from
+                // base + 7i floats), and masked-off lanes are not accessed.
+                rows[i] = A5(unsafe { _mm512_maskz_loadu_ps(0x7f, base.add(RAY_FLOATS * i)) });
             }
+            let t = Self::transpose(rows);
+            let mut out = [t[0]; 7];
+            for k in 0..7 {
+                out[k] = t[FIELDS[k] / 4];
+            }
+            out
         }
         #[inline(always)]
         fn min(a: A5, b: A5) -> A5 {
