@@ -453,8 +453,8 @@ fn consider(st: &mut PacketHits, i: usize, id: usize, t: f32, b: Bary) {
         st.t[i] = t;
         st.tm[i] = up(t);
         st.id[i] = f32::from_bits(id as u32);
-        for k in 0..3 {
-            st.b[k][i] = b[k];
+        for (row, bk) in st.b.iter_mut().zip(b) {
+            row[i] = bk;
         }
         st.inv[i] = 1.0;
         st.found |= bit;
