@@ -13,6 +13,9 @@ pub const NO_LIGHT: u32 = u32::MAX;
 /// otherwise its orientation follows the winding/ReverseOrientation). It is *not* flipped
 /// toward the ray; one-sided area lights emit on the side of `ng`.
 #[derive(Clone, Copy, Debug)]
+// C layout: sixteen 4-byte fields in this order, which the packet queries write as one
+// 64-byte row (`SurfaceHit::from_lanes`).
+#[repr(C)]
 pub struct SurfaceHit {
     /// Ray parameter of the hit.
     pub t: f32,
@@ -34,7 +37,20 @@ pub struct SurfaceHit {
     pub light: u32,
 }
 
+// The layout `from_lanes` relies on: no padding.
+const _: () = assert!(std::mem::size_of::<SurfaceHit>() == 64);
+
 impl SurfaceHit {
+    /// The hit whose fields, in declaration order, have the bit patterns `a` (f32 and u32
+    /// fields alike).
+    #[inline(always)]
+    pub(super) fn from_lanes(a: [f32; 16]) -> Self {
+        // SAFETY: `SurfaceHit` is `repr(C)` with sixteen 4-byte fields (glam's `Vec3` and
+        // `Vec2` are `repr(C)` structs of f32) and no padding (size 64, asserted above);
+        // every bit pattern is a valid f32 and u32.
+        unsafe { std::mem::transmute::<[f32; 16], SurfaceHit>(a) }
+    }
+
     /// Origin for a ray leaving the surface toward direction `w` (offset along ±ng by the
     /// error bound so it cannot re-hit the surface it leaves).
     #[inline]

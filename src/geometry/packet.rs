@@ -32,8 +32,54 @@ use std::mem::MaybeUninit;
 /// Rays per packet query.
 pub const PACKET: usize = 16;
 
-/// Closest-hit record of one ray: (leaf-order id, t, barycentrics).
-type LaneHit = (usize, f32, Bary);
+/// The closest-hit state of a packet's traversal, lanes over rays (in memory, so that the
+/// rare scalar steps, exact-zero redos and quadrics, update single lanes).
+pub(super) struct PacketHits {
+    /// Best hit distance so far per ray (its t_max at first, −∞ in inactive lanes).
+    pub(super) t: Lanes,
+    /// `up(t)`: the bound of the tests, so that hits at exactly the best t are seen.
+    tm: Lanes,
+    /// Leaf-order id of each ray's best hit, as f32 bit patterns (compared as integers).
+    pub(super) id: Lanes,
+    /// The best hit's edge functions (after [`PacketHits::finish`]: its barycentrics).
+    /// Scalar-redo and quadric hits store their barycentrics here with `inv` = 1, whose
+    /// product is exact.
+    pub(super) b: [Lanes; 3],
+    /// The best hit's reciprocal determinant: barycentric k = b[k] · inv (the products of
+    /// `RayShear4::closest`, formed once per ray at the end).
+    inv: Lanes,
+    /// Rays with a hit.
+    pub(super) found: u32,
+    /// Rays with another primitive hit at exactly their best t (redone by the scalar query).
+    pub(super) ties: u32,
+}
+
+impl PacketHits {
+    /// No hit yet.
+    pub(super) const fn new() -> Self {
+        PacketHits {
+            t: [0.0; PACKET],
+            tm: [0.0; PACKET],
+            id: [0.0; PACKET],
+            b: [[0.0; PACKET]; 3],
+            inv: [0.0; PACKET],
+            found: 0,
+            ties: 0,
+        }
+    }
+
+    /// Hit of ray `i` as (leaf-order id, t, barycentrics); valid for rays in `found`, after
+    /// [`PacketHits::finish`].
+    #[inline(always)]
+    pub(super) fn hit(&self, i: usize) -> (usize, f32, Bary) {
+        let i = i & (PACKET - 1);
+        (
+            self.id[i].to_bits() as usize,
+            self.t[i],
+            [self.b[0][i], self.b[1][i], self.b[2][i]],
+        )
+    }
+}
 
 impl Geometry {
     /// Closest hit of each active ray (bit i of `active` ⇒ rays[i] is traced); out[i] = None for
@@ -90,14 +136,12 @@ impl Geometry {
             }
             return;
         }
-        let mut hits = [(0usize, 0.0f32, [0.0f32; 3]); PACKET];
-        let (found, ties) = bvh.closest_packet(isa, rays, active, &mut hits, |id, ray, t_max| {
+        let mut hits = PacketHits::new();
+        bvh.closest_packet(isa, rays, active, &mut hits, |id, ray, t_max| {
             self.quadric_t_outlined(id, ray.o, ray.d, t_max)
         });
-        for i in bits(found & !ties) {
-            let (id, t, b) = hits[i];
-            out[i] = Some(self.surface_hit(id, &rays[i], t, b));
-        }
+        let ties = hits.ties;
+        self.hit_records(isa, rays, &hits, hits.found & !ties, out);
         for i in bits(ties) {
             out[i] = self.intersect(&rays[i]);
         }
@@ -140,7 +184,7 @@ const PACKET_MASK: u32 = ((1u64 << PACKET) - 1) as u32;
 
 /// Indices of the set bits of `m`, lowest first.
 #[inline(always)]
-fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+pub(super) fn bits(mut m: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         if m == 0 {
             return None;
@@ -307,21 +351,6 @@ struct TriLanes<S: Simd> {
     inv: S::F,
 }
 
-impl<S: Simd> TriLanes<S> {
-    /// The lanes of t, inv, e0, e1, e2 in memory (barycentric k of lane i = e_k[i] · inv[i],
-    /// the products of `RayShear4::closest`).
-    #[inline(always)]
-    fn spill(&self) -> [Lanes; 5] {
-        let mut a = [[0.0f32; PACKET]; 5];
-        S::store(self.t, &mut a[0]);
-        S::store(self.inv, &mut a[1]);
-        for k in 0..3 {
-            S::store(self.e[k], &mut a[2 + k]);
-        }
-        a
-    }
-}
-
 /// Ray-space vertex `v` (a function, not a closure: out of line it would miss the caller's
 /// target features).
 #[inline(always)]
@@ -413,41 +442,52 @@ fn up(b: f32) -> f32 {
     f32::from_bits(b.to_bits() + (0.0..f32::INFINITY).contains(&b) as u32)
 }
 
-/// [`up`] on every lane.
+/// Record a hit of ray `i` on primitive `id` at `t` (below `up(best[i])`) with barycentrics
+/// `b`: a closer one replaces the best, one at exactly the best t from another primitive
+/// marks a tie (the scalar steps; [`consider_lanes`] is the vector one).
 #[inline(always)]
-fn up_lanes(b: &Lanes) -> Lanes {
-    let mut u = *b;
-    for x in u.iter_mut() {
-        *x = up(*x);
+fn consider(st: &mut PacketHits, i: usize, id: usize, t: f32, b: Bary) {
+    let i = i & (PACKET - 1);
+    let bit = 1 << i;
+    if t < st.t[i] {
+        st.t[i] = t;
+        st.tm[i] = up(t);
+        st.id[i] = f32::from_bits(id as u32);
+        for (row, bk) in st.b.iter_mut().zip(b) {
+            row[i] = bk;
+        }
+        st.inv[i] = 1.0;
+        st.found |= bit;
+        st.ties &= !bit;
+    } else if t == st.t[i] && st.found & bit != 0 && st.id[i].to_bits() != id as u32 {
+        st.ties |= bit;
     }
-    u
 }
 
-/// Record a hit of ray `i` on primitive `id` at `t` (below `up(best[i])`): a closer one
-/// replaces the best, one at exactly the best t from another primitive marks a tie.
-#[allow(clippy::too_many_arguments)]
+/// [`consider`] for the rays `hit` of triangle `id`'s test `h`, on all lanes at once: the
+/// same comparisons per lane, and the barycentric products deferred to the end (the same
+/// operands, hence the same bits).
 #[inline(always)]
-fn consider(
-    best: &mut Lanes,
-    tm: &mut Lanes,
-    out: &mut [LaneHit; PACKET],
-    found: &mut u32,
-    ties: &mut u32,
-    i: usize,
-    id: usize,
-    t: f32,
-    b: Bary,
-) {
-    let bit = 1 << i;
-    if t < best[i] {
-        best[i] = t;
-        tm[i] = up(t);
-        out[i] = (id, t, b);
-        *found |= bit;
-        *ties &= !bit;
-    } else if t == best[i] && *found & bit != 0 && out[i].0 != id {
-        *ties |= bit;
+fn consider_lanes<S: Simd>(st: &mut PacketHits, id: u32, h: &TriLanes<S>, hit: u32) {
+    let best = S::load(&st.t);
+    let ids = S::load(&st.id);
+    let idv = S::splat(f32::from_bits(id));
+    let hm = S::mask(hit);
+    let closer = S::and(S::lt(h.t, best), hm);
+    let same = S::and(S::and(S::eq(h.t, best), hm), S::mask(st.found));
+    let tie = S::andnot(same, S::eq_bits(ids, idv));
+    S::store(S::select(closer, h.t, best), &mut st.t);
+    // Hits have 0 < t < ∞, where `up` adds one to the bit pattern.
+    let tm = S::select(closer, h.t, S::load(&st.tm));
+    S::store(S::inc_bits(closer, tm), &mut st.tm);
+    S::store(S::select(closer, idv, ids), &mut st.id);
+    for k in 0..3 {
+        S::store(S::select(closer, h.e[k], S::load(&st.b[k])), &mut st.b[k]);
     }
+    S::store(S::select(closer, h.inv, S::load(&st.inv)), &mut st.inv);
+    let closer = S::bits(closer);
+    st.found |= closer;
+    st.ties = (st.ties & !closer) | S::bits(tie);
 }
 
 /// The [`RayShear4`] of ray `i`, built on first use (`built` marks the built ones).
@@ -530,18 +570,19 @@ impl WideBvh {
 }
 
 impl WideBvh {
-    /// Closest hits of the rays `active` on backend `isa` (one this CPU runs): writes `out[i]` for each ray i in
-    /// the returned hit mask; the second mask flags rays with another primitive hit at exactly
-    /// their best t (the caller redoes those with the scalar query). `other(id, ray, t_max)`
+    /// Closest hits of the rays `active` on backend `isa` (one this CPU runs) into `out` (a
+    /// fresh [`PacketHits`]): `out.hit(i)` for each ray i in `out.found`; `out.ties` flags
+    /// rays with another primitive hit at exactly their best t (the caller redoes those with
+    /// the scalar query). `other(id, ray, t_max)`
     /// is the hit distance of a non-triangle primitive if below `t_max`, else +∞.
     pub(super) fn closest_packet(
         &self,
         isa: Isa,
         rays: &[Ray; PACKET],
         active: u32,
-        out: &mut [LaneHit; PACKET],
+        out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
-    ) -> (u32, u32) {
+    ) {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
@@ -560,9 +601,9 @@ impl WideBvh {
         &self,
         rays: &[Ray; PACKET],
         active: u32,
-        out: &mut [LaneHit; PACKET],
+        out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
-    ) -> (u32, u32) {
+    ) {
         self.closest_packet_impl::<Avx512>(rays, active, out, other)
     }
 
@@ -573,9 +614,9 @@ impl WideBvh {
         &self,
         rays: &[Ray; PACKET],
         active: u32,
-        out: &mut [LaneHit; PACKET],
+        out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
-    ) -> (u32, u32) {
+    ) {
         self.closest_packet_impl::<Avx2>(rays, active, out, other)
     }
 
@@ -632,25 +673,24 @@ impl WideBvh {
         &self,
         rays: &[Ray; PACKET],
         active: u32,
-        out: &mut [LaneHit; PACKET],
+        st: &mut PacketHits,
         mut other: impl FnMut(usize, &Ray, f32) -> f32,
-    ) -> (u32, u32) {
+    ) {
         if self.nodes.is_empty() || active == 0 {
-            return (0, 0);
+            return;
         }
         let l = S::rays(rays);
         let r = PacketBox::<S>::new(&l, active);
-        let mut best: Lanes = [f32::NEG_INFINITY; PACKET];
-        for i in bits(active) {
-            best[i] = rays[i].t_max;
-        }
+        let best = S::select(S::mask(active), l[6], S::splat(f32::NEG_INFINITY));
+        S::store(best, &mut st.t);
         // Bounds of the tests: up(best), so that hits at exactly the best t are seen.
-        let mut tm = up_lanes(&best);
+        let zero = S::splat(0.0);
+        let finite = S::and(S::le(zero, best), S::lt(best, S::splat(f32::INFINITY)));
+        S::store(S::inc_bits(finite, best), &mut st.tm);
         let pshear = PacketShear::<S>::new(rays, &l, active);
         // Per-ray shears for packets whose rays differ in shear axes, built at first use.
         let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
         let mut built = 0u32;
-        let (mut found, mut ties) = (0u32, 0u32);
         let mut stack = [const { MaybeUninit::<Pending>::uninit() }; STACK];
         let mut sp = 0usize;
         let (mut cur, mut mask) = (0u32, active);
@@ -660,7 +700,7 @@ impl WideBvh {
                 // SAFETY: interior references are node indices written by the build, and the
                 // root exists (`nodes` is not empty).
                 let node = unsafe { self.nodes.get_unchecked(cur as usize) };
-                let mut m = node_hits::<S>(node, &r, &best, &mut near);
+                let mut m = node_hits::<S>(node, &r, &st.t, &mut near);
                 let mut order = [0usize; 4];
                 let mut key = [0.0f32; 4];
                 let mut n = 0;
@@ -706,34 +746,17 @@ impl WideBvh {
                     if let Some(ps) = &pshear {
                         for lane in bits(pk.tri) {
                             let p = tri_vertices(pk, lane);
-                            let id = pk.ids[lane & 3] as usize;
-                            let h = triangle_lanes(ps, p, &tm, mask);
+                            let id = pk.ids[lane & 3];
+                            let h = triangle_lanes(ps, p, &st.tm, mask);
                             let hits = h.hit & mask;
                             if hits != 0 {
-                                let [t, inv, e0, e1, e2] = h.spill();
-                                for i in bits(hits) {
-                                    let i = i & (PACKET - 1);
-                                    let b = [e0[i] * inv[i], e1[i] * inv[i], e2[i] * inv[i]];
-                                    consider(
-                                        &mut best, &mut tm, out, &mut found, &mut ties, i, id,
-                                        t[i], b,
-                                    );
-                                }
+                                consider_lanes(st, id, &h, hits);
                             }
                             for i in bits(h.redo & mask) {
                                 let i = i & (PACKET - 1);
-                                if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, tm[i]) {
-                                    consider(
-                                        &mut best,
-                                        &mut tm,
-                                        out,
-                                        &mut found,
-                                        &mut ties,
-                                        i,
-                                        id,
-                                        t,
-                                        [b0, b1, b2],
-                                    );
+                                if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, st.tm[i])
+                                {
+                                    consider(st, i, id as usize, t, [b0, b1, b2]);
                                 }
                             }
                         }
@@ -741,11 +764,9 @@ impl WideBvh {
                         for i in bits(mask) {
                             let i = i & (PACKET - 1);
                             let shear = ray_shear(&mut shears, &mut built, rays, i);
-                            if let Some((lane, t, b)) = shear.closest(pk, tm[i]) {
+                            if let Some((lane, t, b)) = shear.closest(pk, st.tm[i]) {
                                 let id = pk.ids[lane & 3] as usize;
-                                consider(
-                                    &mut best, &mut tm, out, &mut found, &mut ties, i, id, t, b,
-                                );
+                                consider(st, i, id, t, b);
                             }
                         }
                     }
@@ -753,20 +774,10 @@ impl WideBvh {
                         let id = pk.ids[lane & 3] as usize;
                         for i in bits(mask) {
                             let i = i & (PACKET - 1);
-                            let t_max = tm[i];
+                            let t_max = st.tm[i];
                             let t = other(id, &rays[i], t_max);
                             if t < t_max {
-                                consider(
-                                    &mut best,
-                                    &mut tm,
-                                    out,
-                                    &mut found,
-                                    &mut ties,
-                                    i,
-                                    id,
-                                    t,
-                                    [1.0 / 3.0; 3],
-                                );
+                                consider(st, i, id, t, [1.0 / 3.0; 3]);
                             }
                         }
                     }
@@ -779,12 +790,17 @@ impl WideBvh {
             // Pop the nearest pending subtree that some ray may still find a hit in.
             loop {
                 if sp == 0 {
-                    return (found, ties);
+                    // The barycentrics of the best hits (see `PacketHits::b`).
+                    let inv = S::load(&st.inv);
+                    for k in 0..3 {
+                        S::store(S::load(&st.b[k]) * inv, &mut st.b[k]);
+                    }
+                    return;
                 }
                 sp -= 1;
                 // SAFETY: every slot below the stack pointer was written by a push above.
                 let e = unsafe { stack.get_unchecked(sp).assume_init_ref() };
-                let m = still_open::<S>(&e.near, &best, e.mask);
+                let m = still_open::<S>(&e.near, &st.t, e.mask);
                 if m != 0 {
                     cur = e.child;
                     mask = m;

@@ -34,6 +34,8 @@ pub(super) trait Simd: Copy {
     fn store(v: Self::F, a: &mut Lanes);
     /// Lane-wise IEEE quotient.
     fn div(a: Self::F, b: Self::F) -> Self::F;
+    /// Lane-wise IEEE square root.
+    fn sqrt(a: Self::F) -> Self::F;
     /// The rays' origins, directions and t_max transposed to lanes: `[o.x, o.y, o.z, d.x,
     /// d.y, d.z, t_max]`.
     fn rays(rays: &[Ray; LANES]) -> [Self::F; 7];
@@ -65,6 +67,27 @@ pub(super) trait Simd: Copy {
     fn xor(a: Self::M, b: Self::M) -> Self::M;
     /// One bit per lane (bit i = lane i).
     fn bits(m: Self::M) -> u32;
+    /// Lanes whose bit patterns are equal (integer compare: ids kept in f32 lanes).
+    fn eq_bits(a: Self::F, b: Self::F) -> Self::M;
+    /// The bit pattern plus one in lanes `m` (`next_up` of a non-negative finite value),
+    /// `a` elsewhere.
+    fn inc_bits(m: Self::M, a: Self::F) -> Self::F;
+    /// The mask with lane i set where bit i of `b` is (the inverse of [`Simd::bits`]).
+    fn mask(b: u32) -> Self::M;
+    /// The 16 × 16 transpose: lane k of result i is lane i of `rows[k]` (bits moved as is).
+    fn transpose(rows: [Self::F; LANES]) -> [Self::F; LANES];
+}
+
+/// [`Simd::transpose`] through memory, for the backends without a faster one.
+#[inline(always)]
+fn transpose_lanes(a: &[Lanes; LANES]) -> [Lanes; LANES] {
+    let mut t = [[0.0f32; LANES]; LANES];
+    for k in 0..LANES {
+        for i in 0..LANES {
+            t[i][k] = a[k][i];
+        }
+    }
+    t
 }
 
 /// [`Simd::rays`] by scalar moves.
@@ -158,6 +181,14 @@ impl Simd for Portable {
         a / b
     }
     #[inline(always)]
+    fn sqrt(a: PV) -> PV {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = a.0[i].sqrt();
+        }
+        PV(r)
+    }
+    #[inline(always)]
     fn rays(rays: &[Ray; LANES]) -> [PV; 7] {
         ray_arrays(rays).map(PV)
     }
@@ -235,6 +266,38 @@ impl Simd for Portable {
             .enumerate()
             .fold(0, |b, (i, &m)| b | (m >> 31) << i)
     }
+    #[inline(always)]
+    fn eq_bits(a: PV, b: PV) -> Self::M {
+        let mut m = [0; LANES];
+        for i in 0..LANES {
+            m[i] = if a.0[i].to_bits() == b.0[i].to_bits() {
+                !0
+            } else {
+                0
+            };
+        }
+        m
+    }
+    #[inline(always)]
+    fn inc_bits(m: Self::M, a: PV) -> PV {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = f32::from_bits(a.0[i].to_bits().wrapping_add(m[i] >> 31));
+        }
+        PV(r)
+    }
+    #[inline(always)]
+    fn mask(b: u32) -> Self::M {
+        let mut m = [0; LANES];
+        for i in 0..LANES {
+            m[i] = 0u32.wrapping_sub(b >> i & 1);
+        }
+        m
+    }
+    #[inline(always)]
+    fn transpose(rows: [PV; LANES]) -> [PV; LANES] {
+        transpose_lanes(&rows.map(|r| r.0)).map(PV)
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -245,7 +308,7 @@ pub(super) use x86::{Avx2, Avx512};
 /// after `is_x86_feature_detected!`, which is what the `SAFETY` comments below rely on.
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::{LANES, Lanes, Ray, Simd};
+    use super::{LANES, Lanes, Ray, Simd, transpose_lanes};
     use std::arch::x86_64::*;
     use std::mem::{offset_of, size_of};
 
@@ -343,6 +406,11 @@ mod x86 {
         #[inline(always)]
         fn div(a: A2, b: A2) -> A2 {
             halves!(_mm256_div_ps, a, b)
+        }
+        #[inline(always)]
+        fn sqrt(a: A2) -> A2 {
+            // SAFETY: AVX2 is available (see the module docs).
+            unsafe { A2(_mm256_sqrt_ps(a.0), _mm256_sqrt_ps(a.1)) }
         }
         #[inline(always)]
         fn rays(rays: &[Ray; LANES]) -> [A2; 7] {
@@ -448,6 +516,57 @@ mod x86 {
                 (_mm256_movemask_ps(m.0) as u32) | (_mm256_movemask_ps(m.1) as u32) << (LANES / 2)
             }
         }
+        #[inline(always)]
+        fn eq_bits(a: A2, b: A2) -> A2 {
+            // SAFETY: AVX2 is available (see the module docs).
+            unsafe {
+                let (a0, a1) = (_mm256_castps_si256(a.0), _mm256_castps_si256(a.1));
+                let (b0, b1) = (_mm256_castps_si256(b.0), _mm256_castps_si256(b.1));
+                A2(
+                    _mm256_castsi256_ps(_mm256_cmpeq_epi32(a0, b0)),
+                    _mm256_castsi256_ps(_mm256_cmpeq_epi32(a1, b1)),
+                )
+            }
+        }
+        #[inline(always)]
+        fn inc_bits(m: A2, a: A2) -> A2 {
+            // SAFETY: AVX2 is available (see the module docs).
+            let up = unsafe {
+                let one = _mm256_set1_epi32(1);
+                let (a0, a1) = (_mm256_castps_si256(a.0), _mm256_castps_si256(a.1));
+                A2(
+                    _mm256_castsi256_ps(_mm256_add_epi32(a0, one)),
+                    _mm256_castsi256_ps(_mm256_add_epi32(a1, one)),
+                )
+            };
+            Self::select(m, up, a)
+        }
+        #[inline(always)]
+        fn mask(b: u32) -> A2 {
+            // SAFETY: AVX2 is available (see the module docs).
+            unsafe {
+                let lo = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+                let hi = _mm256_slli_epi32::<8>(lo);
+                let v = _mm256_set1_epi32(b as i32);
+                A2(
+                    _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(v, lo), lo)),
+                    _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(v, hi), hi)),
+                )
+            }
+        }
+        #[inline(always)]
+        fn transpose(rows: [A2; LANES]) -> [A2; LANES] {
+            let mut a = [[0.0f32; LANES]; LANES];
+            for k in 0..LANES {
+                Self::store(rows[k], &mut a[k]);
+            }
+            let t = transpose_lanes(&a);
+            let mut out = [Self::splat(0.0); LANES];
+            for i in 0..LANES {
+                out[i] = Self::load(&t[i]);
+            }
+            out
+        }
     }
 
     impl Simd for Avx512 {
@@ -474,36 +593,30 @@ mod x86 {
             unsafe { A5(_mm512_div_ps(a.0, b.0)) }
         }
         #[inline(always)]
+        fn sqrt(a: A5) -> A5 {
+            // SAFETY: AVX-512F is available (see the module docs).
+            unsafe { A5(_mm512_sqrt_ps(a.0)) }
+        }
+        #[inline(always)]
         fn rays(rays: &[Ray; LANES]) -> [A5; 7] {
+            // Ray i's seven floats as row i (masked loads: nothing past the ray is read),
+            // transposed: field k of every ray is then row FIELDS[k] / 4. Shuffles instead of
+            // seven gathers, which are slow on some CPUs (Zen 4).
+            const RAY_FLOATS: usize = size_of::<Ray>() / 4;
+            const _: () = assert!(size_of::<Ray>() == 28 && RAY_FLOATS == 7);
             let base = rays.as_ptr() as *const f32;
-            // SAFETY: AVX-512F is available; every gathered address is ray i's field at byte
-            // offset ray_offset(i) + FIELDS[k] < size_of_val(rays), inside the array.
-            unsafe {
-                let idx = _mm512_setr_epi32(
-                    ray_offset(0),
-                    ray_offset(1),
-                    ray_offset(2),
-                    ray_offset(3),
-                    ray_offset(4),
-                    ray_offset(5),
-                    ray_offset(6),
-                    ray_offset(7),
-                    ray_offset(8),
-                    ray_offset(9),
-                    ray_offset(10),
-                    ray_offset(11),
-                    ray_offset(12),
-                    ray_offset(13),
-                    ray_offset(14),
-                    ray_offset(15),
-                );
-                let mut out = [A5(_mm512_setzero_ps()); 7];
-                for k in 0..7 {
-                    let idx = _mm512_add_epi32(idx, _mm512_set1_epi32(FIELDS[k] as i32));
-                    out[k] = A5(_mm512_i32gather_ps::<1>(idx, base));
-                }
-                out
+            let mut rows = [Self::splat(0.0); LANES];
+            for i in 0..LANES {
+                // SAFETY: AVX-512F is available; lanes 0..7 lie in ray i (28 bytes from
+                // base + 7i floats), and masked-off lanes are not accessed.
+                rows[i] = A5(unsafe { _mm512_maskz_loadu_ps(0x7f, base.add(RAY_FLOATS * i)) });
             }
+            let t = Self::transpose(rows);
+            let mut out = [t[0]; 7];
+            for k in 0..7 {
+                out[k] = t[FIELDS[k] / 4];
+            }
+            out
         }
         #[inline(always)]
         fn min(a: A5, b: A5) -> A5 {
@@ -575,6 +688,68 @@ mod x86 {
         fn bits(m: __mmask16) -> u32 {
             m as u32
         }
+        #[inline(always)]
+        fn eq_bits(a: A5, b: A5) -> __mmask16 {
+            // SAFETY: AVX-512F is available (see the module docs).
+            unsafe { _mm512_cmpeq_epi32_mask(_mm512_castps_si512(a.0), _mm512_castps_si512(b.0)) }
+        }
+        #[inline(always)]
+        fn inc_bits(m: __mmask16, a: A5) -> A5 {
+            // SAFETY: AVX-512F is available (see the module docs).
+            unsafe {
+                let x = _mm512_castps_si512(a.0);
+                let y = _mm512_mask_add_epi32(x, m, x, _mm512_set1_epi32(1));
+                A5(_mm512_castsi512_ps(y))
+            }
+        }
+        #[inline(always)]
+        fn mask(b: u32) -> __mmask16 {
+            b as __mmask16
+        }
+        #[inline(always)]
+        fn transpose(rows: [A5; LANES]) -> [A5; LANES] {
+            // SAFETY: AVX-512F is available (see the module docs).
+            unsafe {
+                let mut r = [_mm512_setzero_ps(); LANES];
+                for k in 0..LANES {
+                    r[k] = rows[k].0;
+                }
+                // 2 × 2 blocks of floats within each 128-bit lane, then of pairs: u[4j + m]
+                // holds, in 128-bit lane L, element 4L + m of rows 4j..4j + 3.
+                let mut t = [_mm512_setzero_ps(); LANES];
+                for j in 0..8 {
+                    t[2 * j] = _mm512_unpacklo_ps(r[2 * j], r[2 * j + 1]);
+                    t[2 * j + 1] = _mm512_unpackhi_ps(r[2 * j], r[2 * j + 1]);
+                }
+                let mut u = [_mm512_setzero_ps(); LANES];
+                for j in 0..4 {
+                    let (a, b) = (_mm512_castps_pd(t[4 * j]), _mm512_castps_pd(t[4 * j + 2]));
+                    let (c, d) = (
+                        _mm512_castps_pd(t[4 * j + 1]),
+                        _mm512_castps_pd(t[4 * j + 3]),
+                    );
+                    u[4 * j] = _mm512_castpd_ps(_mm512_unpacklo_pd(a, b));
+                    u[4 * j + 1] = _mm512_castpd_ps(_mm512_unpackhi_pd(a, b));
+                    u[4 * j + 2] = _mm512_castpd_ps(_mm512_unpacklo_pd(c, d));
+                    u[4 * j + 3] = _mm512_castpd_ps(_mm512_unpackhi_pd(c, d));
+                }
+                // Then the 128-bit lanes: result 4L + m gathers lane L of u[m], u[4 + m],
+                // u[8 + m], u[12 + m].
+                let mut out = [A5(_mm512_setzero_ps()); LANES];
+                for m in 0..4 {
+                    let (a, b, c, d) = (u[m], u[4 + m], u[8 + m], u[12 + m]);
+                    let v0 = _mm512_shuffle_f32x4::<0x44>(a, b);
+                    let v1 = _mm512_shuffle_f32x4::<0xee>(a, b);
+                    let v2 = _mm512_shuffle_f32x4::<0x44>(c, d);
+                    let v3 = _mm512_shuffle_f32x4::<0xee>(c, d);
+                    out[m] = A5(_mm512_shuffle_f32x4::<0x88>(v0, v2));
+                    out[4 + m] = A5(_mm512_shuffle_f32x4::<0xdd>(v0, v2));
+                    out[8 + m] = A5(_mm512_shuffle_f32x4::<0x88>(v1, v3));
+                    out[12 + m] = A5(_mm512_shuffle_f32x4::<0xdd>(v1, v3));
+                }
+                out
+            }
+        }
     }
 }
 
@@ -617,7 +792,13 @@ mod tests {
 
     /// `x`'s bits, with every NaN as `f32::NAN` (see [`lane_bits`]).
     fn canon(x: f32) -> u32 {
-        if x.is_nan() { f32::NAN } else { x }.to_bits()
+        // On the bits: a float select of NaNs could be folded to `x` (NaN payloads are
+        // unspecified to LLVM).
+        if x.is_nan() {
+            f32::NAN.to_bits()
+        } else {
+            x.to_bits()
+        }
     }
 
     /// Every operation of backend `S` on the special values, as bit patterns.
@@ -631,6 +812,7 @@ mod tests {
                 x - y,
                 x * y,
                 S::div(x, y),
+                S::sqrt(x),
                 S::min(x, y),
                 S::max(x, y),
                 S::sign_one(x),
@@ -640,7 +822,15 @@ mod tests {
             for f in values {
                 v.extend(lane_bits::<S>(f));
             }
-            let masks = [S::lt(x, y), S::le(x, y), S::eq(x, y), S::sign(x)];
+            v.extend(lane_bits::<S>(S::inc_bits(S::lt(x, y), x)));
+            let masks = [
+                S::lt(x, y),
+                S::le(x, y),
+                S::eq(x, y),
+                S::sign(x),
+                S::eq_bits(x, y),
+                S::mask(0x8421 << round),
+            ];
             let (m0, m1) = (masks[0], masks[2]);
             let combos = [
                 S::and(m0, m1),
@@ -649,6 +839,11 @@ mod tests {
                 S::xor(m0, m1),
             ];
             v.extend(masks.iter().chain(&combos).map(|&m| S::bits(m)));
+        }
+        let rows: [S::F; LANES] =
+            std::array::from_fn(|k| S::load(&std::array::from_fn(|i| (k * LANES + i) as f32)));
+        for f in S::transpose(rows) {
+            v.extend(lane_bits::<S>(f));
         }
         let rays: [Ray; LANES] = std::array::from_fn(|i| Ray {
             o: Vec3::new(i as f32, -(i as f32), 0.5),
@@ -666,17 +861,27 @@ mod tests {
     fn portable_lanes_are_the_scalar_operations() {
         let (a, b) = rows(1);
         let r = results::<Portable>();
-        let per_round = 9 * LANES + 8;
+        let per_round = 11 * LANES + 10;
         for i in 0..LANES {
             let (x, y) = (a[i], b[i]);
             let at = |k: usize| r[per_round + k * LANES + i];
             assert_eq!(at(0), canon(x + y));
             assert_eq!(at(3), canon(x / y));
+            assert_eq!(at(4), canon(x.sqrt()));
             // SSE semantics: the second operand unless the first is strictly smaller/larger.
-            assert_eq!(at(4), canon(if x < y { x } else { y }));
-            assert_eq!(at(5), canon(if x > y { x } else { y }));
-            assert_eq!(at(6), canon(1.0f32.copysign(x)));
-            assert_eq!(at(7), canon(x.abs()));
+            assert_eq!(at(5), canon(if x < y { x } else { y }));
+            assert_eq!(at(6), canon(if x > y { x } else { y }));
+            assert_eq!(at(7), canon(1.0f32.copysign(x)));
+            assert_eq!(at(8), canon(x.abs()));
+            let up = f32::from_bits(x.to_bits().wrapping_add(1));
+            assert_eq!(at(10), canon(if x < y { up } else { x }));
+        }
+        // The transpose follows the four rounds: result i, lane k = row k, lane i = 16k + i.
+        let t = &r[4 * per_round..];
+        for i in 0..LANES {
+            for k in 0..LANES {
+                assert_eq!(t[i * LANES + k], ((k * LANES + i) as f32).to_bits());
+            }
         }
     }
 
