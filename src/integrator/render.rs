@@ -6,12 +6,16 @@ use super::RenderOptions;
 use super::direct::{CameraPacket, DIM_FILTER, DirectLighting, PacketScratch};
 use super::film::filter_sample;
 use crate::Rgb;
+use crate::camera::CameraRays;
 use crate::geometry::PACKET;
+use crate::geometry::Ray;
 use crate::image::Image;
+use crate::isa::Isa;
 use crate::light_selection::make_selector;
 use crate::sampling::{PixelSamples, make_pattern};
+use crate::scene::Filter;
 use crate::scene::Scene;
-use glam::UVec2;
+use glam::{UVec2, Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::io::IsTerminal;
@@ -65,6 +69,7 @@ pub fn render(
         mis_light: opts.mis_light,
     };
     let camera = scene.camera.rays(res);
+    let isa = Isa::detect();
     let tiles_x = res.x.div_ceil(TILE);
     let tiles_y = res.y.div_ceil(TILE);
     let n_tiles = (tiles_x * tiles_y) as u64;
@@ -124,24 +129,34 @@ pub fn render(
                     owner.truncate(keep as usize);
                     cam.clear();
                 };
+            // Per lane: the pixel and filter draw; the camera rays of a full packet are then
+            // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
+            let mut lanes = Lanes::new();
             for y in y0..y1 {
                 for x in x0..x1 {
                     let pixel = UVec2::new(x, y);
                     pxs.push(pattern.pixel(pixel));
                     owner.push(((y - y0) * w + (x - x0)) as usize);
+                    let mut slot = pxs.len() - 1;
                     for i in 0..opts.spp {
-                        let slot = pxs.len() - 1;
-                        let u = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
-                        let p = filter_sample(&scene.film.filter, pixel, u);
-                        cam.push(slot as u8, i, camera.generate(p));
+                        let k = cam.n;
+                        lanes.pixel[k] = pixel;
+                        lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
+                        cam.pixel[k] = slot as u8;
+                        cam.eye[k] = i;
+                        cam.n = k + 1;
                         // Flushed as soon as full, so its last lane is of the newest pixel.
                         if cam.is_full() {
+                            lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
                             flush(&mut cam, &mut pxs, &mut owner);
+                            // A pixel with samples left was kept, in slot 0.
+                            slot = 0;
                         }
                     }
                 }
             }
             if cam.n > 0 {
+                lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
                 flush(&mut cam, &mut pxs, &mut owner);
             }
             let out: Vec<Rgb> = sums.iter().map(|&s| s / opts.spp as f32).collect();
@@ -175,4 +190,64 @@ pub fn render(
         );
     }
     Ok((img, stats))
+}
+
+/// The camera samples of a packet's lanes before their rays are made.
+struct Lanes {
+    /// Per lane: the pixel.
+    pixel: [UVec2; PACKET],
+    /// Per lane: the pixel-filter draw.
+    u: [Vec2; PACKET],
+}
+
+impl Lanes {
+    fn new() -> Self {
+        Self {
+            pixel: [UVec2::ZERO; PACKET],
+            u: [Vec2::splat(0.5); PACKET],
+        }
+    }
+
+    /// The camera ray of every lane into `ray` (lanes past the packet's end get rays too, of
+    /// stale samples, which nothing reads): [`filter_sample`] then [`CameraRays::direction`],
+    /// per lane exactly as the scalar [`CameraRays::generate`], on `isa`'s widest vectors.
+    #[inline]
+    fn rays(&self, isa: Isa, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `isa` comes from `Isa::detect`: this CPU runs AVX-512 F.
+            Isa::Avx512 => unsafe { self.rays_avx512(camera, filter, ray) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above, this CPU runs AVX2.
+            Isa::Avx2 => unsafe { self.rays_avx2(camera, filter, ray) },
+            _ => self.rays_portable(camera, filter, ray),
+        }
+    }
+
+    /// [`Lanes::rays`] as plain loops over the lanes, which the compiler vectorises.
+    #[inline(always)]
+    fn rays_portable(&self, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+        let mut d = [Vec3::ZERO; PACKET];
+        for k in 0..PACKET {
+            d[k] = camera.direction(filter_sample(filter, self.pixel[k], self.u[k]));
+        }
+        let o = camera.origin();
+        for k in 0..PACKET {
+            ray[k] = Ray::new(o, d[k]);
+        }
+    }
+
+    /// [`Lanes::rays_portable`] compiled for AVX-512 (16 lanes = one vector).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    fn rays_avx512(&self, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+        self.rays_portable(camera, filter, ray)
+    }
+
+    /// [`Lanes::rays_portable`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn rays_avx2(&self, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+        self.rays_portable(camera, filter, ray)
+    }
 }
