@@ -89,82 +89,77 @@ pub fn render(
     let start = Instant::now();
     let tiles: Vec<Vec<Rgb>> = (0..tiles_x * tiles_y)
         .into_par_iter()
-        .map(|t| {
-            let (tx, ty) = (t % tiles_x, t / tiles_x);
-            let x0 = tx * TILE;
-            let y0 = ty * TILE;
-            let x1 = (x0 + TILE).min(res.x);
-            let y1 = (y0 + TILE).min(res.y);
-            let (w, h) = (x1 - x0, y1 - y0);
-            // Samples in pixel-major order, PACKET at a time: a pixel's sum adds its samples in
-            // index order, exactly as one loop per pixel would.
-            let mut sums = vec![Rgb::ZERO; (w * h) as usize];
-            let mut pxs: Vec<PixelSamples> = Vec::with_capacity(PACKET + 1);
-            let mut owner: Vec<usize> = Vec::with_capacity(PACKET + 1);
-            let mut cam = CameraPacket::new();
-            let mut radiance = [Rgb::ZERO; PACKET];
-            let mut scratch = PacketScratch::new();
-            let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
-            let mut flush =
-                |cam: &mut CameraPacket, pxs: &mut Vec<PixelSamples>, owner: &mut Vec<usize>| {
-                    tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut scratch);
-                    for k in 0..cam.n {
-                        let l = radiance[k];
-                        if l.is_finite() {
-                            sums[owner[cam.pixel[k] as usize]] += l;
-                        } else {
-                            tile_bad += 1;
+        // One pool of PixelSamples per worker (filled in place, pixel after pixel).
+        .map_init(
+            || -> Vec<PixelSamples> { (0..PACKET).map(|_| pattern.pixel(UVec2::ZERO)).collect() },
+            |pxs, t| {
+                let (tx, ty) = (t % tiles_x, t / tiles_x);
+                let x0 = tx * TILE;
+                let y0 = ty * TILE;
+                let x1 = (x0 + TILE).min(res.x);
+                let y1 = (y0 + TILE).min(res.y);
+                let (w, h) = (x1 - x0, y1 - y0);
+                // Samples in pixel-major order, PACKET at a time: a pixel's sum adds its samples in
+                // index order, exactly as one loop per pixel would.
+                let mut sums = vec![Rgb::ZERO; (w * h) as usize];
+                // Pixels take the pool's slots in turn and keep theirs while their samples last.
+                // No slot is taken while still in use: a pixel takes one when the open packet has
+                // at most PACKET − 1 lanes, of at most PACKET − 1 pixels, which hold the slots
+                // just before it in turn.
+                let mut owner = [0usize; PACKET];
+                let mut next = 0;
+                let mut cam = CameraPacket::new();
+                let mut radiance = [Rgb::ZERO; PACKET];
+                let mut scratch = PacketScratch::new();
+                let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
+                let mut flush =
+                    |cam: &mut CameraPacket, pxs: &[PixelSamples], owner: &[usize; PACKET]| {
+                        tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut scratch);
+                        for k in 0..cam.n {
+                            let l = radiance[k];
+                            if l.is_finite() {
+                                sums[owner[cam.pixel[k] as usize]] += l;
+                            } else {
+                                tile_bad += 1;
+                            }
                         }
-                    }
-                    // A pixel whose samples go on into the next packet keeps its (cached) samples.
-                    let last = cam.n - 1;
-                    let keep = cam.eye[last] + 1 < opts.spp;
-                    let slot = cam.pixel[last] as usize;
-                    // `slot != 0`: a self-swap still copies the ~3.6 KB PixelSamples 3 times.
-                    if keep && slot != 0 {
-                        pxs.swap(0, slot);
-                        owner.swap(0, slot);
-                    }
-                    pxs.truncate(keep as usize);
-                    owner.truncate(keep as usize);
-                    cam.clear();
-                };
-            // Per lane: the pixel and filter draw; the camera rays of a full packet are then
-            // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
-            let mut lanes = Lanes::new();
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let pixel = UVec2::new(x, y);
-                    pxs.push(pattern.pixel(pixel));
-                    owner.push(((y - y0) * w + (x - x0)) as usize);
-                    let mut slot = pxs.len() - 1;
-                    for i in 0..opts.spp {
-                        let k = cam.n;
-                        lanes.pixel[k] = pixel;
-                        lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
-                        cam.pixel[k] = slot as u8;
-                        cam.eye[k] = i;
-                        cam.n = k + 1;
-                        // Flushed as soon as full, so its last lane is of the newest pixel.
-                        if cam.is_full() {
-                            lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
-                            flush(&mut cam, &mut pxs, &mut owner);
-                            // A pixel with samples left was kept, in slot 0.
-                            slot = 0;
+                        cam.clear();
+                    };
+                // Per lane: the pixel and filter draw; the camera rays of a full packet are then
+                // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
+                let mut lanes = Lanes::new();
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        let pixel = UVec2::new(x, y);
+                        let slot = next;
+                        next = (next + 1) % PACKET;
+                        pattern.pixel_into(pixel, &mut pxs[slot]);
+                        owner[slot] = ((y - y0) * w + (x - x0)) as usize;
+                        for i in 0..opts.spp {
+                            let k = cam.n;
+                            lanes.pixel[k] = pixel;
+                            lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
+                            cam.pixel[k] = slot as u8;
+                            cam.eye[k] = i;
+                            cam.n = k + 1;
+                            if cam.is_full() {
+                                lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
+                                flush(&mut cam, pxs, &owner);
+                            }
                         }
                     }
                 }
-            }
-            if cam.n > 0 {
-                lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
-                flush(&mut cam, &mut pxs, &mut owner);
-            }
-            let out: Vec<Rgb> = sums.iter().map(|&s| s / opts.spp as f32).collect();
-            rays.fetch_add(tile_rays, Ordering::Relaxed);
-            bad.fetch_add(tile_bad, Ordering::Relaxed);
-            bar.inc(1);
-            out
-        })
+                if cam.n > 0 {
+                    lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
+                    flush(&mut cam, pxs, &owner);
+                }
+                let out: Vec<Rgb> = sums.iter().map(|&s| s / opts.spp as f32).collect();
+                rays.fetch_add(tile_rays, Ordering::Relaxed);
+                bad.fetch_add(tile_bad, Ordering::Relaxed);
+                bar.inc(1);
+                out
+            },
+        )
         .collect();
     bar.finish_and_clear();
     let time = start.elapsed();
