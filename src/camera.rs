@@ -43,9 +43,14 @@ impl Camera {
     /// Everything `generate_ray` needs for resolution `res`, computed once per render rather
     /// than once per ray.
     pub fn rays(&self, res: UVec2) -> CameraRays {
+        let m = self.camera_to_world.m;
         CameraRays {
             origin: self.camera_to_world.point(Vec3::ZERO),
-            camera_to_world: self.camera_to_world,
+            axes: [
+                m.x_axis.truncate(),
+                m.y_axis.truncate(),
+                m.z_axis.truncate(),
+            ],
             win: self.window(res),
             tan_half: (self.fov_deg.to_radians() * 0.5).tan(),
             res: res.as_vec2(),
@@ -79,7 +84,8 @@ impl Camera {
 #[derive(Clone, Copy, Debug)]
 pub struct CameraRays {
     origin: Vec3,
-    camera_to_world: Transform,
+    /// The first three columns of `camera_to_world.m` (its action on vectors).
+    axes: [Vec3; 3],
     win: [f32; 4],
     tan_half: f32,
     res: Vec2,
@@ -89,10 +95,28 @@ impl CameraRays {
     /// The unit-direction ray through continuous raster position `p`.
     #[inline]
     pub fn generate(&self, p: Vec2) -> Ray {
+        Ray::new(self.origin, self.direction(p))
+    }
+
+    /// The origin of every ray (the eye).
+    #[inline]
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    /// The unit direction of [`CameraRays::generate`]: the one definition of the camera math.
+    /// Plain f32 arithmetic (no 4-lane matrix code), so that a loop over many positions
+    /// vectorises lane by lane; the transform multiplies and adds in the order of glam's
+    /// `Mat4::transform_vector3` (x, then + y, then + z), so the bits are those of
+    /// `camera_to_world.vector(d).normalize()`.
+    #[inline(always)]
+    pub fn direction(&self, p: Vec2) -> Vec3 {
         let w = &self.win;
         let sx = w[0] + (p.x / self.res.x) * (w[1] - w[0]);
         let sy = w[3] - (p.y / self.res.y) * (w[3] - w[2]);
         let d = Vec3::new(sx * self.tan_half, sy * self.tan_half, 1.0);
-        Ray::new(self.origin, self.camera_to_world.vector(d).normalize())
+        let [ax, ay, az] = self.axes;
+        let v = az * d.z + (ay * d.y + ax * d.x);
+        v * (1.0 / (v.dot(v)).sqrt())
     }
 }

@@ -6,12 +6,16 @@ use super::RenderOptions;
 use super::direct::{CameraPacket, DIM_FILTER, DirectLighting, PacketScratch};
 use super::film::filter_sample;
 use crate::Rgb;
+use crate::camera::CameraRays;
 use crate::geometry::PACKET;
+use crate::geometry::Ray;
 use crate::image::Image;
+use crate::isa::Isa;
 use crate::light_selection::make_selector;
 use crate::sampling::{PixelSamples, make_pattern};
+use crate::scene::Filter;
 use crate::scene::Scene;
-use glam::UVec2;
+use glam::{UVec2, Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::io::IsTerminal;
@@ -65,6 +69,7 @@ pub fn render(
         mis_light: opts.mis_light,
     };
     let camera = scene.camera.rays(res);
+    let isa = Isa::detect();
     let tiles_x = res.x.div_ceil(TILE);
     let tiles_y = res.y.div_ceil(TILE);
     let n_tiles = (tiles_x * tiles_y) as u64;
@@ -84,72 +89,77 @@ pub fn render(
     let start = Instant::now();
     let tiles: Vec<Vec<Rgb>> = (0..tiles_x * tiles_y)
         .into_par_iter()
-        .map(|t| {
-            let (tx, ty) = (t % tiles_x, t / tiles_x);
-            let x0 = tx * TILE;
-            let y0 = ty * TILE;
-            let x1 = (x0 + TILE).min(res.x);
-            let y1 = (y0 + TILE).min(res.y);
-            let (w, h) = (x1 - x0, y1 - y0);
-            // Samples in pixel-major order, PACKET at a time: a pixel's sum adds its samples in
-            // index order, exactly as one loop per pixel would.
-            let mut sums = vec![Rgb::ZERO; (w * h) as usize];
-            let mut pxs: Vec<PixelSamples> = Vec::with_capacity(PACKET + 1);
-            let mut owner: Vec<usize> = Vec::with_capacity(PACKET + 1);
-            let mut cam = CameraPacket::new();
-            let mut radiance = [Rgb::ZERO; PACKET];
-            let mut scratch = PacketScratch::new();
-            let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
-            let mut flush =
-                |cam: &mut CameraPacket, pxs: &mut Vec<PixelSamples>, owner: &mut Vec<usize>| {
-                    tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut scratch);
-                    for k in 0..cam.n {
-                        let l = radiance[k];
-                        if l.is_finite() {
-                            sums[owner[cam.pixel[k] as usize]] += l;
-                        } else {
-                            tile_bad += 1;
+        // One pool of PixelSamples per worker (filled in place, pixel after pixel).
+        .map_init(
+            || -> Vec<PixelSamples> { (0..PACKET).map(|_| pattern.pixel(UVec2::ZERO)).collect() },
+            |pxs, t| {
+                let (tx, ty) = (t % tiles_x, t / tiles_x);
+                let x0 = tx * TILE;
+                let y0 = ty * TILE;
+                let x1 = (x0 + TILE).min(res.x);
+                let y1 = (y0 + TILE).min(res.y);
+                let (w, h) = (x1 - x0, y1 - y0);
+                // Samples in pixel-major order, PACKET at a time: a pixel's sum adds its samples in
+                // index order, exactly as one loop per pixel would.
+                let mut sums = vec![Rgb::ZERO; (w * h) as usize];
+                // Pixels take the pool's slots in turn and keep theirs while their samples last.
+                // No slot is taken while still in use: a pixel takes one when the open packet has
+                // at most PACKET − 1 lanes, of at most PACKET − 1 pixels, which hold the slots
+                // just before it in turn.
+                let mut owner = [0usize; PACKET];
+                let mut next = 0;
+                let mut cam = CameraPacket::new();
+                let mut radiance = [Rgb::ZERO; PACKET];
+                let mut scratch = PacketScratch::new();
+                let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
+                let mut flush =
+                    |cam: &mut CameraPacket, pxs: &[PixelSamples], owner: &[usize; PACKET]| {
+                        tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut scratch);
+                        for k in 0..cam.n {
+                            let l = radiance[k];
+                            if l.is_finite() {
+                                sums[owner[cam.pixel[k] as usize]] += l;
+                            } else {
+                                tile_bad += 1;
+                            }
                         }
-                    }
-                    // A pixel whose samples go on into the next packet keeps its (cached) samples.
-                    let last = cam.n - 1;
-                    let keep = cam.eye[last] + 1 < opts.spp;
-                    let slot = cam.pixel[last] as usize;
-                    // `slot != 0`: a self-swap still copies the ~3.6 KB PixelSamples 3 times.
-                    if keep && slot != 0 {
-                        pxs.swap(0, slot);
-                        owner.swap(0, slot);
-                    }
-                    pxs.truncate(keep as usize);
-                    owner.truncate(keep as usize);
-                    cam.clear();
-                };
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let pixel = UVec2::new(x, y);
-                    pxs.push(pattern.pixel(pixel));
-                    owner.push(((y - y0) * w + (x - x0)) as usize);
-                    for i in 0..opts.spp {
-                        let slot = pxs.len() - 1;
-                        let u = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
-                        let p = filter_sample(&scene.film.filter, pixel, u);
-                        cam.push(slot as u8, i, camera.generate(p));
-                        // Flushed as soon as full, so its last lane is of the newest pixel.
-                        if cam.is_full() {
-                            flush(&mut cam, &mut pxs, &mut owner);
+                        cam.clear();
+                    };
+                // Per lane: the pixel and filter draw; the camera rays of a full packet are then
+                // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
+                let mut lanes = Lanes::new();
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        let pixel = UVec2::new(x, y);
+                        let slot = next;
+                        next = (next + 1) % PACKET;
+                        pattern.pixel_into(pixel, &mut pxs[slot]);
+                        owner[slot] = ((y - y0) * w + (x - x0)) as usize;
+                        for i in 0..opts.spp {
+                            let k = cam.n;
+                            lanes.pixel[k] = pixel;
+                            lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
+                            cam.pixel[k] = slot as u8;
+                            cam.eye[k] = i;
+                            cam.n = k + 1;
+                            if cam.is_full() {
+                                lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
+                                flush(&mut cam, pxs, &owner);
+                            }
                         }
                     }
                 }
-            }
-            if cam.n > 0 {
-                flush(&mut cam, &mut pxs, &mut owner);
-            }
-            let out: Vec<Rgb> = sums.iter().map(|&s| s / opts.spp as f32).collect();
-            rays.fetch_add(tile_rays, Ordering::Relaxed);
-            bad.fetch_add(tile_bad, Ordering::Relaxed);
-            bar.inc(1);
-            out
-        })
+                if cam.n > 0 {
+                    lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
+                    flush(&mut cam, pxs, &owner);
+                }
+                let out: Vec<Rgb> = sums.iter().map(|&s| s / opts.spp as f32).collect();
+                rays.fetch_add(tile_rays, Ordering::Relaxed);
+                bad.fetch_add(tile_bad, Ordering::Relaxed);
+                bar.inc(1);
+                out
+            },
+        )
         .collect();
     bar.finish_and_clear();
     let time = start.elapsed();
@@ -175,4 +185,109 @@ pub fn render(
         );
     }
     Ok((img, stats))
+}
+
+/// The camera samples of a packet's lanes before their rays are made.
+struct Lanes {
+    /// Per lane: the pixel.
+    pixel: [UVec2; PACKET],
+    /// Per lane: the pixel-filter draw.
+    u: [Vec2; PACKET],
+}
+
+impl Lanes {
+    fn new() -> Self {
+        Self {
+            pixel: [UVec2::ZERO; PACKET],
+            u: [Vec2::splat(0.5); PACKET],
+        }
+    }
+
+    /// The camera ray of every lane into `ray` (lanes past the packet's end get rays too, of
+    /// stale samples, which nothing reads): [`filter_sample`] then [`CameraRays::direction`],
+    /// per lane exactly as the scalar [`CameraRays::generate`], on `isa`'s widest vectors.
+    #[inline]
+    fn rays(&self, isa: Isa, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `isa` comes from `Isa::detect`: this CPU runs AVX-512 F.
+            Isa::Avx512 => unsafe { self.rays_avx512(camera, filter, ray) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above, this CPU runs AVX2.
+            Isa::Avx2 => unsafe { self.rays_avx2(camera, filter, ray) },
+            _ => self.rays_portable(camera, filter, ray),
+        }
+    }
+
+    /// [`Lanes::rays`] as plain loops over the lanes, which the compiler vectorises.
+    #[inline(always)]
+    fn rays_portable(&self, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+        let mut d = [Vec3::ZERO; PACKET];
+        for ((d, &pixel), &u) in d.iter_mut().zip(&self.pixel).zip(&self.u) {
+            *d = camera.direction(filter_sample(filter, pixel, u));
+        }
+        let o = camera.origin();
+        for (r, &d) in ray.iter_mut().zip(&d) {
+            *r = Ray::new(o, d);
+        }
+    }
+
+    /// [`Lanes::rays_portable`] compiled for AVX-512 (16 lanes = one vector).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    fn rays_avx512(&self, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+        self.rays_portable(camera, filter, ray)
+    }
+
+    /// [`Lanes::rays_portable`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn rays_avx2(&self, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+        self.rays_portable(camera, filter, ray)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::sampling::PatternKind;
+
+    #[test]
+    fn packet_camera_rays_equal_the_scalar_rays() {
+        // Every instruction set's 16-lane rays are bit for bit the scalar
+        // `generate(filter_sample(..))` of each lane, for both filters and lanes spanning
+        // several pixels (as packets do for small sample counts).
+        let camera = Camera::look_at(
+            Vec3::new(0.3, 1.0, -4.0),
+            Vec3::new(0.0, 0.8, 0.0),
+            Vec3::Y,
+            39.0,
+        )
+        .expect("valid camera");
+        let rays = camera.rays(UVec2::new(97, 61));
+        let pattern = crate::sampling::make_pattern(PatternKind::Random, 3);
+        let radius = Vec2::new(1.0, 0.75);
+        for filter in [Filter::Box { radius }, Filter::Triangle { radius }] {
+            for isa in Isa::available() {
+                for packet in 0..8u32 {
+                    let mut lanes = Lanes::new();
+                    for k in 0..PACKET {
+                        let n = packet * PACKET as u32 + k as u32;
+                        lanes.pixel[k] = UVec2::new(n % 97, (n / 3) % 61);
+                        lanes.u[k] = pattern.sample_2d(lanes.pixel[k], 0, n, 1 << 20);
+                    }
+                    let mut out = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
+                    lanes.rays(isa, &rays, &filter, &mut out);
+                    for (k, r) in out.iter().enumerate() {
+                        let want =
+                            rays.generate(filter_sample(&filter, lanes.pixel[k], lanes.u[k]));
+                        let bits = |r: &Ray| [r.o, r.d].map(|v| v.to_array().map(f32::to_bits));
+                        assert_eq!(bits(r), bits(&want), "{isa:?} {filter:?} lane {k}");
+                        assert_eq!(r.t_max, want.t_max);
+                    }
+                }
+            }
+        }
+    }
 }

@@ -113,6 +113,11 @@ pub trait SamplePattern: Send + Sync {
     fn kind(&self) -> PatternKind;
     /// The same samples for one pixel, with that pixel's keys hashed once (hot path).
     fn pixel(&self, pixel: UVec2) -> PixelSamples;
+    /// [`SamplePattern::pixel`] written over `out` in place: no ~3.6 KB value is built and
+    /// moved, and `out`'s per-count caches (which depend on the count only) stay warm.
+    fn pixel_into(&self, pixel: UVec2, out: &mut PixelSamples) {
+        *out = self.pixel(pixel);
+    }
 }
 
 /// Make the pattern of `kind` with a global seed.
@@ -371,34 +376,47 @@ impl SamplePattern for Pattern {
     }
 
     fn pixel(&self, pixel: UVec2) -> PixelSamples {
+        let mut px = self.pixel_of_sets(pixel, Default::default(), Default::default());
+        self.pixel_into(pixel, &mut px);
+        px
+    }
+
+    fn pixel_into(&self, pixel: UVec2, out: &mut PixelSamples) {
+        out.reset(*self, pixel);
         #[cfg(target_arch = "x86_64")]
         if self.kind == PatternKind::Stratified && self.isa == Isa::Avx512 {
             // SAFETY: `Isa::detect` returned Avx512 only if the CPU has these features.
-            return unsafe { self.pixel_stratified_avx512(pixel) };
+            unsafe { self.sets_stratified_avx512(pixel, &mut out.sets_1d, &mut out.sets_2d) };
+            return;
         }
         let prefix = self.pixel_hash(pixel);
-        let dims: [u64; CACHED_DIMS] = std::array::from_fn(|d| hash_step(prefix, d as u64));
-        self.pixel_of_sets(
-            pixel,
-            std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_1D)),
-            std::array::from_fn(|d| self.set_of_dim(dims[d], TAG_2D)),
-        )
+        for d in 0..CACHED_DIMS {
+            let dim = hash_step(prefix, d as u64);
+            out.sets_1d[d] = self.set_of_dim(dim, TAG_1D);
+            out.sets_2d[d] = self.set_of_dim(dim, TAG_2D);
+        }
     }
 }
 
 impl Pattern {
-    /// [`SamplePattern::pixel`] of a `stratified` pattern on AVX-512: the keys of the 8 cached
-    /// dimensions are 8 u64 lanes, so every hash of a pixel's set keys is one vector op.
+    /// The set keys of [`SamplePattern::pixel`] of a `stratified` pattern on AVX-512, into
+    /// `sets_1d` / `sets_2d`: the keys of the 8 cached dimensions are 8 u64 lanes, so every
+    /// hash of a pixel's set keys is one vector op.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    fn pixel_stratified_avx512(&self, pixel: UVec2) -> PixelSamples {
+    fn sets_stratified_avx512(
+        &self,
+        pixel: UVec2,
+        sets_1d: &mut [SetKeys; CACHED_DIMS],
+        sets_2d: &mut [SetKeys; CACHED_DIMS],
+    ) {
         use super::hash::{hash_step_avx512, mix64_avx512};
         use std::arch::x86_64::*;
         const _: () = assert!(CACHED_DIMS == 8, "one 8-lane vector of dimensions");
         let prefix = _mm512_set1_epi64(self.pixel_hash(pixel) as i64);
         let dims = hash_step_avx512(prefix, _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
         // The `stratified` arm of `SetKeys::new` for the 8 keys of one tag.
-        let sets = |tag: u64| {
+        let sets = |tag: u64, out: &mut [SetKeys; CACHED_DIMS]| {
             let key = hash_step_avx512(dims, _mm512_set1_epi64(tag as i64));
             let k = mix64_avx512(key);
             let k2 = mix64_avx512(k);
@@ -409,15 +427,18 @@ impl Pattern {
                 unsafe { _mm512_storeu_si512(o.as_mut_ptr() as *mut __m512i, v) };
             }
             let [key, k, k2, jitter] = lanes;
-            std::array::from_fn(|d| SetKeys {
-                perm: Permutation::from_mixed(k[d], k2[d]),
-                jitter: jitter[d],
-                jitter_fast: jitter[d].wrapping_add(HASH_INIT),
-                key: key[d],
-                ..Default::default()
-            })
+            for (d, o) in out.iter_mut().enumerate() {
+                *o = SetKeys {
+                    perm: Permutation::from_mixed(k[d], k2[d]),
+                    jitter: jitter[d],
+                    jitter_fast: jitter[d].wrapping_add(HASH_INIT),
+                    key: key[d],
+                    ..Default::default()
+                };
+            }
         };
-        self.pixel_of_sets(pixel, sets(TAG_1D), sets(TAG_2D))
+        sets(TAG_1D, sets_1d);
+        sets(TAG_2D, sets_2d);
     }
 
     /// The [`PixelSamples`] of `pixel` with these sets' keys and empty caches.
@@ -875,6 +896,21 @@ pub struct PixelSamples {
 }
 
 impl PixelSamples {
+    /// Make these the samples of `pixel` under `pattern` except for the set keys (which the
+    /// caller writes next): every chunk emptied, the per-count caches kept (they depend on
+    /// the count only).
+    #[inline]
+    fn reset(&mut self, pattern: Pattern, pixel: UVec2) {
+        self.pattern = pattern;
+        self.pixel = pixel;
+        for c in &self.chunks_1d {
+            c.len.set(0);
+        }
+        for c in &self.chunks_2d {
+            c.len.set(0);
+        }
+    }
+
     /// The pixel these samples belong to.
     #[inline]
     pub fn pixel(&self) -> UVec2 {
@@ -1087,6 +1123,47 @@ mod tests {
                                 .map(f32::to_bits),
                             "{kind} dim {dim} index {index}"
                         );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn pixel_into_reuses_samples_bit_identically() {
+        // One PixelSamples refilled pixel after pixel (warm chunks and count caches of the
+        // previous pixel) returns what a fresh one returns.
+        for (kind, isa) in PatternKind::ALL
+            .into_iter()
+            .flat_map(|k| Isa::available().into_iter().map(move |i| (k, i)))
+        {
+            let pat = Pattern { seed: 5, kind, isa };
+            let mut px = pat.pixel(UVec2::new(9, 9));
+            for (n, pixel) in [UVec2::new(0, 0), UVec2::new(3, 1), UVec2::new(3, 2)]
+                .into_iter()
+                .enumerate()
+            {
+                pat.pixel_into(pixel, &mut px);
+                let fresh = pat.pixel(pixel);
+                assert_eq!(px.pixel(), pixel);
+                // Starting with the previous pixel's last count: its chunks must not serve.
+                for count in [16u32, 64, 5, 37][..4 - n].iter().copied().chain([16]) {
+                    for index in 0..count {
+                        for dim in [0u32, 4, 9] {
+                            assert_eq!(
+                                px.sample_1d(dim, index, count).to_bits(),
+                                fresh.sample_1d(dim, index, count).to_bits(),
+                                "{kind} {isa:?} 1d count {count} index {index}"
+                            );
+                            assert_eq!(
+                                px.sample_2d(dim, index, count).to_array().map(f32::to_bits),
+                                fresh
+                                    .sample_2d(dim, index, count)
+                                    .to_array()
+                                    .map(f32::to_bits),
+                                "{kind} {isa:?} 2d count {count} index {index}"
+                            );
+                        }
                     }
                 }
             }
