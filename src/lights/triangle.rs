@@ -61,9 +61,11 @@ impl TriangleLight {
 }
 
 impl LightSource for TriangleLight {
-    // Inlined into `Light::sample_li`'s dispatch: one call level and one copy of the returned
-    // sample fewer on every light sample of a triangle-lit scene.
-    #[inline]
+    // Always inlined: into `Light::sample_li`'s dispatch (one call level and one copy of the
+    // returned sample fewer on every light sample of a triangle-lit scene), and into the
+    // integrator's lane kernel, which vectorises only if the whole lane body is inline (with
+    // plain `#[inline]`, LLVM sometimes kept it as a call there, one lane at a time).
+    #[inline(always)]
     fn sample_li(
         &self,
         ctx: &LightSampleContext,
