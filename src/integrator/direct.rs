@@ -57,16 +57,16 @@ pub struct DirectLighting<'a> {
 }
 
 /// The pattern values one light sample and one BSDF sample consume, drawn together up front:
-/// the permutation hash chains of the four dimensions are independent, so evaluating them
-/// back to back lets the CPU overlap them instead of waiting on each behind a ray query.
+/// the permutation hash chains of the dimensions are independent, so evaluating them back to
+/// back lets the CPU overlap them instead of waiting on each behind a ray query. The lobe
+/// choice (`DIM_LOBE`) is drawn later, only for receivers whose BSDF has lobes to choose
+/// (values are pure functions of pixel, dimension and index, so skipping it changes nothing).
 #[derive(Clone, Copy, Default)]
 struct Draws {
     /// Light-selection number (`DIM_LIGHT_SELECT`).
     light_select: f32,
     /// Point on the light (`DIM_LIGHT`).
     light: Vec2,
-    /// Lobe choice (`DIM_LOBE`).
-    lobe: f32,
     /// BSDF direction (`DIM_BSDF`).
     bsdf: Vec2,
 }
@@ -82,7 +82,6 @@ impl Draws {
             d.light = px.sample_2d(DIM_LIGHT, index, count);
         }
         if bsdf {
-            d.lobe = px.sample_1d(DIM_LOBE, index, count);
             d.bsdf = px.sample_2d(DIM_BSDF, index, count);
         }
         d
@@ -485,11 +484,15 @@ impl<'a> DirectLighting<'a> {
                 if use_bsdf {
                     if diffuse {
                         bsdf_lanes.load(k, d.bsdf);
-                    } else if let Some(b) = self.bsdf_ray(&view(), &d) {
-                        // One logical ray whatever comes of it: an emitter query, then maybe a
-                        // visibility test.
-                        rays += 1;
-                        sampled.set(k, &b);
+                    } else {
+                        let px = &pxs[cam.pixel[k] as usize];
+                        let lobe = px.sample_1d(DIM_LOBE, cam.eye[k] * m + j, count);
+                        if let Some(b) = self.bsdf_ray(&view(), lobe, d.bsdf) {
+                            // One logical ray whatever comes of it: an emitter query, then
+                            // maybe a visibility test.
+                            rays += 1;
+                            sampled.set(k, &b);
+                        }
                     }
                 }
             }
@@ -638,12 +641,12 @@ impl<'a> DirectLighting<'a> {
 
     /// The first half of one BSDF-sampling estimate f·cos·Le / pdf: the sampled ray and its
     /// weight f·cos / pdf (`None` when the estimate is zero without tracing it).
-    fn bsdf_ray(&self, sh: &Shading, d: &Draws) -> Option<BsdfRay> {
+    fn bsdf_ray(&self, sh: &Shading, lobe: f32, u: Vec2) -> Option<BsdfRay> {
         // Lambert inline: `Bsdf::sample` carries every BSDF and stays out of line, so the
         // common diffuse hit paid a call and a `BsdfSample` returned through memory.
         let bs = match sh.bsdf {
-            Bsdf::Lambert(b) => b.sample(sh.wo_local, d.lobe, d.bsdf),
-            other => other.sample(sh.wo_local, d.lobe, d.bsdf),
+            Bsdf::Lambert(b) => b.sample(sh.wo_local, lobe, u),
+            other => other.sample(sh.wo_local, lobe, u),
         }?;
         bsdf_ray_of(&bs, &sh.frame, sh.ctx.n, sh.hit)
     }
