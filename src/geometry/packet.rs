@@ -5,7 +5,7 @@
 //! On the default backend ([`WideBvh`]) one traversal serves the whole packet: each node's four
 //! child boxes are tested against every ray, with each ray's own arithmetic of `Node4::hit` and
 //! its own best distance, so a ray's box verdicts are the scalar ones, and a leaf's triangles
-//! are tested against the rays that passed its box, each lane doing [`RayShear4`]'s f32
+//! are tested against the rays that passed its box, each lane doing [`RayShear4`](super::tri4::RayShear4)'s f32
 //! operations. The kernels are generic over the 16-lane vector type of `simd16` (AVX-512,
 //! AVX2 or portable lane loops, picked at run time: [`Isa`]).
 //!
@@ -22,8 +22,8 @@ use super::bvh::{NEAR_SLACK, ROUNDING_SLACK};
 #[cfg(target_arch = "x86_64")]
 use super::simd16::{Avx2, Avx512};
 use super::simd16::{Lanes, Portable, Simd};
-use super::tri4::{RayShear4, TriPacket};
-use super::triangle::{RayShear, shear_axes};
+use super::tri4::TriPacket;
+use super::triangle::RayShear;
 use super::wide::{Bary, LEAF, Node4, STACK, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use crate::isa::Isa;
@@ -292,53 +292,92 @@ fn node_hits<S: Simd>(
     m
 }
 
-/// Per-ray constants of the watertight triangle test, lanes over rays, for a packet whose
-/// active rays share the shear axes (the common case for coherent packets): the constants of
-/// [`RayShear4`] for each ray.
+/// Per-ray constants of the watertight triangle test, lanes over rays: the constants of
+/// [`RayShear4`](super::tri4::RayShear4) for each ray, with each lane's own shear axes (`shear_axes` of its direction).
 struct PacketShear<S: Simd> {
-    k: [usize; 3],
+    /// The shear axes when all active rays share them (the common case for coherent packets),
+    /// else `None`: then each lane picks its vertex coordinates by `pick`.
+    k: Option<[usize; 3]>,
+    /// Per sheared coordinate j: the lanes whose axis k[j] is 0, and those whose axis is 1.
+    pick: [[S::M; 2]; 3],
     o: [S::F; 3],
     s: [S::F; 3],
 }
 
+/// Lane-wise `a[k]`, where `m` = [lanes with k = 0, lanes with k = 1] (disjoint).
+#[inline(always)]
+fn pick3<S: Simd>(m: [S::M; 2], a: [S::F; 3]) -> S::F {
+    S::select(m[0], a[0], S::select(m[1], a[1], a[2]))
+}
+
 impl<S: Simd> PacketShear<S> {
-    /// From the rays' lanes `l` ([`Simd::rays`]); `None` if the active rays do not all share
-    /// the shear axes.
+    /// From the rays' lanes `l` ([`Simd::rays`]).
     #[inline(always)]
-    fn new(rays: &[Ray; PACKET], l: &[S::F; 7], active: u32) -> Option<Self> {
-        let k = shear_axes(rays[active.trailing_zeros() as usize & (PACKET - 1)].d);
-        // `shear_axes` per lane: kz and the sign of d[kz] determine the axes.
-        let uniform = |b: u32| {
-            let b = b & active;
-            b == 0 || b == active
-        };
+    fn new(l: &[S::F; 7], active: u32) -> Self {
+        // `shear_axes` per lane: kz is the dominant axis (ties to the later one), and
+        // (kx, ky) = (kz + 1, kz + 2) mod 3, swapped when d[kz] < 0.
         let d = [l[3], l[4], l[5]];
         let a = [S::abs(l[3]), S::abs(l[4]), S::abs(l[5])];
         let x_gt_y = S::lt(a[1], a[0]);
         let x_max = S::and(x_gt_y, S::lt(a[2], a[0]));
         let y_max = S::andnot(S::lt(a[2], a[1]), x_gt_y);
-        let kz_neg = S::lt(d[k[2] % 3], S::splat(0.0));
-        if !(uniform(S::bits(x_max)) && uniform(S::bits(y_max)) && uniform(S::bits(kz_neg))) {
-            return None;
-        }
+        let z_max = S::andnot(S::mask(PACKET_MASK), S::or(x_max, y_max));
+        let neg = S::lt(pick3::<S>([x_max, y_max], d), S::splat(0.0));
+        let pos = S::andnot(S::mask(PACKET_MASK), neg);
+        let either = |p: S::M, n: S::M| S::or(S::and(pos, p), S::and(neg, n));
+        let pick = [
+            [either(z_max, y_max), either(x_max, z_max)],
+            [either(y_max, z_max), either(z_max, x_max)],
+            [x_max, y_max],
+        ];
+        let uniform = |m: S::M| {
+            let b = S::bits(m) & active;
+            b == 0 || b == active
+        };
+        let k = (uniform(x_max) && uniform(y_max) && uniform(neg)).then(|| {
+            let first = |m: S::M| S::bits(m) & active != 0;
+            let kz = if first(x_max) {
+                0
+            } else if first(y_max) {
+                1
+            } else {
+                2
+            };
+            let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if first(neg) {
+                [ky, kx, kz]
+            } else {
+                [kx, ky, kz]
+            }
+        });
         // The quotients of `RayShear4::new`: −(a / b) = (−a) / b exactly, and the product
         // with −1 is an exact negation.
-        let (dx, dy, dz) = (d[k[0] % 3], d[k[1] % 3], d[k[2] % 3]);
+        let o = [l[0], l[1], l[2]];
+        let (dx, dy, dz) = (
+            pick3::<S>(pick[0], d),
+            pick3::<S>(pick[1], d),
+            pick3::<S>(pick[2], d),
+        );
         let minus = S::splat(-1.0);
-        Some(PacketShear {
+        PacketShear {
             k,
-            o: [l[k[0] % 3], l[k[1] % 3], l[k[2] % 3]],
+            pick,
+            o: [
+                pick3::<S>(pick[0], o),
+                pick3::<S>(pick[1], o),
+                pick3::<S>(pick[2], o),
+            ],
             s: [
                 S::div(dx, dz) * minus,
                 S::div(dy, dz) * minus,
                 S::div(S::splat(1.0), dz),
             ],
-        })
+        }
     }
 }
 
 /// One triangle against every ray of the packet: each lane performs the f32 operations of
-/// [`RayShear4`]'s lane test for that ray (same order, hence the same bits).
+/// [`RayShear4`](super::tri4::RayShear4)'s lane test for that ray (same order, hence the same bits).
 struct TriLanes<S: Simd> {
     /// Rays accepted by the f32 test with t in (0, t_max).
     hit: u32,
@@ -355,12 +394,18 @@ struct TriLanes<S: Simd> {
 /// target features).
 #[inline(always)]
 fn shear<S: Simd>(v: [f32; 3], ps: &PacketShear<S>) -> (S::F, S::F, S::F) {
-    let k = ps.k;
-    let (ax, ay, az) = (
-        S::splat(v[k[0]]) - ps.o[0],
-        S::splat(v[k[1]]) - ps.o[1],
-        S::splat(v[k[2]]) - ps.o[2],
-    );
+    let c = match ps.k {
+        Some(k) => [S::splat(v[k[0]]), S::splat(v[k[1]]), S::splat(v[k[2]])],
+        None => {
+            let v = [S::splat(v[0]), S::splat(v[1]), S::splat(v[2])];
+            [
+                pick3::<S>(ps.pick[0], v),
+                pick3::<S>(ps.pick[1], v),
+                pick3::<S>(ps.pick[2], v),
+            ]
+        }
+    };
+    let (ax, ay, az) = (c[0] - ps.o[0], c[1] - ps.o[1], c[2] - ps.o[2]);
     (ax + az * ps.s[0], ay + az * ps.s[1], az * ps.s[2])
 }
 
@@ -488,23 +533,6 @@ fn consider_lanes<S: Simd>(st: &mut PacketHits, id: u32, h: &TriLanes<S>, hit: u
     let closer = S::bits(closer);
     st.found |= closer;
     st.ties = (st.ties & !closer) | S::bits(tie);
-}
-
-/// The [`RayShear4`] of ray `i`, built on first use (`built` marks the built ones).
-#[inline(always)]
-fn ray_shear<'a>(
-    shears: &'a mut [MaybeUninit<RayShear4>; PACKET],
-    built: &mut u32,
-    rays: &[Ray; PACKET],
-    i: usize,
-) -> &'a RayShear4 {
-    let i = i & (PACKET - 1);
-    if *built & (1 << i) == 0 {
-        shears[i].write(RayShear4::new(rays[i].o, rays[i].d));
-        *built |= 1 << i;
-    }
-    // SAFETY: slot i was written, now or at an earlier call (its bit in `built` is set).
-    unsafe { shears[i].assume_init_ref() }
 }
 
 /// A pending subtree of the closest-hit traversal: each ray's entry distance, so that a pop
@@ -687,10 +715,7 @@ impl WideBvh {
         let zero = S::splat(0.0);
         let finite = S::and(S::le(zero, best), S::lt(best, S::splat(f32::INFINITY)));
         S::store(S::inc_bits(finite, best), &mut st.tm);
-        let pshear = PacketShear::<S>::new(rays, &l, active);
-        // Per-ray shears for packets whose rays differ in shear axes, built at first use.
-        let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
-        let mut built = 0u32;
+        let ps = PacketShear::<S>::new(&l, active);
         let mut stack = [const { MaybeUninit::<Pending>::uninit() }; STACK];
         let mut sp = 0usize;
         let (mut cur, mut mask) = (0u32, active);
@@ -743,30 +768,18 @@ impl WideBvh {
                     // `packets` whose final packet has `last` set (see `WideBvh::leaf`).
                     let pk = unsafe { self.packets.get_unchecked(pi) };
                     // Accept t = best too, to notice ties (see the module docs).
-                    if let Some(ps) = &pshear {
-                        for lane in bits(pk.tri) {
-                            let p = tri_vertices(pk, lane);
-                            let id = pk.ids[lane & 3];
-                            let h = triangle_lanes(ps, p, &st.tm, mask);
-                            let hits = h.hit & mask;
-                            if hits != 0 {
-                                consider_lanes(st, id, &h, hits);
-                            }
-                            for i in bits(h.redo & mask) {
-                                let i = i & (PACKET - 1);
-                                if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, st.tm[i])
-                                {
-                                    consider(st, i, id as usize, t, [b0, b1, b2]);
-                                }
-                            }
+                    for lane in bits(pk.tri) {
+                        let p = tri_vertices(pk, lane);
+                        let id = pk.ids[lane & 3];
+                        let h = triangle_lanes(&ps, p, &st.tm, mask);
+                        let hits = h.hit & mask;
+                        if hits != 0 {
+                            consider_lanes(st, id, &h, hits);
                         }
-                    } else if pk.tri != 0 {
-                        for i in bits(mask) {
+                        for i in bits(h.redo & mask) {
                             let i = i & (PACKET - 1);
-                            let shear = ray_shear(&mut shears, &mut built, rays, i);
-                            if let Some((lane, t, b)) = shear.closest(pk, st.tm[i]) {
-                                let id = pk.ids[lane & 3] as usize;
-                                consider(st, i, id, t, b);
+                            if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, st.tm[i]) {
+                                consider(st, i, id as usize, t, [b0, b1, b2]);
                             }
                         }
                     }
@@ -827,10 +840,7 @@ impl WideBvh {
         for i in bits(active) {
             t_max[i] = rays[i].t_max;
         }
-        let pshear = PacketShear::<S>::new(rays, &l, active);
-        // Per-ray shears for packets whose rays differ in shear axes, built at first use.
-        let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
-        let mut built = 0u32;
+        let ps = PacketShear::<S>::new(&l, active);
         let mut blocked = 0u32;
         // Only interior nodes are pushed (leaves are tested on sight), with their ray mask.
         let mut stack = [const { MaybeUninit::<(u32, u32)>::uninit() }; STACK];
@@ -871,22 +881,14 @@ impl WideBvh {
                     loop {
                         // SAFETY: as in `closest_packet`, a leaf's packet run lies in `packets`.
                         let pk = unsafe { self.packets.get_unchecked(pi) };
-                        if let Some(ps) = &pshear {
-                            for lane in bits(pk.tri) {
-                                let p = tri_vertices(pk, lane);
-                                let h = triangle_lanes(ps, p, &t_max, m & !blocked);
-                                blocked |= h.hit & m;
-                                for i in bits(h.redo & m & !blocked) {
-                                    let i = i & (PACKET - 1);
-                                    let hit = redo_triangle(&rays[i], p, t_max[i]).is_some();
-                                    blocked |= (hit as u32) << i;
-                                }
-                            }
-                        } else if pk.tri != 0 {
-                            for i in bits(m & !blocked) {
+                        for lane in bits(pk.tri) {
+                            let p = tri_vertices(pk, lane);
+                            let h = triangle_lanes(&ps, p, &t_max, m & !blocked);
+                            blocked |= h.hit & m;
+                            for i in bits(h.redo & m & !blocked) {
                                 let i = i & (PACKET - 1);
-                                let shear = ray_shear(&mut shears, &mut built, rays, i);
-                                blocked |= (shear.any(pk, t_max[i]) as u32) << i;
+                                let hit = redo_triangle(&rays[i], p, t_max[i]).is_some();
+                                blocked |= (hit as u32) << i;
                             }
                         }
                         for lane in bits(pk.other) {
