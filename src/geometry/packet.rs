@@ -27,10 +27,101 @@ use super::triangle::RayShear;
 use super::wide::{Bary, LEAF, Node4, STACK, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use crate::isa::Isa;
+use glam::Vec3;
 use std::mem::MaybeUninit;
 
 /// Rays per packet query.
 pub const PACKET: usize = 16;
+
+/// [`PACKET`] rays in structure-of-arrays form (lane i = ray i), for callers whose rays are
+/// already in vector lanes: the `*_soa` queries read them without the transpose that
+/// `[Ray; PACKET]` needs.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct RayPacket {
+    /// Origins: `o[axis][lane]`.
+    pub o: [[f32; PACKET]; 3],
+    /// Directions: `d[axis][lane]` (need not be normalised, as in [`Ray`]).
+    pub d: [[f32; PACKET]; 3],
+    /// Upper bounds of the valid parameter ranges.
+    pub t_max: [f32; PACKET],
+}
+
+impl RayPacket {
+    /// The lanes of `rays`.
+    pub fn from_rays(rays: &[Ray; PACKET]) -> Self {
+        let mut p = RayPacket {
+            o: [[0.0; PACKET]; 3],
+            d: [[0.0; PACKET]; 3],
+            t_max: [0.0; PACKET],
+        };
+        for (i, r) in rays.iter().enumerate() {
+            p.set(i, r);
+        }
+        p
+    }
+
+    /// Ray `i` (`i` < [`PACKET`]).
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        let i = i & (PACKET - 1);
+        Ray {
+            o: Vec3::new(self.o[0][i], self.o[1][i], self.o[2][i]),
+            d: Vec3::new(self.d[0][i], self.d[1][i], self.d[2][i]),
+            t_max: self.t_max[i],
+        }
+    }
+
+    /// Make lane `i` (`i` < [`PACKET`]) the ray `r`.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, r: &Ray) {
+        let i = i & (PACKET - 1);
+        for a in 0..3 {
+            self.o[a][i] = r.o[a];
+            self.d[a][i] = r.d[a];
+        }
+        self.t_max[i] = r.t_max;
+    }
+}
+
+/// The two forms of a packet's rays the kernels read: `[Ray; PACKET]` and [`RayPacket`].
+pub(super) trait PacketRays {
+    /// `[o.x, o.y, o.z, d.x, d.y, d.z, t_max]` as lanes (see [`Simd::rays`]).
+    fn lanes<S: Simd>(&self) -> [S::F; 7];
+    /// Ray `i` (for the scalar steps).
+    fn ray(&self, i: usize) -> Ray;
+}
+
+impl PacketRays for [Ray; PACKET] {
+    #[inline(always)]
+    fn lanes<S: Simd>(&self) -> [S::F; 7] {
+        S::rays(self)
+    }
+    #[inline(always)]
+    fn ray(&self, i: usize) -> Ray {
+        self[i & (PACKET - 1)]
+    }
+}
+
+impl PacketRays for RayPacket {
+    #[inline(always)]
+    fn lanes<S: Simd>(&self) -> [S::F; 7] {
+        let (o, d) = (&self.o, &self.d);
+        [
+            S::load(&o[0]),
+            S::load(&o[1]),
+            S::load(&o[2]),
+            S::load(&d[0]),
+            S::load(&d[1]),
+            S::load(&d[2]),
+            S::load(&self.t_max),
+        ]
+    }
+    #[inline(always)]
+    fn ray(&self, i: usize) -> Ray {
+        RayPacket::ray(self, i)
+    }
+}
 
 /// The closest-hit state of a packet's traversal, lanes over rays (in memory, so that the
 /// rare scalar steps, exact-zero redos and quadrics, update single lanes).
@@ -105,11 +196,34 @@ impl Geometry {
         self.intersect_packet_with(isa.supported(), rays, active, out);
     }
 
-    /// [`Self::intersect_packet`] on `isa`, a set this CPU runs.
-    fn intersect_packet_with(
+    /// [`Self::intersect_packet`] for rays already in lanes: out[i] equals
+    /// `self.intersect(&rays.ray(i))` for each active lane i.
+    pub fn intersect_packet_soa(
+        &self,
+        rays: &RayPacket,
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+    ) {
+        self.intersect_packet_with(self.isa, rays, active, out);
+    }
+
+    /// [`Self::intersect_packet_soa`] on a chosen vector backend (see
+    /// [`Self::intersect_packet_on`]).
+    pub fn intersect_packet_soa_on(
         &self,
         isa: Isa,
-        rays: &[Ray; PACKET],
+        rays: &RayPacket,
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+    ) {
+        self.intersect_packet_with(isa.supported(), rays, active, out);
+    }
+
+    /// [`Self::intersect_packet`] on `isa`, a set this CPU runs.
+    fn intersect_packet_with<R: PacketRays + ?Sized>(
+        &self,
+        isa: Isa,
+        rays: &R,
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
@@ -119,7 +233,7 @@ impl Geometry {
         // written) stalls on store forwarding.
         let Some(bvh) = self.wide() else {
             for i in bits(active) {
-                if let Some(h) = self.intersect(&rays[i]) {
+                if let Some(h) = self.intersect(&rays.ray(i)) {
                     out[i] = Some(h);
                 }
             }
@@ -130,7 +244,7 @@ impl Geometry {
             // vectors (`RayQuery::intersect`'s pre-test, lane by lane), then the scalar query
             // for the rays that enter the box.
             for i in bits(bvh.root_box_packet(isa, rays, active)) {
-                if let Some(h) = self.intersect_full(&rays[i]) {
+                if let Some(h) = self.intersect_full(&rays.ray(i)) {
                     out[i] = Some(h);
                 }
             }
@@ -143,11 +257,11 @@ impl Geometry {
         let ties = hits.ties;
         self.hit_records(isa, rays, &hits, hits.found & !ties, out);
         for i in bits(ties) {
-            out[i] = self.intersect(&rays[i]);
+            out[i] = self.intersect(&rays.ray(i));
         }
     }
 
-    /// Bit i set ⇔ ray i is active and `self.occluded(&rays[i])`.
+    /// Bit i set ⇔ ray i is active and `self.occluded(&rays.ray(i))`.
     ///
     /// One traversal of the wide BVH for the packet; a subtree that at most [`SPARSE`] of the
     /// rays enter is finished by the scalar query of each (incoherent shadow rays, e.g. on
@@ -162,11 +276,23 @@ impl Geometry {
         self.occluded_packet_with(isa.supported(), rays, active)
     }
 
+    /// [`Self::occluded_packet`] for rays already in lanes: bit i set ⇔ lane i is active and
+    /// `self.occluded(&rays.ray(i))`.
+    pub fn occluded_packet_soa(&self, rays: &RayPacket, active: u32) -> u32 {
+        self.occluded_packet_with(self.isa, rays, active)
+    }
+
+    /// [`Self::occluded_packet_soa`] on a chosen vector backend (see
+    /// [`Self::occluded_packet_on`]).
+    pub fn occluded_packet_soa_on(&self, isa: Isa, rays: &RayPacket, active: u32) -> u32 {
+        self.occluded_packet_with(isa.supported(), rays, active)
+    }
+
     /// [`Self::occluded_packet`] on `isa`, a set this CPU runs.
-    fn occluded_packet_with(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
+    fn occluded_packet_with<R: PacketRays + ?Sized>(&self, isa: Isa, rays: &R, active: u32) -> u32 {
         let active = active & PACKET_MASK;
         let Some(bvh) = self.wide() else {
-            return bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i);
+            return bits(active).fold(0, |m, i| m | (self.occluded(&rays.ray(i)) as u32) << i);
         };
         bvh.any_packet(isa, rays, active, SPARSE, |id, ray| {
             self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
@@ -555,7 +681,12 @@ impl WideBvh {
     /// The rays `active` that enter the box of the root's first child before their t_max, on
     /// backend `isa` (one this CPU runs); for a single-leaf tree, bit i is `!self.single_leaf_missed(ray i)` (the
     /// same operations on the same values: `SingleLeaf::hit` is lane 0 of `Node4::hit`).
-    pub(super) fn root_box_packet(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
+    pub(super) fn root_box_packet<R: PacketRays + ?Sized>(
+        &self,
+        isa: Isa,
+        rays: &R,
+        active: u32,
+    ) -> u32 {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
@@ -563,30 +694,30 @@ impl WideBvh {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.root_box_avx2(rays, active) },
-            _ => self.root_box_impl::<Portable>(rays, active),
+            _ => self.root_box_impl::<Portable, R>(rays, active),
         }
     }
 
     /// [`Self::root_box_impl`] on AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    fn root_box_avx512(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
-        self.root_box_impl::<Avx512>(rays, active)
+    fn root_box_avx512<R: PacketRays + ?Sized>(&self, rays: &R, active: u32) -> u32 {
+        self.root_box_impl::<Avx512, R>(rays, active)
     }
 
     /// [`Self::root_box_impl`] on AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn root_box_avx2(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
-        self.root_box_impl::<Avx2>(rays, active)
+    fn root_box_avx2<R: PacketRays + ?Sized>(&self, rays: &R, active: u32) -> u32 {
+        self.root_box_impl::<Avx2, R>(rays, active)
     }
 
     #[inline(always)]
-    fn root_box_impl<S: Simd>(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+    fn root_box_impl<S: Simd, R: PacketRays + ?Sized>(&self, rays: &R, active: u32) -> u32 {
         let Some(root) = self.nodes.first() else {
             return 0;
         };
-        let l = S::rays(rays);
+        let l = rays.lanes::<S>();
         let r = PacketBox::<S>::new(&l, active);
         let mut near = [0.0f32; PACKET];
         let m = match r.uniform {
@@ -603,10 +734,10 @@ impl WideBvh {
     /// rays with another primitive hit at exactly their best t (the caller redoes those with
     /// the scalar query). `other(id, ray, t_max)`
     /// is the hit distance of a non-triangle primitive if below `t_max`, else +∞.
-    pub(super) fn closest_packet(
+    pub(super) fn closest_packet<R: PacketRays + ?Sized>(
         &self,
         isa: Isa,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
@@ -618,43 +749,43 @@ impl WideBvh {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.closest_packet_avx2(rays, active, out, other) },
-            _ => self.closest_packet_impl::<Portable>(rays, active, out, other),
+            _ => self.closest_packet_impl::<Portable, R>(rays, active, out, other),
         }
     }
 
     /// [`Self::closest_packet_impl`] on AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    fn closest_packet_avx512(
+    fn closest_packet_avx512<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
     ) {
-        self.closest_packet_impl::<Avx512>(rays, active, out, other)
+        self.closest_packet_impl::<Avx512, R>(rays, active, out, other)
     }
 
     /// [`Self::closest_packet_impl`] on AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn closest_packet_avx2(
+    fn closest_packet_avx2<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
     ) {
-        self.closest_packet_impl::<Avx2>(rays, active, out, other)
+        self.closest_packet_impl::<Avx2, R>(rays, active, out, other)
     }
 
     /// Mask of the rays `active` that something blocks in (0, t_max), on backend `isa` (one
     /// this CPU runs);
     /// `other(id, ray)` tells whether non-triangle primitive `id` blocks `ray`.
-    pub(super) fn any_packet(
+    pub(super) fn any_packet<R: PacketRays + ?Sized>(
         &self,
         isa: Isa,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
@@ -666,40 +797,40 @@ impl WideBvh {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.any_packet_avx2(rays, active, sparse, other) },
-            _ => self.any_packet_impl::<Portable>(rays, active, sparse, other),
+            _ => self.any_packet_impl::<Portable, R>(rays, active, sparse, other),
         }
     }
 
     /// [`Self::any_packet_impl`] on AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    fn any_packet_avx512(
+    fn any_packet_avx512<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
-        self.any_packet_impl::<Avx512>(rays, active, sparse, other)
+        self.any_packet_impl::<Avx512, R>(rays, active, sparse, other)
     }
 
     /// [`Self::any_packet_impl`] on AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn any_packet_avx2(
+    fn any_packet_avx2<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
-        self.any_packet_impl::<Avx2>(rays, active, sparse, other)
+        self.any_packet_impl::<Avx2, R>(rays, active, sparse, other)
     }
 
     #[inline(always)]
-    fn closest_packet_impl<S: Simd>(
+    fn closest_packet_impl<S: Simd, R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         st: &mut PacketHits,
         mut other: impl FnMut(usize, &Ray, f32) -> f32,
@@ -707,7 +838,7 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return;
         }
-        let l = S::rays(rays);
+        let l = rays.lanes::<S>();
         let r = PacketBox::<S>::new(&l, active);
         let best = S::select(S::mask(active), l[6], S::splat(f32::NEG_INFINITY));
         S::store(best, &mut st.t);
@@ -778,7 +909,8 @@ impl WideBvh {
                         }
                         for i in bits(h.redo & mask) {
                             let i = i & (PACKET - 1);
-                            if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, st.tm[i]) {
+                            if let Some((t, b0, b1, b2)) = redo_triangle(&rays.ray(i), p, st.tm[i])
+                            {
                                 consider(st, i, id as usize, t, [b0, b1, b2]);
                             }
                         }
@@ -788,7 +920,7 @@ impl WideBvh {
                         for i in bits(mask) {
                             let i = i & (PACKET - 1);
                             let t_max = st.tm[i];
-                            let t = other(id, &rays[i], t_max);
+                            let t = other(id, &rays.ray(i), t_max);
                             if t < t_max {
                                 consider(st, i, id, t, [1.0 / 3.0; 3]);
                             }
@@ -824,9 +956,9 @@ impl WideBvh {
     }
 
     #[inline(always)]
-    fn any_packet_impl<S: Simd>(
+    fn any_packet_impl<S: Simd, R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         sparse: u32,
         mut other: impl FnMut(usize, &Ray) -> bool,
@@ -834,12 +966,11 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return 0;
         }
-        let l = S::rays(rays);
+        let l = rays.lanes::<S>();
         let r = PacketBox::<S>::new(&l, active);
-        let mut t_max: Lanes = [f32::NEG_INFINITY; PACKET];
-        for i in bits(active) {
-            t_max[i] = rays[i].t_max;
-        }
+        let mut t_max: Lanes = [0.0; PACKET];
+        let inactive = S::splat(f32::NEG_INFINITY);
+        S::store(S::select(S::mask(active), l[6], inactive), &mut t_max);
         let ps = PacketShear::<S>::new(&l, active);
         let mut blocked = 0u32;
         // Only interior nodes are pushed (leaves are tested on sight), with their ray mask.
@@ -852,7 +983,7 @@ impl WideBvh {
                 // Few rays left in this subtree: the packet would test every box for all 16
                 // lanes, the scalar query only for these rays.
                 for i in bits(mask & !blocked) {
-                    let ray = &rays[i & (PACKET - 1)];
+                    let ray = &rays.ray(i & (PACKET - 1));
                     let hit = self.any_from(cur, ray.o, ray.d, ray.t_max, |id| other(id, ray));
                     blocked |= (hit as u32) << i;
                 }
@@ -887,13 +1018,13 @@ impl WideBvh {
                             blocked |= h.hit & m;
                             for i in bits(h.redo & m & !blocked) {
                                 let i = i & (PACKET - 1);
-                                let hit = redo_triangle(&rays[i], p, t_max[i]).is_some();
+                                let hit = redo_triangle(&rays.ray(i), p, t_max[i]).is_some();
                                 blocked |= (hit as u32) << i;
                             }
                         }
                         for lane in bits(pk.other) {
                             for i in bits(m & !blocked) {
-                                let hit = other(pk.ids[lane & 3] as usize, &rays[i]);
+                                let hit = other(pk.ids[lane & 3] as usize, &rays.ray(i));
                                 blocked |= (hit as u32) << i;
                             }
                         }
