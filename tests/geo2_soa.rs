@@ -20,7 +20,16 @@ const MASKS: [u32; 6] = [0xffff, 0xa5c3, 0x0001, 0x8000, 0x7ffe, 0];
 const ISAS: [Isa; 3] = [Isa::Portable, Isa::Avx2, Isa::Avx512];
 
 /// Everything a hit record holds, as bits.
-type Key = (u32, u32, [u32; 3], [u32; 3], [u32; 3], [u32; 2], u32, (u32, u32));
+type Key = (
+    u32,
+    u32,
+    [u32; 3],
+    [u32; 3],
+    [u32; 3],
+    [u32; 2],
+    u32,
+    (u32, u32),
+);
 
 fn key(h: &Option<SurfaceHit>) -> Option<Key> {
     h.map(|h| {

@@ -516,14 +516,22 @@ struct TriLanes<S: Simd> {
     inv: S::F,
 }
 
-/// Ray-space vertex `v` (a function, not a closure: out of line it would miss the caller's
-/// target features).
+/// Ray-space vertex `j` of triangle `lane` of `pk` (a function, not a closure: out of line it
+/// would miss the caller's target features). The coordinates are broadcast straight from the
+/// packet: copied to a stack array first, they were read back before the copy's narrower
+/// stores could be forwarded (a stall that cost a tenth of the any-hit kernel).
 #[inline(always)]
-fn shear<S: Simd>(v: [f32; 3], ps: &PacketShear<S>) -> (S::F, S::F, S::F) {
+fn shear<S: Simd>(
+    pk: &TriPacket,
+    lane: usize,
+    j: usize,
+    ps: &PacketShear<S>,
+) -> (S::F, S::F, S::F) {
+    let v = |a: usize| S::splat(AsRef::<[f32; 4]>::as_ref(&pk.v[j][a])[lane & 3]);
     let c = match ps.k {
-        Some(k) => [S::splat(v[k[0]]), S::splat(v[k[1]]), S::splat(v[k[2]])],
+        Some(k) => [v(k[0]), v(k[1]), v(k[2])],
         None => {
-            let v = [S::splat(v[0]), S::splat(v[1]), S::splat(v[2])];
+            let v = [v(0), v(1), v(2)];
             [
                 pick3::<S>(ps.pick[0], v),
                 pick3::<S>(ps.pick[1], v),
@@ -540,13 +548,14 @@ fn shear<S: Simd>(v: [f32; 3], ps: &PacketShear<S>) -> (S::F, S::F, S::F) {
 #[inline(always)]
 fn triangle_lanes<S: Simd>(
     ps: &PacketShear<S>,
-    p: [[f32; 3]; 3],
+    pk: &TriPacket,
+    lane: usize,
     t_max: &Lanes,
     mask: u32,
 ) -> TriLanes<S> {
-    let (ax, ay, az) = shear(p[0], ps);
-    let (bx, by, bz) = shear(p[1], ps);
-    let (cx, cy, cz) = shear(p[2], ps);
+    let (ax, ay, az) = shear(pk, lane, 0, ps);
+    let (bx, by, bz) = shear(pk, lane, 1, ps);
+    let (cx, cy, cz) = shear(pk, lane, 2, ps);
     let e0 = bx * cy - by * cx;
     let e1 = cx * ay - cy * ax;
     let e2 = ax * by - ay * bx;
@@ -900,15 +909,15 @@ impl WideBvh {
                     let pk = unsafe { self.packets.get_unchecked(pi) };
                     // Accept t = best too, to notice ties (see the module docs).
                     for lane in bits(pk.tri) {
-                        let p = tri_vertices(pk, lane);
                         let id = pk.ids[lane & 3];
-                        let h = triangle_lanes(&ps, p, &st.tm, mask);
+                        let h = triangle_lanes(&ps, pk, lane, &st.tm, mask);
                         let hits = h.hit & mask;
                         if hits != 0 {
                             consider_lanes(st, id, &h, hits);
                         }
                         for i in bits(h.redo & mask) {
                             let i = i & (PACKET - 1);
+                            let p = tri_vertices(pk, lane);
                             if let Some((t, b0, b1, b2)) = redo_triangle(&rays.ray(i), p, st.tm[i])
                             {
                                 consider(st, i, id as usize, t, [b0, b1, b2]);
@@ -1013,11 +1022,11 @@ impl WideBvh {
                         // SAFETY: as in `closest_packet`, a leaf's packet run lies in `packets`.
                         let pk = unsafe { self.packets.get_unchecked(pi) };
                         for lane in bits(pk.tri) {
-                            let p = tri_vertices(pk, lane);
-                            let h = triangle_lanes(&ps, p, &t_max, m & !blocked);
+                            let h = triangle_lanes(&ps, pk, lane, &t_max, m & !blocked);
                             blocked |= h.hit & m;
                             for i in bits(h.redo & m & !blocked) {
                                 let i = i & (PACKET - 1);
+                                let p = tri_vertices(pk, lane);
                                 let hit = redo_triangle(&rays.ray(i), p, t_max[i]).is_some();
                                 blocked |= (hit as u32) << i;
                             }
