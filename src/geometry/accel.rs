@@ -4,7 +4,7 @@
 
 use super::bvh::Bvh;
 use super::float::gamma;
-use super::packet::{PACKET, PacketHits, bits};
+use super::packet::{PACKET, PacketHits, PacketRays, bits};
 use super::quadric::Quadric;
 #[cfg(target_arch = "x86_64")]
 use super::simd16::{Avx2, Avx512};
@@ -346,10 +346,10 @@ impl Geometry {
     /// The hit records of the rays `lanes` of a packet query (`hits` finished), into `out`,
     /// on backend `isa` (one this CPU runs): `out[i] = Some(self.surface_hit(..))` for each,
     /// bit for bit.
-    pub(super) fn hit_records(
+    pub(super) fn hit_records<R: PacketRays + ?Sized>(
         &self,
         isa: Isa,
-        rays: &[Ray; PACKET],
+        rays: &R,
         hits: &PacketHits,
         lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
@@ -361,42 +361,42 @@ impl Geometry {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.hit_records_avx2(rays, hits, lanes, out) },
-            _ => self.hit_records_impl::<Portable>(rays, hits, lanes, out),
+            _ => self.hit_records_impl::<Portable, R>(rays, hits, lanes, out),
         }
     }
 
     /// [`Self::hit_records_impl`] on AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    fn hit_records_avx512(
+    fn hit_records_avx512<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         hits: &PacketHits,
         lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.hit_records_impl::<Avx512>(rays, hits, lanes, out)
+        self.hit_records_impl::<Avx512, R>(rays, hits, lanes, out)
     }
 
     /// [`Self::hit_records_impl`] on AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn hit_records_avx2(
+    fn hit_records_avx2<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         hits: &PacketHits,
         lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.hit_records_impl::<Avx2>(rays, hits, lanes, out)
+        self.hit_records_impl::<Avx2, R>(rays, hits, lanes, out)
     }
 
     /// Rays that hit the same triangle (most of a coherent packet) get their records on the
     /// vector lanes at once; single rays and quadric hits go through [`Self::surface_hit`].
     #[inline(always)]
-    fn hit_records_impl<S: Simd>(
+    fn hit_records_impl<S: Simd, R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         hits: &PacketHits,
         mut lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
@@ -416,7 +416,7 @@ impl Geometry {
                 _ => {
                     for i in bits(group) {
                         let (id, t, b) = hits.hit(i);
-                        out[i] = Some(self.surface_hit(id, &rays[i], t, b));
+                        out[i] = Some(self.surface_hit(id, &rays.ray(i), t, b));
                     }
                 }
             }

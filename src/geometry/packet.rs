@@ -5,7 +5,7 @@
 //! On the default backend ([`WideBvh`]) one traversal serves the whole packet: each node's four
 //! child boxes are tested against every ray, with each ray's own arithmetic of `Node4::hit` and
 //! its own best distance, so a ray's box verdicts are the scalar ones, and a leaf's triangles
-//! are tested against the rays that passed its box, each lane doing [`RayShear4`]'s f32
+//! are tested against the rays that passed its box, each lane doing [`RayShear4`](super::tri4::RayShear4)'s f32
 //! operations. The kernels are generic over the 16-lane vector type of `simd16` (AVX-512,
 //! AVX2 or portable lane loops, picked at run time: [`Isa`]).
 //!
@@ -22,15 +22,106 @@ use super::bvh::{NEAR_SLACK, ROUNDING_SLACK};
 #[cfg(target_arch = "x86_64")]
 use super::simd16::{Avx2, Avx512};
 use super::simd16::{Lanes, Portable, Simd};
-use super::tri4::{RayShear4, TriPacket};
-use super::triangle::{RayShear, shear_axes};
+use super::tri4::TriPacket;
+use super::triangle::RayShear;
 use super::wide::{Bary, LEAF, Node4, STACK, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use crate::isa::Isa;
+use glam::Vec3;
 use std::mem::MaybeUninit;
 
 /// Rays per packet query.
 pub const PACKET: usize = 16;
+
+/// [`PACKET`] rays in structure-of-arrays form (lane i = ray i), for callers whose rays are
+/// already in vector lanes: the `*_soa` queries read them without the transpose that
+/// `[Ray; PACKET]` needs.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct RayPacket {
+    /// Origins: `o[axis][lane]`.
+    pub o: [[f32; PACKET]; 3],
+    /// Directions: `d[axis][lane]` (need not be normalised, as in [`Ray`]).
+    pub d: [[f32; PACKET]; 3],
+    /// Upper bounds of the valid parameter ranges.
+    pub t_max: [f32; PACKET],
+}
+
+impl RayPacket {
+    /// The lanes of `rays`.
+    pub fn from_rays(rays: &[Ray; PACKET]) -> Self {
+        let mut p = RayPacket {
+            o: [[0.0; PACKET]; 3],
+            d: [[0.0; PACKET]; 3],
+            t_max: [0.0; PACKET],
+        };
+        for (i, r) in rays.iter().enumerate() {
+            p.set(i, r);
+        }
+        p
+    }
+
+    /// Ray `i` (`i` < [`PACKET`]).
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        let i = i & (PACKET - 1);
+        Ray {
+            o: Vec3::new(self.o[0][i], self.o[1][i], self.o[2][i]),
+            d: Vec3::new(self.d[0][i], self.d[1][i], self.d[2][i]),
+            t_max: self.t_max[i],
+        }
+    }
+
+    /// Make lane `i` (`i` < [`PACKET`]) the ray `r`.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, r: &Ray) {
+        let i = i & (PACKET - 1);
+        for a in 0..3 {
+            self.o[a][i] = r.o[a];
+            self.d[a][i] = r.d[a];
+        }
+        self.t_max[i] = r.t_max;
+    }
+}
+
+/// The two forms of a packet's rays the kernels read: `[Ray; PACKET]` and [`RayPacket`].
+pub(super) trait PacketRays {
+    /// `[o.x, o.y, o.z, d.x, d.y, d.z, t_max]` as lanes (see [`Simd::rays`]).
+    fn lanes<S: Simd>(&self) -> [S::F; 7];
+    /// Ray `i` (for the scalar steps).
+    fn ray(&self, i: usize) -> Ray;
+}
+
+impl PacketRays for [Ray; PACKET] {
+    #[inline(always)]
+    fn lanes<S: Simd>(&self) -> [S::F; 7] {
+        S::rays(self)
+    }
+    #[inline(always)]
+    fn ray(&self, i: usize) -> Ray {
+        self[i & (PACKET - 1)]
+    }
+}
+
+impl PacketRays for RayPacket {
+    #[inline(always)]
+    fn lanes<S: Simd>(&self) -> [S::F; 7] {
+        let (o, d) = (&self.o, &self.d);
+        [
+            S::load(&o[0]),
+            S::load(&o[1]),
+            S::load(&o[2]),
+            S::load(&d[0]),
+            S::load(&d[1]),
+            S::load(&d[2]),
+            S::load(&self.t_max),
+        ]
+    }
+    #[inline(always)]
+    fn ray(&self, i: usize) -> Ray {
+        RayPacket::ray(self, i)
+    }
+}
 
 /// The closest-hit state of a packet's traversal, lanes over rays (in memory, so that the
 /// rare scalar steps, exact-zero redos and quadrics, update single lanes).
@@ -105,11 +196,34 @@ impl Geometry {
         self.intersect_packet_with(isa.supported(), rays, active, out);
     }
 
-    /// [`Self::intersect_packet`] on `isa`, a set this CPU runs.
-    fn intersect_packet_with(
+    /// [`Self::intersect_packet`] for rays already in lanes: out[i] equals
+    /// `self.intersect(&rays.ray(i))` for each active lane i.
+    pub fn intersect_packet_soa(
+        &self,
+        rays: &RayPacket,
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+    ) {
+        self.intersect_packet_with(self.isa, rays, active, out);
+    }
+
+    /// [`Self::intersect_packet_soa`] on a chosen vector backend (see
+    /// [`Self::intersect_packet_on`]).
+    pub fn intersect_packet_soa_on(
         &self,
         isa: Isa,
-        rays: &[Ray; PACKET],
+        rays: &RayPacket,
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+    ) {
+        self.intersect_packet_with(isa.supported(), rays, active, out);
+    }
+
+    /// [`Self::intersect_packet`] on `isa`, a set this CPU runs.
+    fn intersect_packet_with<R: PacketRays + ?Sized>(
+        &self,
+        isa: Isa,
+        rays: &R,
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
@@ -119,7 +233,7 @@ impl Geometry {
         // written) stalls on store forwarding.
         let Some(bvh) = self.wide() else {
             for i in bits(active) {
-                if let Some(h) = self.intersect(&rays[i]) {
+                if let Some(h) = self.intersect(&rays.ray(i)) {
                     out[i] = Some(h);
                 }
             }
@@ -130,7 +244,7 @@ impl Geometry {
             // vectors (`RayQuery::intersect`'s pre-test, lane by lane), then the scalar query
             // for the rays that enter the box.
             for i in bits(bvh.root_box_packet(isa, rays, active)) {
-                if let Some(h) = self.intersect_full(&rays[i]) {
+                if let Some(h) = self.intersect_full(&rays.ray(i)) {
                     out[i] = Some(h);
                 }
             }
@@ -143,11 +257,11 @@ impl Geometry {
         let ties = hits.ties;
         self.hit_records(isa, rays, &hits, hits.found & !ties, out);
         for i in bits(ties) {
-            out[i] = self.intersect(&rays[i]);
+            out[i] = self.intersect(&rays.ray(i));
         }
     }
 
-    /// Bit i set ⇔ ray i is active and `self.occluded(&rays[i])`.
+    /// Bit i set ⇔ ray i is active and `self.occluded(&rays.ray(i))`.
     ///
     /// One traversal of the wide BVH for the packet; a subtree that at most [`SPARSE`] of the
     /// rays enter is finished by the scalar query of each (incoherent shadow rays, e.g. on
@@ -162,11 +276,23 @@ impl Geometry {
         self.occluded_packet_with(isa.supported(), rays, active)
     }
 
+    /// [`Self::occluded_packet`] for rays already in lanes: bit i set ⇔ lane i is active and
+    /// `self.occluded(&rays.ray(i))`.
+    pub fn occluded_packet_soa(&self, rays: &RayPacket, active: u32) -> u32 {
+        self.occluded_packet_with(self.isa, rays, active)
+    }
+
+    /// [`Self::occluded_packet_soa`] on a chosen vector backend (see
+    /// [`Self::occluded_packet_on`]).
+    pub fn occluded_packet_soa_on(&self, isa: Isa, rays: &RayPacket, active: u32) -> u32 {
+        self.occluded_packet_with(isa.supported(), rays, active)
+    }
+
     /// [`Self::occluded_packet`] on `isa`, a set this CPU runs.
-    fn occluded_packet_with(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
+    fn occluded_packet_with<R: PacketRays + ?Sized>(&self, isa: Isa, rays: &R, active: u32) -> u32 {
         let active = active & PACKET_MASK;
         let Some(bvh) = self.wide() else {
-            return bits(active).fold(0, |m, i| m | (self.occluded(&rays[i]) as u32) << i);
+            return bits(active).fold(0, |m, i| m | (self.occluded(&rays.ray(i)) as u32) << i);
         };
         bvh.any_packet(isa, rays, active, SPARSE, |id, ray| {
             self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
@@ -292,53 +418,92 @@ fn node_hits<S: Simd>(
     m
 }
 
-/// Per-ray constants of the watertight triangle test, lanes over rays, for a packet whose
-/// active rays share the shear axes (the common case for coherent packets): the constants of
-/// [`RayShear4`] for each ray.
+/// Per-ray constants of the watertight triangle test, lanes over rays: the constants of
+/// [`RayShear4`](super::tri4::RayShear4) for each ray, with each lane's own shear axes (`shear_axes` of its direction).
 struct PacketShear<S: Simd> {
-    k: [usize; 3],
+    /// The shear axes when all active rays share them (the common case for coherent packets),
+    /// else `None`: then each lane picks its vertex coordinates by `pick`.
+    k: Option<[usize; 3]>,
+    /// Per sheared coordinate j: the lanes whose axis k[j] is 0, and those whose axis is 1.
+    pick: [[S::M; 2]; 3],
     o: [S::F; 3],
     s: [S::F; 3],
 }
 
+/// Lane-wise `a[k]`, where `m` = [lanes with k = 0, lanes with k = 1] (disjoint).
+#[inline(always)]
+fn pick3<S: Simd>(m: [S::M; 2], a: [S::F; 3]) -> S::F {
+    S::select(m[0], a[0], S::select(m[1], a[1], a[2]))
+}
+
 impl<S: Simd> PacketShear<S> {
-    /// From the rays' lanes `l` ([`Simd::rays`]); `None` if the active rays do not all share
-    /// the shear axes.
+    /// From the rays' lanes `l` ([`Simd::rays`]).
     #[inline(always)]
-    fn new(rays: &[Ray; PACKET], l: &[S::F; 7], active: u32) -> Option<Self> {
-        let k = shear_axes(rays[active.trailing_zeros() as usize & (PACKET - 1)].d);
-        // `shear_axes` per lane: kz and the sign of d[kz] determine the axes.
-        let uniform = |b: u32| {
-            let b = b & active;
-            b == 0 || b == active
-        };
+    fn new(l: &[S::F; 7], active: u32) -> Self {
+        // `shear_axes` per lane: kz is the dominant axis (ties to the later one), and
+        // (kx, ky) = (kz + 1, kz + 2) mod 3, swapped when d[kz] < 0.
         let d = [l[3], l[4], l[5]];
         let a = [S::abs(l[3]), S::abs(l[4]), S::abs(l[5])];
         let x_gt_y = S::lt(a[1], a[0]);
         let x_max = S::and(x_gt_y, S::lt(a[2], a[0]));
         let y_max = S::andnot(S::lt(a[2], a[1]), x_gt_y);
-        let kz_neg = S::lt(d[k[2] % 3], S::splat(0.0));
-        if !(uniform(S::bits(x_max)) && uniform(S::bits(y_max)) && uniform(S::bits(kz_neg))) {
-            return None;
-        }
+        let z_max = S::andnot(S::mask(PACKET_MASK), S::or(x_max, y_max));
+        let neg = S::lt(pick3::<S>([x_max, y_max], d), S::splat(0.0));
+        let pos = S::andnot(S::mask(PACKET_MASK), neg);
+        let either = |p: S::M, n: S::M| S::or(S::and(pos, p), S::and(neg, n));
+        let pick = [
+            [either(z_max, y_max), either(x_max, z_max)],
+            [either(y_max, z_max), either(z_max, x_max)],
+            [x_max, y_max],
+        ];
+        let uniform = |m: S::M| {
+            let b = S::bits(m) & active;
+            b == 0 || b == active
+        };
+        let k = (uniform(x_max) && uniform(y_max) && uniform(neg)).then(|| {
+            let first = |m: S::M| S::bits(m) & active != 0;
+            let kz = if first(x_max) {
+                0
+            } else if first(y_max) {
+                1
+            } else {
+                2
+            };
+            let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if first(neg) {
+                [ky, kx, kz]
+            } else {
+                [kx, ky, kz]
+            }
+        });
         // The quotients of `RayShear4::new`: −(a / b) = (−a) / b exactly, and the product
         // with −1 is an exact negation.
-        let (dx, dy, dz) = (d[k[0] % 3], d[k[1] % 3], d[k[2] % 3]);
+        let o = [l[0], l[1], l[2]];
+        let (dx, dy, dz) = (
+            pick3::<S>(pick[0], d),
+            pick3::<S>(pick[1], d),
+            pick3::<S>(pick[2], d),
+        );
         let minus = S::splat(-1.0);
-        Some(PacketShear {
+        PacketShear {
             k,
-            o: [l[k[0] % 3], l[k[1] % 3], l[k[2] % 3]],
+            pick,
+            o: [
+                pick3::<S>(pick[0], o),
+                pick3::<S>(pick[1], o),
+                pick3::<S>(pick[2], o),
+            ],
             s: [
                 S::div(dx, dz) * minus,
                 S::div(dy, dz) * minus,
                 S::div(S::splat(1.0), dz),
             ],
-        })
+        }
     }
 }
 
 /// One triangle against every ray of the packet: each lane performs the f32 operations of
-/// [`RayShear4`]'s lane test for that ray (same order, hence the same bits).
+/// [`RayShear4`](super::tri4::RayShear4)'s lane test for that ray (same order, hence the same bits).
 struct TriLanes<S: Simd> {
     /// Rays accepted by the f32 test with t in (0, t_max).
     hit: u32,
@@ -351,16 +516,30 @@ struct TriLanes<S: Simd> {
     inv: S::F,
 }
 
-/// Ray-space vertex `v` (a function, not a closure: out of line it would miss the caller's
-/// target features).
+/// Ray-space vertex `j` of triangle `lane` of `pk` (a function, not a closure: out of line it
+/// would miss the caller's target features). The coordinates are broadcast straight from the
+/// packet: copied to a stack array first, they were read back before the copy's narrower
+/// stores could be forwarded (a stall that cost a tenth of the any-hit kernel).
 #[inline(always)]
-fn shear<S: Simd>(v: [f32; 3], ps: &PacketShear<S>) -> (S::F, S::F, S::F) {
-    let k = ps.k;
-    let (ax, ay, az) = (
-        S::splat(v[k[0]]) - ps.o[0],
-        S::splat(v[k[1]]) - ps.o[1],
-        S::splat(v[k[2]]) - ps.o[2],
-    );
+fn shear<S: Simd>(
+    pk: &TriPacket,
+    lane: usize,
+    j: usize,
+    ps: &PacketShear<S>,
+) -> (S::F, S::F, S::F) {
+    let v = |a: usize| S::splat(AsRef::<[f32; 4]>::as_ref(&pk.v[j][a])[lane & 3]);
+    let c = match ps.k {
+        Some(k) => [v(k[0]), v(k[1]), v(k[2])],
+        None => {
+            let v = [v(0), v(1), v(2)];
+            [
+                pick3::<S>(ps.pick[0], v),
+                pick3::<S>(ps.pick[1], v),
+                pick3::<S>(ps.pick[2], v),
+            ]
+        }
+    };
+    let (ax, ay, az) = (c[0] - ps.o[0], c[1] - ps.o[1], c[2] - ps.o[2]);
     (ax + az * ps.s[0], ay + az * ps.s[1], az * ps.s[2])
 }
 
@@ -369,13 +548,14 @@ fn shear<S: Simd>(v: [f32; 3], ps: &PacketShear<S>) -> (S::F, S::F, S::F) {
 #[inline(always)]
 fn triangle_lanes<S: Simd>(
     ps: &PacketShear<S>,
-    p: [[f32; 3]; 3],
+    pk: &TriPacket,
+    lane: usize,
     t_max: &Lanes,
     mask: u32,
 ) -> TriLanes<S> {
-    let (ax, ay, az) = shear(p[0], ps);
-    let (bx, by, bz) = shear(p[1], ps);
-    let (cx, cy, cz) = shear(p[2], ps);
+    let (ax, ay, az) = shear(pk, lane, 0, ps);
+    let (bx, by, bz) = shear(pk, lane, 1, ps);
+    let (cx, cy, cz) = shear(pk, lane, 2, ps);
     let e0 = bx * cy - by * cx;
     let e1 = cx * ay - cy * ax;
     let e2 = ax * by - ay * bx;
@@ -490,23 +670,6 @@ fn consider_lanes<S: Simd>(st: &mut PacketHits, id: u32, h: &TriLanes<S>, hit: u
     st.ties = (st.ties & !closer) | S::bits(tie);
 }
 
-/// The [`RayShear4`] of ray `i`, built on first use (`built` marks the built ones).
-#[inline(always)]
-fn ray_shear<'a>(
-    shears: &'a mut [MaybeUninit<RayShear4>; PACKET],
-    built: &mut u32,
-    rays: &[Ray; PACKET],
-    i: usize,
-) -> &'a RayShear4 {
-    let i = i & (PACKET - 1);
-    if *built & (1 << i) == 0 {
-        shears[i].write(RayShear4::new(rays[i].o, rays[i].d));
-        *built |= 1 << i;
-    }
-    // SAFETY: slot i was written, now or at an earlier call (its bit in `built` is set).
-    unsafe { shears[i].assume_init_ref() }
-}
-
 /// A pending subtree of the closest-hit traversal: each ray's entry distance, so that a pop
 /// drops the rays whose best hit has since come closer (the scalar traversal's pop test).
 #[derive(Clone, Copy)]
@@ -527,7 +690,12 @@ impl WideBvh {
     /// The rays `active` that enter the box of the root's first child before their t_max, on
     /// backend `isa` (one this CPU runs); for a single-leaf tree, bit i is `!self.single_leaf_missed(ray i)` (the
     /// same operations on the same values: `SingleLeaf::hit` is lane 0 of `Node4::hit`).
-    pub(super) fn root_box_packet(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
+    pub(super) fn root_box_packet<R: PacketRays + ?Sized>(
+        &self,
+        isa: Isa,
+        rays: &R,
+        active: u32,
+    ) -> u32 {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
@@ -535,30 +703,30 @@ impl WideBvh {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.root_box_avx2(rays, active) },
-            _ => self.root_box_impl::<Portable>(rays, active),
+            _ => self.root_box_impl::<Portable, R>(rays, active),
         }
     }
 
     /// [`Self::root_box_impl`] on AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    fn root_box_avx512(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
-        self.root_box_impl::<Avx512>(rays, active)
+    fn root_box_avx512<R: PacketRays + ?Sized>(&self, rays: &R, active: u32) -> u32 {
+        self.root_box_impl::<Avx512, R>(rays, active)
     }
 
     /// [`Self::root_box_impl`] on AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn root_box_avx2(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
-        self.root_box_impl::<Avx2>(rays, active)
+    fn root_box_avx2<R: PacketRays + ?Sized>(&self, rays: &R, active: u32) -> u32 {
+        self.root_box_impl::<Avx2, R>(rays, active)
     }
 
     #[inline(always)]
-    fn root_box_impl<S: Simd>(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+    fn root_box_impl<S: Simd, R: PacketRays + ?Sized>(&self, rays: &R, active: u32) -> u32 {
         let Some(root) = self.nodes.first() else {
             return 0;
         };
-        let l = S::rays(rays);
+        let l = rays.lanes::<S>();
         let r = PacketBox::<S>::new(&l, active);
         let mut near = [0.0f32; PACKET];
         let m = match r.uniform {
@@ -575,10 +743,10 @@ impl WideBvh {
     /// rays with another primitive hit at exactly their best t (the caller redoes those with
     /// the scalar query). `other(id, ray, t_max)`
     /// is the hit distance of a non-triangle primitive if below `t_max`, else +∞.
-    pub(super) fn closest_packet(
+    pub(super) fn closest_packet<R: PacketRays + ?Sized>(
         &self,
         isa: Isa,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
@@ -590,43 +758,43 @@ impl WideBvh {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.closest_packet_avx2(rays, active, out, other) },
-            _ => self.closest_packet_impl::<Portable>(rays, active, out, other),
+            _ => self.closest_packet_impl::<Portable, R>(rays, active, out, other),
         }
     }
 
     /// [`Self::closest_packet_impl`] on AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    fn closest_packet_avx512(
+    fn closest_packet_avx512<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
     ) {
-        self.closest_packet_impl::<Avx512>(rays, active, out, other)
+        self.closest_packet_impl::<Avx512, R>(rays, active, out, other)
     }
 
     /// [`Self::closest_packet_impl`] on AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn closest_packet_avx2(
+    fn closest_packet_avx2<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
     ) {
-        self.closest_packet_impl::<Avx2>(rays, active, out, other)
+        self.closest_packet_impl::<Avx2, R>(rays, active, out, other)
     }
 
     /// Mask of the rays `active` that something blocks in (0, t_max), on backend `isa` (one
     /// this CPU runs);
     /// `other(id, ray)` tells whether non-triangle primitive `id` blocks `ray`.
-    pub(super) fn any_packet(
+    pub(super) fn any_packet<R: PacketRays + ?Sized>(
         &self,
         isa: Isa,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
@@ -638,40 +806,40 @@ impl WideBvh {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above: the CPU runs AVX2.
             Isa::Avx2 => unsafe { self.any_packet_avx2(rays, active, sparse, other) },
-            _ => self.any_packet_impl::<Portable>(rays, active, sparse, other),
+            _ => self.any_packet_impl::<Portable, R>(rays, active, sparse, other),
         }
     }
 
     /// [`Self::any_packet_impl`] on AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    fn any_packet_avx512(
+    fn any_packet_avx512<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
-        self.any_packet_impl::<Avx512>(rays, active, sparse, other)
+        self.any_packet_impl::<Avx512, R>(rays, active, sparse, other)
     }
 
     /// [`Self::any_packet_impl`] on AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn any_packet_avx2(
+    fn any_packet_avx2<R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
-        self.any_packet_impl::<Avx2>(rays, active, sparse, other)
+        self.any_packet_impl::<Avx2, R>(rays, active, sparse, other)
     }
 
     #[inline(always)]
-    fn closest_packet_impl<S: Simd>(
+    fn closest_packet_impl<S: Simd, R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         st: &mut PacketHits,
         mut other: impl FnMut(usize, &Ray, f32) -> f32,
@@ -679,7 +847,7 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return;
         }
-        let l = S::rays(rays);
+        let l = rays.lanes::<S>();
         let r = PacketBox::<S>::new(&l, active);
         let best = S::select(S::mask(active), l[6], S::splat(f32::NEG_INFINITY));
         S::store(best, &mut st.t);
@@ -687,10 +855,7 @@ impl WideBvh {
         let zero = S::splat(0.0);
         let finite = S::and(S::le(zero, best), S::lt(best, S::splat(f32::INFINITY)));
         S::store(S::inc_bits(finite, best), &mut st.tm);
-        let pshear = PacketShear::<S>::new(rays, &l, active);
-        // Per-ray shears for packets whose rays differ in shear axes, built at first use.
-        let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
-        let mut built = 0u32;
+        let ps = PacketShear::<S>::new(&l, active);
         let mut stack = [const { MaybeUninit::<Pending>::uninit() }; STACK];
         let mut sp = 0usize;
         let (mut cur, mut mask) = (0u32, active);
@@ -743,30 +908,19 @@ impl WideBvh {
                     // `packets` whose final packet has `last` set (see `WideBvh::leaf`).
                     let pk = unsafe { self.packets.get_unchecked(pi) };
                     // Accept t = best too, to notice ties (see the module docs).
-                    if let Some(ps) = &pshear {
-                        for lane in bits(pk.tri) {
-                            let p = tri_vertices(pk, lane);
-                            let id = pk.ids[lane & 3];
-                            let h = triangle_lanes(ps, p, &st.tm, mask);
-                            let hits = h.hit & mask;
-                            if hits != 0 {
-                                consider_lanes(st, id, &h, hits);
-                            }
-                            for i in bits(h.redo & mask) {
-                                let i = i & (PACKET - 1);
-                                if let Some((t, b0, b1, b2)) = redo_triangle(&rays[i], p, st.tm[i])
-                                {
-                                    consider(st, i, id as usize, t, [b0, b1, b2]);
-                                }
-                            }
+                    for lane in bits(pk.tri) {
+                        let id = pk.ids[lane & 3];
+                        let h = triangle_lanes(&ps, pk, lane, &st.tm, mask);
+                        let hits = h.hit & mask;
+                        if hits != 0 {
+                            consider_lanes(st, id, &h, hits);
                         }
-                    } else if pk.tri != 0 {
-                        for i in bits(mask) {
+                        for i in bits(h.redo & mask) {
                             let i = i & (PACKET - 1);
-                            let shear = ray_shear(&mut shears, &mut built, rays, i);
-                            if let Some((lane, t, b)) = shear.closest(pk, st.tm[i]) {
-                                let id = pk.ids[lane & 3] as usize;
-                                consider(st, i, id, t, b);
+                            let p = tri_vertices(pk, lane);
+                            if let Some((t, b0, b1, b2)) = redo_triangle(&rays.ray(i), p, st.tm[i])
+                            {
+                                consider(st, i, id as usize, t, [b0, b1, b2]);
                             }
                         }
                     }
@@ -775,7 +929,7 @@ impl WideBvh {
                         for i in bits(mask) {
                             let i = i & (PACKET - 1);
                             let t_max = st.tm[i];
-                            let t = other(id, &rays[i], t_max);
+                            let t = other(id, &rays.ray(i), t_max);
                             if t < t_max {
                                 consider(st, i, id, t, [1.0 / 3.0; 3]);
                             }
@@ -811,9 +965,9 @@ impl WideBvh {
     }
 
     #[inline(always)]
-    fn any_packet_impl<S: Simd>(
+    fn any_packet_impl<S: Simd, R: PacketRays + ?Sized>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         sparse: u32,
         mut other: impl FnMut(usize, &Ray) -> bool,
@@ -821,16 +975,12 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return 0;
         }
-        let l = S::rays(rays);
+        let l = rays.lanes::<S>();
         let r = PacketBox::<S>::new(&l, active);
-        let mut t_max: Lanes = [f32::NEG_INFINITY; PACKET];
-        for i in bits(active) {
-            t_max[i] = rays[i].t_max;
-        }
-        let pshear = PacketShear::<S>::new(rays, &l, active);
-        // Per-ray shears for packets whose rays differ in shear axes, built at first use.
-        let mut shears = [const { MaybeUninit::<RayShear4>::uninit() }; PACKET];
-        let mut built = 0u32;
+        let mut t_max: Lanes = [0.0; PACKET];
+        let inactive = S::splat(f32::NEG_INFINITY);
+        S::store(S::select(S::mask(active), l[6], inactive), &mut t_max);
+        let ps = PacketShear::<S>::new(&l, active);
         let mut blocked = 0u32;
         // Only interior nodes are pushed (leaves are tested on sight), with their ray mask.
         let mut stack = [const { MaybeUninit::<(u32, u32)>::uninit() }; STACK];
@@ -842,7 +992,7 @@ impl WideBvh {
                 // Few rays left in this subtree: the packet would test every box for all 16
                 // lanes, the scalar query only for these rays.
                 for i in bits(mask & !blocked) {
-                    let ray = &rays[i & (PACKET - 1)];
+                    let ray = &rays.ray(i & (PACKET - 1));
                     let hit = self.any_from(cur, ray.o, ray.d, ray.t_max, |id| other(id, ray));
                     blocked |= (hit as u32) << i;
                 }
@@ -871,27 +1021,19 @@ impl WideBvh {
                     loop {
                         // SAFETY: as in `closest_packet`, a leaf's packet run lies in `packets`.
                         let pk = unsafe { self.packets.get_unchecked(pi) };
-                        if let Some(ps) = &pshear {
-                            for lane in bits(pk.tri) {
-                                let p = tri_vertices(pk, lane);
-                                let h = triangle_lanes(ps, p, &t_max, m & !blocked);
-                                blocked |= h.hit & m;
-                                for i in bits(h.redo & m & !blocked) {
-                                    let i = i & (PACKET - 1);
-                                    let hit = redo_triangle(&rays[i], p, t_max[i]).is_some();
-                                    blocked |= (hit as u32) << i;
-                                }
-                            }
-                        } else if pk.tri != 0 {
-                            for i in bits(m & !blocked) {
+                        for lane in bits(pk.tri) {
+                            let h = triangle_lanes(&ps, pk, lane, &t_max, m & !blocked);
+                            blocked |= h.hit & m;
+                            for i in bits(h.redo & m & !blocked) {
                                 let i = i & (PACKET - 1);
-                                let shear = ray_shear(&mut shears, &mut built, rays, i);
-                                blocked |= (shear.any(pk, t_max[i]) as u32) << i;
+                                let p = tri_vertices(pk, lane);
+                                let hit = redo_triangle(&rays.ray(i), p, t_max[i]).is_some();
+                                blocked |= (hit as u32) << i;
                             }
                         }
                         for lane in bits(pk.other) {
                             for i in bits(m & !blocked) {
-                                let hit = other(pk.ids[lane & 3] as usize, &rays[i]);
+                                let hit = other(pk.ids[lane & 3] as usize, &rays.ray(i));
                                 blocked |= (hit as u32) << i;
                             }
                         }
