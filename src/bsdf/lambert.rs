@@ -33,7 +33,7 @@ impl Bxdf for Lambert {
         self.r * FRAC_1_PI
     }
 
-    #[inline]
+    #[inline(always)]
     fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
         super::sample_by_hemisphere(self, self.sampling, wo, u)
     }

@@ -312,8 +312,10 @@ impl TriangleLightLanes {
                 two_sided: self.two_sided[k],
             };
             let u = Vec2::new(self.u[0][k], self.u[1][k]);
-            let est = tri.sample_li(&ctx, u, SamplingMode::Area).and_then(|ls| {
-                light_estimate(
+            // `match`, not `Option::and_then`: a closure may be left out of line, and one call
+            // in the loop keeps it from vectorising.
+            let est = match tri.sample_li(&ctx, u, SamplingMode::Area) {
+                Some(ls) => light_estimate(
                     &ls,
                     self.pmf[k],
                     &lambert,
@@ -322,8 +324,9 @@ impl TriangleLightLanes {
                     &ctx,
                     &hit,
                     mis,
-                )
-            });
+                ),
+                None => None,
+            };
             let (ok, ray, value) = match est {
                 Some((ray, value)) => (true, ray, value),
                 None => (false, Ray::new(Vec3::ZERO, Vec3::ZERO), Rgb::ZERO),
@@ -421,9 +424,10 @@ impl DiffuseBsdfLanes {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let u = Vec2::new(self.u[0][k], self.u[1][k]);
-            let b = lambert
-                .sample(wo_local, 0.0, u)
-                .and_then(|bs| bsdf_ray_of(&bs, &frame, ctx.n, &hit));
+            let b = match lambert.sample(wo_local, 0.0, u) {
+                Some(bs) => bsdf_ray_of(&bs, &frame, ctx.n, &hit),
+                None => None,
+            };
             let (ok, b) = match b {
                 Some(b) => (true, b),
                 None => (false, BsdfRay::NONE),

@@ -274,7 +274,8 @@ pub(crate) fn triangle_solid_angle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
 /// The connection from `p` to `p_light`, a point drawn with area density `pdf_area` on an
 /// emitter of radiance `l` whose normal there is `n_light`: the one place where a sampled point
 /// on an area light becomes a [`LightLiSample`] with a solid-angle pdf.
-#[inline]
+// Always inlined: the integrator's lane kernel vectorises only if its whole body is inline.
+#[inline(always)]
 pub(crate) fn area_sample(
     p: Vec3,
     p_light: Vec3,
