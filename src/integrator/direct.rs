@@ -6,12 +6,12 @@
 //! surface on the viewer's side (reflection only), so their MIS combination stays unbiased even
 //! where shading normals disagree with the geometry.
 
-use super::lanes::{DiffuseBsdfLanes, Receivers, TriangleLightLanes};
+use super::lanes::{DiffuseBsdfLanes, Pending, Receivers, Sampled, TriangleLightLanes};
 use super::{MisHeuristic, Strategy};
 use crate::Rgb;
 use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
-use crate::geometry::{Geometry, PACKET, Ray, SurfaceHit};
+use crate::geometry::{PACKET, Ray, SurfaceHit};
 use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
 use crate::lights::{Emitter, Light, LightLiSample, LightSampleContext, LightSource, SamplingMode};
 use crate::sampling::{Frame, PixelSamples, SamplePattern};
@@ -169,90 +169,6 @@ impl BsdfRay {
     };
 }
 
-/// The BSDF rays of a packet's lanes (bit k of `active`: lane k has one), field by field: the
-/// rays go to the emitter query as they are, and the rest is read only for lanes that reach
-/// an emitter.
-struct Sampled {
-    active: u32,
-    ray: [Ray; PACKET],
-    weight: [Rgb; PACKET],
-    pdf: [f32; PACKET],
-    /// Bit k: lane k's sample is from a delta lobe.
-    delta: u32,
-}
-
-impl Sampled {
-    fn new(idle: Ray) -> Self {
-        Self {
-            active: 0,
-            ray: [idle; PACKET],
-            weight: [Rgb::ZERO; PACKET],
-            pdf: [0.0; PACKET],
-            delta: 0,
-        }
-    }
-
-    /// Give lane k the ray `b`.
-    #[inline]
-    fn set(&mut self, k: usize, b: &BsdfRay) {
-        self.active |= 1 << k;
-        self.ray[k] = b.ray;
-        self.weight[k] = b.weight;
-        self.pdf[k] = b.pdf;
-        self.delta = self.delta & !(1 << k) | (b.delta as u32) << k;
-    }
-
-    /// Lane k's ray.
-    #[inline]
-    fn get(&self, k: usize) -> BsdfRay {
-        BsdfRay {
-            ray: self.ray[k],
-            weight: self.weight[k],
-            pdf: self.pdf[k],
-            delta: self.delta >> k & 1 != 0,
-        }
-    }
-}
-
-/// One value per lane that counts unless its ray is blocked: the rays go to the geometry as
-/// one packet query.
-struct Pending {
-    active: u32,
-    ray: [Ray; PACKET],
-    value: [Rgb; PACKET],
-}
-
-impl Pending {
-    fn new(idle: Ray) -> Self {
-        Self {
-            active: 0,
-            ray: [idle; PACKET],
-            value: [Rgb::ZERO; PACKET],
-        }
-    }
-
-    #[inline]
-    fn set(&mut self, k: usize, ray: Ray, value: Rgb) {
-        self.active |= 1 << k;
-        self.ray[k] = ray;
-        self.value[k] = value;
-    }
-
-    /// Keep the values whose rays are clear (zero elsewhere, inactive lanes included).
-    fn resolve(&mut self, geometry: &Geometry) {
-        let blocked = if self.active != 0 {
-            geometry.occluded_packet(&self.ray, self.active)
-        } else {
-            0
-        };
-        for (k, v) in self.value.iter_mut().enumerate() {
-            if (self.active & !blocked) >> k & 1 == 0 {
-                *v = Rgb::ZERO;
-            }
-        }
-    }
-}
-
 /// The working arrays of [`DirectLighting::li_packet`], made once per render thread's tile
 /// instead of per packet (every lane a packet reads is written first by that packet).
 pub struct PacketScratch {
@@ -277,15 +193,14 @@ impl Default for PacketScratch {
 impl PacketScratch {
     /// Fresh working arrays.
     pub fn new() -> Self {
-        let idle = Ray::new(Vec3::ZERO, Vec3::Z);
         Self {
             first: [Draws::default(); PACKET],
             hits: [None; PACKET],
             lanes: [const { None }; PACKET],
             emitter_hits: [None; PACKET],
-            light: Pending::new(idle),
-            bsdf: Pending::new(idle),
-            sampled: Sampled::new(idle),
+            light: Pending::new(),
+            bsdf: Pending::new(),
+            sampled: Sampled::new(),
             rx: Receivers::new(),
             tri_lanes: TriangleLightLanes::new(),
             bsdf_lanes: DiffuseBsdfLanes::new(),
@@ -447,36 +362,38 @@ impl<'a> DirectLighting<'a> {
         };
         let mis = self.strategy == Strategy::Mis;
         let mut sums = [Rgb::ZERO; PACKET];
+        let mut picked = [SelectedLight { index: 0, pmf: 0.0 }; PACKET];
         for j in 0..m {
             light.active = 0;
             bsdf.active = 0;
-            sampled.active = 0;
+            sampled.clear();
             tri_lanes.active = 0;
             bsdf_lanes.active = 0;
+            // Which lanes take the per-lane paths (and the light each picked).
+            let (mut lone_light, mut lone_bsdf) = (0u32, 0u32);
             for k in 0..n {
                 let Some(lane) = &lanes[k] else { continue };
                 let Some(hit) = &hits[k] else { continue };
-                // The per-lane view is built only where a per-lane path needs it: the kernels'
-                // lanes (diffuse receivers, uniform selection) read the receivers' arrays.
-                let view = || lane.view(k, hit, rx);
-                let d = if j == 0 { first[k] } else { draws!(k, j) };
+                if j > 0 {
+                    first[k] = draws!(k, j);
+                }
+                let d = &first[k];
                 let diffuse = rx.diffuse >> k & 1 != 0;
                 if use_light {
                     let sel = match uniform {
                         Some(count) => UniformSelector::pick(count, d.light_select),
                         None => self
                             .selector
-                            .sample(&view().shading_point(), d.light_select),
+                            .sample(&lane.view(k, hit, rx).shading_point(), d.light_select),
                     };
-                    match sel.map(|sel| (sel, &scene.lights[sel.index as usize])) {
-                        None => {}
-                        Some((sel, Light::Triangle(tri))) if diffuse && area => {
-                            tri_lanes.load(k, tri, sel.pmf, d.light)
-                        }
-                        Some((sel, _)) => {
-                            if let Some((r, v)) = self.light_sample(&view(), sel, d.light, mis) {
-                                light.set(k, r, v);
-                                rays += 1;
+                    if let Some(sel) = sel {
+                        match &scene.lights[sel.index as usize] {
+                            Light::Triangle(tri) if diffuse && area => {
+                                tri_lanes.load(k, tri, sel.pmf, d.light)
+                            }
+                            _ => {
+                                picked[k] = sel;
+                                lone_light |= 1 << k;
                             }
                         }
                     }
@@ -485,47 +402,46 @@ impl<'a> DirectLighting<'a> {
                     if diffuse {
                         bsdf_lanes.load(k, d.bsdf);
                     } else {
-                        let px = &pxs[cam.pixel[k] as usize];
-                        let lobe = px.sample_1d(DIM_LOBE, cam.eye[k] * m + j, count);
-                        if let Some(b) = self.bsdf_ray(&view(), lobe, d.bsdf) {
-                            // One logical ray whatever comes of it: an emitter query, then
-                            // maybe a visibility test.
-                            rays += 1;
-                            sampled.set(k, &b);
-                        }
+                        lone_bsdf |= 1 << k;
                     }
                 }
             }
+            // The kernels write every lane of their output, so they go first and the per-lane
+            // paths then fill in their own lanes. One logical ray per sample that has one
+            // (for BSDF samples whatever comes of it: an emitter query, maybe a visibility
+            // test).
             if tri_lanes.active != 0 {
-                tri_lanes.run(rx, mis.then_some(self.mis), isa);
-                for k in 0..n {
-                    if tri_lanes.active >> k & 1 != 0
-                        && let Some((r, v)) = tri_lanes.result(k)
-                    {
-                        light.set(k, r, v);
-                        rays += 1;
-                    }
-                }
+                rays += u64::from(tri_lanes.run(rx, mis.then_some(self.mis), isa, light));
             }
             if bsdf_lanes.active != 0 {
-                bsdf_lanes.run(rx, isa);
-                for k in 0..n {
-                    if bsdf_lanes.active >> k & 1 != 0
-                        && let Some(b) = bsdf_lanes.result(k)
-                    {
-                        rays += 1;
-                        sampled.set(k, &b);
-                    }
+                rays += u64::from(bsdf_lanes.run(rx, isa, sampled));
+            }
+            for k in bits(lone_light) {
+                let (Some(lane), Some(hit)) = (&lanes[k], &hits[k]) else {
+                    continue;
+                };
+                let sh = lane.view(k, hit, rx);
+                if let Some((r, v)) = self.light_sample(&sh, picked[k], first[k].light, mis) {
+                    light.set(k, &r, v);
+                    rays += 1;
+                }
+            }
+            for k in bits(lone_bsdf) {
+                let (Some(lane), Some(hit)) = (&lanes[k], &hits[k]) else {
+                    continue;
+                };
+                let px = &pxs[cam.pixel[k] as usize];
+                let lobe = px.sample_1d(DIM_LOBE, cam.eye[k] * m + j, count);
+                if let Some(b) = self.bsdf_ray(&lane.view(k, hit, rx), lobe, first[k].bsdf) {
+                    rays += 1;
+                    sampled.set(k, &b);
                 }
             }
             if sampled.active != 0 {
                 scene
                     .emitters
-                    .intersect_packet(&sampled.ray, sampled.active, emitter_hits);
-                for k in 0..n {
-                    if sampled.active >> k & 1 == 0 {
-                        continue;
-                    }
+                    .intersect_packet_soa(&sampled.rays, sampled.active, emitter_hits);
+                for k in bits(sampled.active) {
                     let hit = emitter_hits[k].as_ref();
                     // Most BSDF rays reach no light: nothing to gather, no view to build.
                     if hit.is_none() && scene.infinite_lights.is_empty() {
@@ -536,7 +452,7 @@ impl<'a> DirectLighting<'a> {
                     };
                     let b = sampled.get(k);
                     if let Some((r, v)) = self.bsdf_gather(&lane.view(k, at, rx), &b, hit, mis) {
-                        bsdf.set(k, r, v);
+                        bsdf.set(k, &r, v);
                     }
                 }
             }
@@ -545,10 +461,10 @@ impl<'a> DirectLighting<'a> {
             for k in 0..n {
                 if lanes[k].is_some() {
                     if use_light {
-                        sums[k] += light.value[k];
+                        sums[k] += light.value(k);
                     }
                     if use_bsdf {
-                        sums[k] += bsdf.value[k];
+                        sums[k] += bsdf.value(k);
                     }
                 }
             }
@@ -778,6 +694,18 @@ pub(super) fn bsdf_ray_of(
         weight,
         pdf: bs.pdf,
         delta: bs.delta,
+    })
+}
+
+/// Indices of the set bits of `m`, lowest first.
+#[inline]
+fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            k
+        })
     })
 }
 

@@ -12,7 +12,7 @@ use super::MisHeuristic;
 use super::direct::{BsdfRay, bsdf_ray_of, light_estimate};
 use crate::Rgb;
 use crate::bsdf::{Bxdf, Lambert, LobeSampling};
-use crate::geometry::{PACKET, Ray, ShadingGeometry, SurfaceHit};
+use crate::geometry::{Geometry, PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
 use crate::isa::Isa;
 use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
 use crate::sampling::Frame;
@@ -207,7 +207,7 @@ impl Receivers {
 }
 
 /// Light samples of triangle lights drawn by area for diffuse receivers: bit k of `active`
-/// marks lane k as loaded; after [`Self::run`], `ok` says which lanes have an estimate.
+/// marks lane k as loaded.
 pub(super) struct TriangleLightLanes {
     /// Loaded lanes.
     pub(super) active: u32,
@@ -219,9 +219,6 @@ pub(super) struct TriangleLightLanes {
     l: V3,
     two_sided: [bool; PACKET],
     ok: [bool; PACKET],
-    o: V3,
-    d: V3,
-    value: V3,
 }
 
 impl TriangleLightLanes {
@@ -237,9 +234,6 @@ impl TriangleLightLanes {
             l: V3::ZERO,
             two_sided: [false; PACKET],
             ok: [false; PACKET],
-            o: V3::ZERO,
-            d: V3::ZERO,
-            value: V3::ZERO,
         }
     }
 
@@ -259,49 +253,59 @@ impl TriangleLightLanes {
         self.two_sided[k] = tri.two_sided;
     }
 
-    /// Every lane's estimate (loaded or not: the others' are ignored), MIS-weighted by `mis`
-    /// when given, on instruction set `isa`.
-    pub(super) fn run(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, isa: Isa) {
+    /// Every lane's estimate (loaded or not), MIS-weighted by `mis` when given, on
+    /// instruction set `isa`, written to all the lanes of `out` (so before any lane's own);
+    /// the loaded lanes with an estimate become active there. Returns their number.
+    pub(super) fn run(
+        &mut self,
+        rx: &Receivers,
+        mis: Option<MisHeuristic>,
+        isa: Isa,
+        out: &mut Pending,
+    ) -> u32 {
         match (isa, mis) {
             #[cfg(target_arch = "x86_64")]
             (Isa::Avx512, m) => {
                 // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx, m) }
+                unsafe { self.run_avx512(rx, m, out) }
             }
             #[cfg(target_arch = "x86_64")]
             (Isa::Avx2, m) => {
                 // SAFETY: as above.
-                unsafe { self.run_avx2(rx, m) }
+                unsafe { self.run_avx2(rx, m, out) }
             }
-            (_, None) => self.body(rx, None),
-            (_, Some(MisHeuristic::Power)) => self.body(rx, Some(MisHeuristic::Power)),
-            (_, Some(MisHeuristic::Balance)) => self.body(rx, Some(MisHeuristic::Balance)),
+            (_, None) => self.body(rx, None, out),
+            (_, Some(MisHeuristic::Power)) => self.body(rx, Some(MisHeuristic::Power), out),
+            (_, Some(MisHeuristic::Balance)) => self.body(rx, Some(MisHeuristic::Balance), out),
         }
+        let ok = mask_of(&self.ok) & self.active;
+        out.active |= ok;
+        ok.count_ones()
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn run_avx512(&mut self, rx: &Receivers, mis: Option<MisHeuristic>) {
+    unsafe fn run_avx512(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, out: &mut Pending) {
         match mis {
-            None => self.body(rx, None),
-            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power)),
-            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance)),
+            None => self.body(rx, None, out),
+            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power), out),
+            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance), out),
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&mut self, rx: &Receivers, mis: Option<MisHeuristic>) {
+    unsafe fn run_avx2(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, out: &mut Pending) {
         match mis {
-            None => self.body(rx, None),
-            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power)),
-            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance)),
+            None => self.body(rx, None, out),
+            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power), out),
+            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance), out),
         }
     }
 
     /// The lane loop; inlined into each caller with `mis` a constant.
     #[inline(always)]
-    fn body(&mut self, rx: &Receivers, mis: Option<MisHeuristic>) {
+    fn body(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, out: &mut Pending) {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let tri = TriangleLight {
@@ -332,39 +336,18 @@ impl TriangleLightLanes {
                 None => (false, Ray::new(Vec3::ZERO, Vec3::ZERO), Rgb::ZERO),
             };
             self.ok[k] = ok;
-            self.o.set(k, ray.o);
-            self.d.set(k, ray.d);
-            self.value.set(k, value);
+            out.put(k, &ray, value);
         }
-    }
-
-    /// Lane k's shadow ray and value, if it has an estimate (valid after [`Self::run`]).
-    #[inline]
-    pub(super) fn result(&self, k: usize) -> Option<(Ray, Rgb)> {
-        self.ok[k].then(|| {
-            (
-                Ray {
-                    o: self.o.get(k),
-                    d: self.d.get(k),
-                    t_max: super::direct::SHADOW_T_MAX,
-                },
-                self.value.get(k),
-            )
-        })
     }
 }
 
 /// Cosine-sampled BSDF rays of diffuse receivers (every lane of [`Receivers::diffuse`] that is
-/// loaded here with its draw): after [`Self::run`], `ok` says which lanes have a ray.
+/// loaded here with its draw).
 pub(super) struct DiffuseBsdfLanes {
     /// Loaded lanes.
     pub(super) active: u32,
     u: [Lanes; 2],
     ok: [bool; PACKET],
-    o: V3,
-    d: V3,
-    weight: V3,
-    pdf: Lanes,
 }
 
 impl DiffuseBsdfLanes {
@@ -374,10 +357,6 @@ impl DiffuseBsdfLanes {
             active: 0,
             u: [[0.0; PACKET]; 2],
             ok: [false; PACKET],
-            o: V3::ZERO,
-            d: V3::ZERO,
-            weight: V3::ZERO,
-            pdf: [0.0; PACKET],
         }
     }
 
@@ -389,38 +368,43 @@ impl DiffuseBsdfLanes {
         self.u[1][k] = u.y;
     }
 
-    /// Every lane's ray (loaded or not: the others' are ignored) on instruction set `isa`.
-    pub(super) fn run(&mut self, rx: &Receivers, isa: Isa) {
+    /// Every lane's ray (loaded or not) on instruction set `isa`, written to all the lanes of
+    /// `out` (so before any lane's own); the loaded lanes with a ray become active there.
+    /// Returns their number.
+    pub(super) fn run(&mut self, rx: &Receivers, isa: Isa, out: &mut Sampled) -> u32 {
         match isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx512 => {
                 // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx) }
+                unsafe { self.run_avx512(rx, out) }
             }
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => {
                 // SAFETY: as above.
-                unsafe { self.run_avx2(rx) }
+                unsafe { self.run_avx2(rx, out) }
             }
-            _ => self.body(rx),
+            _ => self.body(rx, out),
         }
+        let ok = mask_of(&self.ok) & self.active;
+        out.active |= ok;
+        ok.count_ones()
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn run_avx512(&mut self, rx: &Receivers) {
-        self.body(rx)
+    unsafe fn run_avx512(&mut self, rx: &Receivers, out: &mut Sampled) {
+        self.body(rx, out)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&mut self, rx: &Receivers) {
-        self.body(rx)
+    unsafe fn run_avx2(&mut self, rx: &Receivers, out: &mut Sampled) {
+        self.body(rx, out)
     }
 
     /// The lane loop.
     #[inline(always)]
-    fn body(&mut self, rx: &Receivers) {
+    fn body(&mut self, rx: &Receivers, out: &mut Sampled) {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let u = Vec2::new(self.u[0][k], self.u[1][k]);
@@ -433,21 +417,133 @@ impl DiffuseBsdfLanes {
                 None => (false, BsdfRay::NONE),
             };
             self.ok[k] = ok;
-            self.o.set(k, b.ray.o);
-            self.d.set(k, b.ray.d);
-            self.weight.set(k, b.weight);
-            self.pdf[k] = b.pdf;
+            out.put(k, &b);
+        }
+    }
+}
+
+/// Bit k set where `b[k]`.
+#[inline]
+fn mask_of(b: &[bool; PACKET]) -> u32 {
+    b.iter()
+        .enumerate()
+        .fold(0, |m, (k, &on)| m | (on as u32) << k)
+}
+
+/// One value per lane that counts unless its ray is blocked: the rays go to the geometry as
+/// one packet query, in the lanes the kernels write them to.
+pub(super) struct Pending {
+    /// Lanes with a ray.
+    pub(super) active: u32,
+    rays: RayPacket,
+    value: V3,
+    /// After [`Self::resolve`]: the active lanes whose rays are clear.
+    clear: u32,
+}
+
+impl Pending {
+    /// No lanes active.
+    pub(super) fn new() -> Self {
+        Self {
+            active: 0,
+            rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
+            value: V3::ZERO,
+            clear: 0,
         }
     }
 
-    /// Lane k's BSDF ray, if it has one (valid after [`Self::run`]).
+    /// Lane k's ray and value, not (yet) active.
+    #[inline(always)]
+    fn put(&mut self, k: usize, ray: &Ray, value: Rgb) {
+        self.rays.set(k, ray);
+        self.value.set(k, value);
+    }
+
+    /// Make lane k active with `ray` and `value`.
     #[inline]
-    pub(super) fn result(&self, k: usize) -> Option<BsdfRay> {
-        self.ok[k].then(|| BsdfRay {
-            ray: Ray::new(self.o.get(k), self.d.get(k)),
+    pub(super) fn set(&mut self, k: usize, ray: &Ray, value: Rgb) {
+        self.active |= 1 << k;
+        self.put(k, ray, value);
+    }
+
+    /// Trace the active rays: afterwards [`Self::value`] is the value where the ray is clear.
+    pub(super) fn resolve(&mut self, geometry: &Geometry) {
+        let blocked = if self.active != 0 {
+            geometry.occluded_packet_soa(&self.rays, self.active)
+        } else {
+            0
+        };
+        self.clear = self.active & !blocked;
+    }
+
+    /// Lane k's value if its ray is clear, else zero (valid after [`Self::resolve`]).
+    #[inline]
+    pub(super) fn value(&self, k: usize) -> Rgb {
+        if self.clear >> k & 1 != 0 {
+            self.value.get(k)
+        } else {
+            Rgb::ZERO
+        }
+    }
+}
+
+/// The BSDF rays of a packet's lanes (bit k of `active`: lane k has one), field by field: the
+/// rays go to the emitter query as they are, and the rest is read only for lanes that reach
+/// an emitter.
+pub(super) struct Sampled {
+    /// Lanes with a ray.
+    pub(super) active: u32,
+    /// The rays.
+    pub(super) rays: RayPacket,
+    weight: V3,
+    pdf: Lanes,
+    /// Bit k: lane k's sample is from a delta lobe.
+    delta: u32,
+}
+
+impl Sampled {
+    /// No lanes active.
+    pub(super) fn new() -> Self {
+        Self {
+            active: 0,
+            rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
+            weight: V3::ZERO,
+            pdf: [0.0; PACKET],
+            delta: 0,
+        }
+    }
+
+    /// Start a new round: no lanes active.
+    #[inline]
+    pub(super) fn clear(&mut self) {
+        self.active = 0;
+        self.delta = 0;
+    }
+
+    /// Lane k's ray, not (yet) active (and not from a delta lobe).
+    #[inline(always)]
+    fn put(&mut self, k: usize, b: &BsdfRay) {
+        self.rays.set(k, &b.ray);
+        self.weight.set(k, b.weight);
+        self.pdf[k] = b.pdf;
+    }
+
+    /// Make lane k active with ray `b`.
+    #[inline]
+    pub(super) fn set(&mut self, k: usize, b: &BsdfRay) {
+        self.active |= 1 << k;
+        self.put(k, b);
+        self.delta |= (b.delta as u32) << k;
+    }
+
+    /// Lane k's ray.
+    #[inline]
+    pub(super) fn get(&self, k: usize) -> BsdfRay {
+        BsdfRay {
+            ray: self.rays.ray(k),
             weight: self.weight.get(k),
             pdf: self.pdf[k],
-            delta: false,
-        })
+            delta: self.delta >> k & 1 != 0,
+        }
     }
 }
