@@ -354,6 +354,11 @@ impl<'a> DirectLighting<'a> {
                 Some(hit) => self.shade(k, hit, rx, &mut lanes[k]),
             };
         }
+        let shaded = lanes
+            .iter()
+            .enumerate()
+            .take(n)
+            .fold(0u32, |s, (k, l)| s | (l.is_some() as u32) << k);
         let area = self.mode() == SamplingMode::Area;
         let uniform = if use_light {
             self.selector.uniform_count()
@@ -458,21 +463,15 @@ impl<'a> DirectLighting<'a> {
             }
             light.resolve(&scene.geometry);
             bsdf.resolve(&scene.geometry);
-            for k in 0..n {
-                if lanes[k].is_some() {
-                    if use_light {
-                        sums[k] += light.value(k);
-                    }
-                    if use_bsdf {
-                        sums[k] += bsdf.value(k);
-                    }
-                }
+            if use_light {
+                light.add_to(shaded, &mut sums);
+            }
+            if use_bsdf {
+                bsdf.add_to(shaded, &mut sums);
             }
         }
-        for k in 0..n {
-            if lanes[k].is_some() {
-                out[k] += sums[k] / m as f32;
-            }
+        for k in bits(shaded) {
+            out[k] += sums[k] / m as f32;
         }
         rays
     }

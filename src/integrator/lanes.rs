@@ -476,13 +476,15 @@ impl Pending {
         self.clear = self.active & !blocked;
     }
 
-    /// Lane k's value if its ray is clear, else zero (valid after [`Self::resolve`]).
+    /// Add to `sums` each lane's value where its ray is clear, zero elsewhere, for the lanes
+    /// `on` (valid after [`Self::resolve`]).
     #[inline]
-    pub(super) fn value(&self, k: usize) -> Rgb {
-        if self.clear >> k & 1 != 0 {
-            self.value.get(k)
-        } else {
-            Rgb::ZERO
+    pub(super) fn add_to(&self, on: u32, sums: &mut [Rgb; PACKET]) {
+        for (k, s) in sums.iter_mut().enumerate() {
+            if on >> k & 1 != 0 {
+                let clear = self.clear >> k & 1 != 0;
+                *s += if clear { self.value.get(k) } else { Rgb::ZERO };
+            }
         }
     }
 }
