@@ -422,7 +422,7 @@ impl<'a> DirectLighting<'a> {
         let isa = scene.geometry.isa();
         // The hits' shading geometry for all lanes at once, then each lane's emission and
         // BSDF; Lambertian receivers go to the lane kernels (their light samples when triangle
-        // lights are sampled by area, and their BSDF rays).
+        // lights, and their BSDF rays).
         for (k, (hit, ray)) in hits.iter().zip(&cam.ray).enumerate().take(n) {
             if let Some(hit) = hit {
                 rx.stage(k, hit, ray.d);
@@ -439,7 +439,7 @@ impl<'a> DirectLighting<'a> {
                 Some(hit) => self.shade(k, hit, rx, &mut lanes[k]),
             };
         }
-        let area = self.mode() == SamplingMode::Area;
+        let mode = self.mode();
         let uniform = if use_light {
             self.selector.uniform_count()
         } else {
@@ -470,7 +470,7 @@ impl<'a> DirectLighting<'a> {
                     };
                     match sel.map(|sel| (sel, &scene.lights[sel.index as usize])) {
                         None => {}
-                        Some((sel, Light::Triangle(tri))) if diffuse && area => {
+                        Some((sel, Light::Triangle(tri))) if diffuse => {
                             tri_lanes.load(k, tri, sel.pmf, d.light)
                         }
                         Some((sel, _)) => {
@@ -497,7 +497,7 @@ impl<'a> DirectLighting<'a> {
                 }
             }
             if tri_lanes.active != 0 {
-                tri_lanes.run(rx, mis.then_some(self.mis), isa);
+                tri_lanes.run(rx, mis.then_some(self.mis), mode, isa);
                 for k in 0..n {
                     if tri_lanes.active >> k & 1 != 0
                         && let Some((r, v)) = tri_lanes.result(k)

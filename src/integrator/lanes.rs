@@ -1,5 +1,6 @@
 //! Structure-of-arrays kernels for the packet estimator's commonest case: a Lambertian
-//! receiver lit by an area-sampled triangle light, and its cosine-sampled BSDF rays.
+//! receiver lit by a triangle light (sampled by area or by solid angle), and its
+//! cosine-sampled BSDF rays.
 //!
 //! Lane by lane these run the very functions the per-lane path runs (the triangle's
 //! `sample_li`, [`light_estimate`], the Lambertian `sample`, [`bsdf_ray_of`]), so each lane's
@@ -206,7 +207,7 @@ impl Receivers {
     }
 }
 
-/// Light samples of triangle lights drawn by area for diffuse receivers: bit k of `active`
+/// Light samples of triangle lights for diffuse receivers: bit k of `active`
 /// marks lane k as loaded; after [`Self::run`], `ok` says which lanes have an estimate.
 pub(super) struct TriangleLightLanes {
     /// Loaded lanes.
@@ -259,49 +260,66 @@ impl TriangleLightLanes {
         self.two_sided[k] = tri.two_sided;
     }
 
-    /// Every lane's estimate (loaded or not: the others' are ignored), MIS-weighted by `mis`
-    /// when given, on instruction set `isa`.
-    pub(super) fn run(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, isa: Isa) {
-        match (isa, mis) {
+    /// Every lane's estimate (loaded or not: the others' are ignored) sampled in `mode`,
+    /// MIS-weighted by `mis` when given, on instruction set `isa`.
+    pub(super) fn run(
+        &mut self,
+        rx: &Receivers,
+        mis: Option<MisHeuristic>,
+        mode: SamplingMode,
+        isa: Isa,
+    ) {
+        match isa {
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, m) => {
+            Isa::Avx512 => {
                 // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx, m) }
+                unsafe { self.run_avx512(rx, mis, mode) }
             }
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, m) => {
+            Isa::Avx2 => {
                 // SAFETY: as above.
-                unsafe { self.run_avx2(rx, m) }
+                unsafe { self.run_avx2(rx, mis, mode) }
             }
-            (_, None) => self.body(rx, None),
-            (_, Some(MisHeuristic::Power)) => self.body(rx, Some(MisHeuristic::Power)),
-            (_, Some(MisHeuristic::Balance)) => self.body(rx, Some(MisHeuristic::Balance)),
+            _ => self.dispatch(rx, mis, mode),
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn run_avx512(&mut self, rx: &Receivers, mis: Option<MisHeuristic>) {
-        match mis {
-            None => self.body(rx, None),
-            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power)),
-            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance)),
-        }
+    unsafe fn run_avx512(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, mode: SamplingMode) {
+        self.dispatch(rx, mis, mode)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&mut self, rx: &Receivers, mis: Option<MisHeuristic>) {
-        match mis {
-            None => self.body(rx, None),
-            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power)),
-            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance)),
+    unsafe fn run_avx2(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, mode: SamplingMode) {
+        self.dispatch(rx, mis, mode)
+    }
+
+    /// One copy of the lane loop per (`mis`, `mode`), each with both constant, so each loop
+    /// body is straight-line code for its own case.
+    #[inline(always)]
+    fn dispatch(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, mode: SamplingMode) {
+        use SamplingMode::{Area, SolidAngle};
+        match (mis, mode) {
+            (None, Area) => self.body(rx, None, Area),
+            (None, SolidAngle) => self.body(rx, None, SolidAngle),
+            (Some(MisHeuristic::Power), Area) => self.body(rx, Some(MisHeuristic::Power), Area),
+            (Some(MisHeuristic::Power), SolidAngle) => {
+                self.body(rx, Some(MisHeuristic::Power), SolidAngle)
+            }
+            (Some(MisHeuristic::Balance), Area) => {
+                self.body(rx, Some(MisHeuristic::Balance), Area)
+            }
+            (Some(MisHeuristic::Balance), SolidAngle) => {
+                self.body(rx, Some(MisHeuristic::Balance), SolidAngle)
+            }
         }
     }
 
-    /// The lane loop; inlined into each caller with `mis` a constant.
+    /// The lane loop; inlined into each caller with `mis` and `mode` constants.
     #[inline(always)]
-    fn body(&mut self, rx: &Receivers, mis: Option<MisHeuristic>) {
+    fn body(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, mode: SamplingMode) {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let tri = TriangleLight {
@@ -312,8 +330,10 @@ impl TriangleLightLanes {
                 two_sided: self.two_sided[k],
             };
             let u = Vec2::new(self.u[0][k], self.u[1][k]);
-            let est = tri.sample_li(&ctx, u, SamplingMode::Area).and_then(|ls| {
-                light_estimate(
+            // A match, not `and_then`: the closure is not always inlined, and one call in
+            // the loop keeps it from vectorising.
+            let est = match tri.sample_li(&ctx, u, mode) {
+                Some(ls) => light_estimate(
                     &ls,
                     self.pmf[k],
                     &lambert,
@@ -322,8 +342,9 @@ impl TriangleLightLanes {
                     &ctx,
                     &hit,
                     mis,
-                )
-            });
+                ),
+                None => None,
+            };
             let (ok, ray, value) = match est {
                 Some((ray, value)) => (true, ray, value),
                 None => (false, Ray::new(Vec3::ZERO, Vec3::ZERO), Rgb::ZERO),
@@ -421,9 +442,11 @@ impl DiffuseBsdfLanes {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let u = Vec2::new(self.u[0][k], self.u[1][k]);
-            let b = lambert
-                .sample(wo_local, 0.0, u)
-                .and_then(|bs| bsdf_ray_of(&bs, &frame, ctx.n, &hit));
+            // A match, not `and_then`, as in the light kernel: the closure may be outlined.
+            let b = match lambert.sample(wo_local, 0.0, u) {
+                Some(bs) => bsdf_ray_of(&bs, &frame, ctx.n, &hit),
+                None => None,
+            };
             let (ok, b) = match b {
                 Some(b) => (true, b),
                 None => (false, BsdfRay::NONE),

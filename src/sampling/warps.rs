@@ -69,22 +69,27 @@ pub fn sin_cos_small_f64(x: f64) -> (f64, f64) {
     sin_cos_0_8_f64(x)
 }
 
-/// `(sin x, cos x)` in f64 for 0 ≤ x ≤ 8 only (the caller guarantees the range; outside it,
-/// and for NaN, the result is finite garbage, never UB). Pure arithmetic and selects, always
-/// inlined, so a loop over lanes of Arvo's sampler (x = ξ₁Ω ∈ [0, 2π]) vectorises.
+/// `(sin x, cos x)` in f64 for 0 ≤ x ≤ 8 only (the caller guarantees the range; outside it
+/// the result is inaccurate, never UB). Pure arithmetic and selects, always inlined, so a loop
+/// over lanes of Arvo's sampler (x = ξ₁Ω ∈ [0, 2π]) vectorises.
 ///
-/// Cody–Waite reduction by π/2 in two parts (the high part has 8 trailing zero bits, so
-/// q·hi is exact for the q ≤ 5 that occur), then Taylor series on |r| ≤ π/4 up to r¹⁵ / r¹⁶,
-/// whose truncation error (< 5e-17) is below f64 rounding. Max abs. error vs libm is tested.
+/// Cody–Waite reduction by π/2 to the nearest quadrant q, in two parts (the high part has 8
+/// trailing zero bits, so q·hi is exact for the q ≤ 5 that occur), then Taylor series on
+/// |r| ≤ π/4 up to r¹⁵ / r¹⁶, whose truncation error (< 5e-17) is below f64 rounding. Error
+/// vs libm is tested (≤ 2 ulp).
 #[inline(always)]
 pub fn sin_cos_0_8_f64(x: f64) -> (f64, f64) {
     const PIO2_HI: f64 = f64::from_bits(std::f64::consts::FRAC_PI_2.to_bits() & !0xff);
     // The zeroed bits, plus π/2 − FRAC_PI_2 (the part of π/2 that f64 cannot hold).
     const PIO2_LO: f64 = (std::f64::consts::FRAC_PI_2 - PIO2_HI) + 6.123_233_995_736_766e-17;
-    // i32, not i64: f64 → i32 converts packed on every x86-64 level (cvttpd2dq), f64 → i64
-    // only with AVX-512DQ. x·2/π + ½ ≥ 0, so truncation is the nearest quadrant.
-    let q = (x * std::f64::consts::FRAC_2_PI + 0.5) as i32;
-    let qf = q as f64;
+    // The nearest quadrant q by the 1.5·2⁵² trick: adding it rounds x·2/π to an integer
+    // (ulp 1 there) whose low bits are q's, and subtracting it again gives q exactly. No
+    // float → int conversion: Rust's saturating `as` does not vectorise (one scalar
+    // conversion per lane), this is one add, one sub and integer ops on the bits.
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    let shifted = x * std::f64::consts::FRAC_2_PI + SHIFT;
+    let q = shifted.to_bits();
+    let qf = shifted - SHIFT;
     let r = (x - qf * PIO2_HI) - qf * PIO2_LO;
     let r2 = r * r;
     // 1/n! for the Taylor terms (exact to f64 rounding as constant expressions).
@@ -113,8 +118,8 @@ pub fn sin_cos_0_8_f64(x: f64) -> (f64, f64) {
     } else {
         (cos_r, sin_r)
     };
-    let sin_sign = ((q & 2) as u64) << 62;
-    let cos_sign = (((q + 1) & 2) as u64) << 62;
+    let sin_sign = (q & 2) << 62;
+    let cos_sign = (q.wrapping_add(1) & 2) << 62;
     (
         f64::from_bits(a.to_bits() ^ sin_sign),
         f64::from_bits(b.to_bits() ^ cos_sign),
