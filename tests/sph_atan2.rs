@@ -6,7 +6,11 @@ use penumbra::sampling::warps::{atan2_f64, sin_cos_0_8_f64};
 /// NaN and the other not); 0 for two NaNs.
 fn ulps(a: f64, b: f64) -> u64 {
     if a.is_nan() || b.is_nan() {
-        return if a.is_nan() && b.is_nan() { 0 } else { u64::MAX };
+        return if a.is_nan() && b.is_nan() {
+            0
+        } else {
+            u64::MAX
+        };
     }
     if a == b {
         return 0;

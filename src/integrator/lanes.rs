@@ -308,9 +308,7 @@ impl TriangleLightLanes {
             (Some(MisHeuristic::Power), SolidAngle) => {
                 self.body(rx, Some(MisHeuristic::Power), SolidAngle)
             }
-            (Some(MisHeuristic::Balance), Area) => {
-                self.body(rx, Some(MisHeuristic::Balance), Area)
-            }
+            (Some(MisHeuristic::Balance), Area) => self.body(rx, Some(MisHeuristic::Balance), Area),
             (Some(MisHeuristic::Balance), SolidAngle) => {
                 self.body(rx, Some(MisHeuristic::Balance), SolidAngle)
             }
