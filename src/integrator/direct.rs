@@ -337,7 +337,7 @@ impl<'a> DirectLighting<'a> {
         let isa = scene.geometry.isa();
         // The hits' shading geometry for all lanes at once, then each lane's emission and
         // BSDF; Lambertian receivers go to the lane kernels (their light samples when triangle
-        // lights are sampled by area, and their BSDF rays).
+        // lights, and their BSDF rays).
         for (k, (hit, ray)) in hits.iter().zip(&cam.ray).enumerate().take(n) {
             if let Some(hit) = hit {
                 rx.stage(k, hit, ray.d);
@@ -359,7 +359,7 @@ impl<'a> DirectLighting<'a> {
             .enumerate()
             .take(n)
             .fold(0u32, |s, (k, l)| s | (l.is_some() as u32) << k);
-        let area = self.mode() == SamplingMode::Area;
+        let mode = self.mode();
         let uniform = if use_light {
             self.selector.uniform_count()
         } else {
@@ -393,7 +393,7 @@ impl<'a> DirectLighting<'a> {
                     };
                     if let Some(sel) = sel {
                         match &scene.lights[sel.index as usize] {
-                            Light::Triangle(tri) if diffuse && area => {
+                            Light::Triangle(tri) if diffuse => {
                                 tri_lanes.load(k, tri, sel.pmf, d.light)
                             }
                             _ => {
@@ -416,7 +416,7 @@ impl<'a> DirectLighting<'a> {
             // (for BSDF samples whatever comes of it: an emitter query, maybe a visibility
             // test).
             if tri_lanes.active != 0 {
-                rays += u64::from(tri_lanes.run(rx, mis.then_some(self.mis), isa, light));
+                rays += u64::from(tri_lanes.run(rx, mis.then_some(self.mis), mode, isa, light));
             }
             if bsdf_lanes.active != 0 {
                 rays += u64::from(bsdf_lanes.run(rx, isa, sampled));

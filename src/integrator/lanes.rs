@@ -1,5 +1,6 @@
 //! Structure-of-arrays kernels for the packet estimator's commonest case: a Lambertian
-//! receiver lit by an area-sampled triangle light, and its cosine-sampled BSDF rays.
+//! receiver lit by a triangle light (sampled by area or by solid angle), and its
+//! cosine-sampled BSDF rays.
 //!
 //! Lane by lane these run the very functions the per-lane path runs (the triangle's
 //! `sample_li`, [`light_estimate`], the Lambertian `sample`, [`bsdf_ray_of`]), so each lane's
@@ -206,8 +207,8 @@ impl Receivers {
     }
 }
 
-/// Light samples of triangle lights drawn by area for diffuse receivers: bit k of `active`
-/// marks lane k as loaded.
+/// Light samples of triangle lights for diffuse receivers: bit k of `active` marks lane k as
+/// loaded.
 pub(super) struct TriangleLightLanes {
     /// Loaded lanes.
     pub(super) active: u32,
@@ -253,30 +254,29 @@ impl TriangleLightLanes {
         self.two_sided[k] = tri.two_sided;
     }
 
-    /// Every lane's estimate (loaded or not), MIS-weighted by `mis` when given, on
-    /// instruction set `isa`, written to all the lanes of `out` (so before any lane's own);
-    /// the loaded lanes with an estimate become active there. Returns their number.
+    /// Every lane's estimate (loaded or not) sampled in `mode`, MIS-weighted by `mis` when
+    /// given, on instruction set `isa`, written to all the lanes of `out` (so before any lane's
+    /// own); the loaded lanes with an estimate become active there. Returns their number.
     pub(super) fn run(
         &mut self,
         rx: &Receivers,
         mis: Option<MisHeuristic>,
+        mode: SamplingMode,
         isa: Isa,
         out: &mut Pending,
     ) -> u32 {
-        match (isa, mis) {
+        match isa {
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, m) => {
+            Isa::Avx512 => {
                 // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx, m, out) }
+                unsafe { self.run_avx512(rx, mis, mode, out) }
             }
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, m) => {
+            Isa::Avx2 => {
                 // SAFETY: as above.
-                unsafe { self.run_avx2(rx, m, out) }
+                unsafe { self.run_avx2(rx, mis, mode, out) }
             }
-            (_, None) => self.body(rx, None, out),
-            (_, Some(MisHeuristic::Power)) => self.body(rx, Some(MisHeuristic::Power), out),
-            (_, Some(MisHeuristic::Balance)) => self.body(rx, Some(MisHeuristic::Balance), out),
+            _ => self.dispatch(rx, mis, mode, out),
         }
         let ok = mask_of(&self.ok) & self.active;
         out.active |= ok;
@@ -285,27 +285,66 @@ impl TriangleLightLanes {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn run_avx512(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, out: &mut Pending) {
-        match mis {
-            None => self.body(rx, None, out),
-            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power), out),
-            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance), out),
-        }
+    unsafe fn run_avx512(
+        &mut self,
+        rx: &Receivers,
+        mis: Option<MisHeuristic>,
+        mode: SamplingMode,
+        out: &mut Pending,
+    ) {
+        self.dispatch(rx, mis, mode, out)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, out: &mut Pending) {
-        match mis {
-            None => self.body(rx, None, out),
-            Some(MisHeuristic::Power) => self.body(rx, Some(MisHeuristic::Power), out),
-            Some(MisHeuristic::Balance) => self.body(rx, Some(MisHeuristic::Balance), out),
+    unsafe fn run_avx2(
+        &mut self,
+        rx: &Receivers,
+        mis: Option<MisHeuristic>,
+        mode: SamplingMode,
+        out: &mut Pending,
+    ) {
+        self.dispatch(rx, mis, mode, out)
+    }
+
+    /// One copy of the lane loop per (`mis`, `mode`), each with both constant, so each loop
+    /// body is straight-line code for its own case.
+    #[inline(always)]
+    fn dispatch(
+        &mut self,
+        rx: &Receivers,
+        mis: Option<MisHeuristic>,
+        mode: SamplingMode,
+        out: &mut Pending,
+    ) {
+        use SamplingMode::{Area, SolidAngle};
+        match (mis, mode) {
+            (None, Area) => self.body(rx, None, Area, out),
+            (None, SolidAngle) => self.body(rx, None, SolidAngle, out),
+            (Some(MisHeuristic::Power), Area) => {
+                self.body(rx, Some(MisHeuristic::Power), Area, out)
+            }
+            (Some(MisHeuristic::Power), SolidAngle) => {
+                self.body(rx, Some(MisHeuristic::Power), SolidAngle, out)
+            }
+            (Some(MisHeuristic::Balance), Area) => {
+                self.body(rx, Some(MisHeuristic::Balance), Area, out)
+            }
+            (Some(MisHeuristic::Balance), SolidAngle) => {
+                self.body(rx, Some(MisHeuristic::Balance), SolidAngle, out)
+            }
         }
     }
 
-    /// The lane loop; inlined into each caller with `mis` a constant.
+    /// The lane loop; inlined into each caller with `mis` and `mode` constants.
     #[inline(always)]
-    fn body(&mut self, rx: &Receivers, mis: Option<MisHeuristic>, out: &mut Pending) {
+    fn body(
+        &mut self,
+        rx: &Receivers,
+        mis: Option<MisHeuristic>,
+        mode: SamplingMode,
+        out: &mut Pending,
+    ) {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let tri = TriangleLight {
@@ -316,9 +355,9 @@ impl TriangleLightLanes {
                 two_sided: self.two_sided[k],
             };
             let u = Vec2::new(self.u[0][k], self.u[1][k]);
-            // `match`, not `Option::and_then`: a closure may be left out of line, and one call
-            // in the loop keeps it from vectorising.
-            let est = match tri.sample_li(&ctx, u, SamplingMode::Area) {
+            // A match, not `and_then`: the closure is not always inlined, and one call in
+            // the loop keeps it from vectorising.
+            let est = match tri.sample_li(&ctx, u, mode) {
                 Some(ls) => light_estimate(
                     &ls,
                     self.pmf[k],
@@ -408,6 +447,7 @@ impl DiffuseBsdfLanes {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let u = Vec2::new(self.u[0][k], self.u[1][k]);
+            // A match, not `and_then`, as in the light kernel: the closure may be outlined.
             let b = match lambert.sample(wo_local, 0.0, u) {
                 Some(bs) => bsdf_ray_of(&bs, &frame, ctx.n, &hit),
                 None => None,

@@ -32,15 +32,28 @@ pub struct SphericalTriangle {
 
 /// Solid angle of the spherical triangle of unit vectors (Van Oosterom & Strackee 1983);
 /// accurate for tiny triangles, unlike the angle excess α + β + γ − π.
+/// The atan2 is [`super::warps::atan2_f64`] (arithmetic and selects), so this inlines and
+/// vectorises in lane loops.
+#[inline(always)]
 fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let num = a.dot(b.cross(c)).abs();
     let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
-    2.0 * num.atan2(den)
+    2.0 * super::warps::atan2_f64(num, den)
 }
 
-/// Unit tangent at `a` of the great-circle arc towards `b` (`None` if b = ±a).
-fn tangent(a: DVec3, b: DVec3) -> Option<DVec3> {
-    (b - a * a.dot(b)).try_normalize()
+/// `v` normalised, and whether that is possible: `DVec3::try_normalize`'s arithmetic (the same
+/// bits) with a flag instead of an `Option`, so callers combine flags by select rather than
+/// branch on each (which would keep lane loops from vectorising).
+#[inline(always)]
+fn unit(v: DVec3) -> (DVec3, bool) {
+    let rcp = v.length_recip();
+    (v * rcp, rcp.is_finite() && rcp > 0.0)
+}
+
+/// Unit tangent at `a` of the great-circle arc towards `b`; the flag is false if b = ±a.
+#[inline(always)]
+fn tangent(a: DVec3, b: DVec3) -> (DVec3, bool) {
+    unit(b - a * a.dot(b))
 }
 
 /// The first, cheap half of [`SphericalTriangle::new`]: the vertex directions and the solid
@@ -57,22 +70,25 @@ pub struct SphericalProjection {
 
 impl SphericalProjection {
     /// Unit directions from `p` to (v0, v1, v2); `None` if a vertex coincides with `p`.
-    #[inline]
+    /// Everything is computed and the flags combined at the end (no early return), so lane
+    /// loops over it if-convert and vectorise.
+    #[inline(always)]
     pub fn new(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<Self> {
         let p = p.as_dvec3();
-        let da = (v0.as_dvec3() - p).try_normalize()?;
-        let db = (v1.as_dvec3() - p).try_normalize()?;
-        let dc = (v2.as_dvec3() - p).try_normalize()?;
-        Some(Self {
+        let (da, ok_a) = unit(v0.as_dvec3() - p);
+        let (db, ok_b) = unit(v1.as_dvec3() - p);
+        let (dc, ok_c) = unit(v2.as_dvec3() - p);
+        let proj = Self {
             da,
             db,
             dc,
             area64: solid_angle(da, db, dc),
-        })
+        };
+        (ok_a & ok_b & ok_c).then_some(proj)
     }
 
     /// Solid angle (sr), f64.
-    #[inline]
+    #[inline(always)]
     pub fn solid_angle(&self) -> f64 {
         self.area64
     }
@@ -81,25 +97,24 @@ impl SphericalProjection {
     #[inline(always)]
     fn arvo(&self) -> Option<Arvo> {
         let Self { da, db, dc, area64 } = *self;
-        if !(area64 >= SphericalTriangle::MIN_SOLID_ANGLE && area64.is_finite()) {
-            return None;
-        }
-        let (t_ab, t_ac) = (tangent(da, db)?, tangent(da, dc)?);
+        let big = area64 >= SphericalTriangle::MIN_SOLID_ANGLE && area64.is_finite();
+        let ((t_ab, ok_ab), (t_ac, ok_ac)) = (tangent(da, db), tangent(da, dc));
         // α = angle between the two unit tangents: its cosine and sine directly.
         let (cos_alpha, sin_alpha) = (t_ab.dot(t_ac), t_ab.cross(t_ac).length());
-        Some(Arvo {
+        let arvo = Arvo {
             a: da,
             b: db,
             area64,
             cos_alpha,
             sin_alpha,
             c_perp: t_ac,
-        })
+        };
+        (big & ok_ab & ok_ac).then_some(arvo)
     }
 
     /// One direction drawn as [`SphericalTriangle::sample`] draws it, without building the
     /// whole sampler (the hot path of triangle lights: one sample per projection).
-    #[inline]
+    #[inline(always)]
     pub fn sample(&self, u: Vec2) -> Option<Vec3> {
         Some(self.arvo()?.sample(u))
     }
@@ -142,35 +157,32 @@ struct Arvo {
 }
 
 impl Arvo {
-    /// Unit direction uniformly distributed in the spherical triangle.
-    #[inline]
+    /// Unit direction uniformly distributed in the spherical triangle. Branch-free (selects
+    /// only) and always inlined, so a loop over lanes vectorises.
+    #[inline(always)]
     fn sample(&self, u: Vec2) -> Vec3 {
         let (a, b) = (self.a, self.b);
         let sub_area = u.x as f64 * self.area64;
         let (sin_alpha, cos_alpha) = (self.sin_alpha, self.cos_alpha);
-        // (s, t) = (sin, cos) of (ξ₁Ω − α).
-        let (sin_sub, cos_sub) = super::warps::sin_cos_small_f64(sub_area);
+        // (s, t) = (sin, cos) of (ξ₁Ω − α); ξ₁Ω ∈ [0, 4π] ⊂ [0, 8] since `arvo` checked Ω.
+        let (sin_sub, cos_sub) = super::warps::sin_cos_0_8_f64(sub_area);
         let s = sin_sub * cos_alpha - cos_sub * sin_alpha;
         let t = cos_sub * cos_alpha + sin_sub * sin_alpha;
         let uu = t - cos_alpha;
         let v = s + sin_alpha * a.dot(b);
         // q = cos of the arc from A to Ĉ, the far vertex of the sub-triangle of area ξ₁·Ω.
         let den = (v * s + uu * t) * sin_alpha;
-        let q = if den != 0.0 {
-            (((v * t - uu * s) * cos_alpha - v) / den).clamp(-1.0, 1.0)
-        } else {
-            1.0
-        };
+        let q = (((v * t - uu * s) * cos_alpha - v) / den).clamp(-1.0, 1.0);
+        let q = if den != 0.0 { q } else { 1.0 };
         let c_perp = self.c_perp;
         // A unit vector already (a ⟂ c_perp, both unit): no renormalisation on this f64
         // sqrt/div latency chain, whose rounding would vanish in the f32 result anyway.
         let c_hat = a * q + c_perp * (1.0 - q * q).max(0.0).sqrt();
         // cos of the arc from B is uniform between Ĉ·B and 1.
         let z = 1.0 - u.y as f64 * (1.0 - c_hat.dot(b));
-        let dir = match tangent(b, c_hat) {
-            Some(t) => b * z + t * (1.0 - z * z).max(0.0).sqrt(),
-            None => b,
-        };
+        let (t, ok) = tangent(b, c_hat);
+        let dir = b * z + t * (1.0 - z * z).max(0.0).sqrt();
+        let dir = if ok { dir } else { b };
         // Unit up to f64 rounding (b ⟂ t, z² + (1 − z²) = 1), far below the f32 result's ulp.
         dir.as_vec3()
     }
