@@ -54,7 +54,7 @@ fn check(scene: &Scene, strategy: Strategy, selection: &str, spp: u32, m: u32) -
                 let rays = est.li_packet(&pxs, &cam, &mut out, &mut scratch);
                 let mut rays_single = 0;
                 for k in 0..cam.n {
-                    let (l, r) = est.li(&pxs[cam.pixel[k] as usize], cam.eye[k], &cam.ray[k]);
+                    let (l, r) = est.li(&pxs[cam.pixel[k] as usize], cam.eye[k], &cam.rays.ray(k));
                     rays_single += r;
                     assert_eq!(
                         l.to_array().map(f32::to_bits),

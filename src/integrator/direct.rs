@@ -11,7 +11,7 @@ use super::{MisHeuristic, Strategy};
 use crate::Rgb;
 use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
-use crate::geometry::{PACKET, Ray, SurfaceHit};
+use crate::geometry::{PACKET, Ray, RayPacket, SurfaceHit};
 use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
 use crate::lights::{Emitter, Light, LightLiSample, LightSampleContext, LightSource, SamplingMode};
 use crate::sampling::{Frame, PixelSamples, SamplePattern};
@@ -89,7 +89,8 @@ impl Draws {
 }
 
 /// A packet of camera samples for [`DirectLighting::li_packet`]: lane k < `n` is eye sample
-/// `eye[k]` of pixel `pixel[k]` (an index into the caller's [`PixelSamples`]) along `ray[k]`.
+/// `eye[k]` of pixel `pixel[k]` (an index into the caller's [`PixelSamples`]) along ray k of
+/// `rays`.
 #[derive(Clone, Copy, Debug)]
 pub struct CameraPacket {
     /// Lanes in use.
@@ -98,8 +99,9 @@ pub struct CameraPacket {
     pub pixel: [u8; PACKET],
     /// Per lane: eye sample index within the pixel.
     pub eye: [u32; PACKET],
-    /// Per lane: the camera ray.
-    pub ray: [Ray; PACKET],
+    /// The camera rays, in lanes (as the vector code that makes them and the packet query
+    /// that traces them both want).
+    pub rays: RayPacket,
 }
 
 impl Default for CameraPacket {
@@ -115,7 +117,7 @@ impl CameraPacket {
             n: 0,
             pixel: [0; PACKET],
             eye: [0; PACKET],
-            ray: [Ray::new(Vec3::ZERO, Vec3::Z); PACKET],
+            rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
         }
     }
 
@@ -134,7 +136,7 @@ impl CameraPacket {
         if self.n < PACKET {
             self.pixel[self.n] = pixel;
             self.eye[self.n] = eye;
-            self.ray[self.n] = ray;
+            self.rays.set(self.n, &ray);
             self.n += 1;
         }
     }
@@ -332,15 +334,15 @@ impl<'a> DirectLighting<'a> {
         }
         scene
             .geometry
-            .intersect_packet(&cam.ray, cam.active(), hits);
+            .intersect_packet_soa(&cam.rays, cam.active(), hits);
         let mut rays = n as u64;
         let isa = scene.geometry.isa();
         // The hits' shading geometry for all lanes at once, then each lane's emission and
         // BSDF; Lambertian receivers go to the lane kernels (their light samples when triangle
         // lights, and their BSDF rays).
-        for (k, (hit, ray)) in hits.iter().zip(&cam.ray).enumerate().take(n) {
+        for (k, hit) in hits.iter().enumerate().take(n) {
             if let Some(hit) = hit {
-                rx.stage(k, hit, ray.d);
+                rx.stage(k, hit, cam.rays.ray(k).d);
             }
         }
         rx.shade(isa);
@@ -349,7 +351,7 @@ impl<'a> DirectLighting<'a> {
             out[k] = match &hits[k] {
                 None => {
                     lanes[k] = None;
-                    self.escaped(cam.ray[k].d)
+                    self.escaped(cam.rays.ray(k).d)
                 }
                 Some(hit) => self.shade(k, hit, rx, &mut lanes[k]),
             };

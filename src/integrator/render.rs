@@ -7,8 +7,7 @@ use super::direct::{CameraPacket, DIM_FILTER, DirectLighting, PacketScratch};
 use super::film::filter_sample;
 use crate::Rgb;
 use crate::camera::CameraRays;
-use crate::geometry::PACKET;
-use crate::geometry::Ray;
+use crate::geometry::{PACKET, Ray, RayPacket};
 use crate::image::Image;
 use crate::isa::Isa;
 use crate::light_selection::make_selector;
@@ -143,14 +142,14 @@ pub fn render(
                             cam.eye[k] = i;
                             cam.n = k + 1;
                             if cam.is_full() {
-                                lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
+                                lanes.rays(isa, &camera, &scene.film.filter, &mut cam.rays);
                                 flush(&mut cam, pxs, &owner);
                             }
                         }
                     }
                 }
                 if cam.n > 0 {
-                    lanes.rays(isa, &camera, &scene.film.filter, &mut cam.ray);
+                    lanes.rays(isa, &camera, &scene.film.filter, &mut cam.rays);
                     flush(&mut cam, pxs, &owner);
                 }
                 let out: Vec<Rgb> = sums.iter().map(|&s| s / opts.spp as f32).collect();
@@ -207,7 +206,7 @@ impl Lanes {
     /// stale samples, which nothing reads): [`filter_sample`] then [`CameraRays::direction`],
     /// per lane exactly as the scalar [`CameraRays::generate`], on `isa`'s widest vectors.
     #[inline]
-    fn rays(&self, isa: Isa, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+    fn rays(&self, isa: Isa, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `isa` comes from `Isa::detect`: this CPU runs AVX-512 F.
@@ -221,28 +220,25 @@ impl Lanes {
 
     /// [`Lanes::rays`] as plain loops over the lanes, which the compiler vectorises.
     #[inline(always)]
-    fn rays_portable(&self, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
-        let mut d = [Vec3::ZERO; PACKET];
-        for ((d, &pixel), &u) in d.iter_mut().zip(&self.pixel).zip(&self.u) {
-            *d = camera.direction(filter_sample(filter, pixel, u));
-        }
-        let o = camera.origin();
-        for (r, &d) in ray.iter_mut().zip(&d) {
-            *r = Ray::new(o, d);
+    fn rays_portable(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
+        let o = Ray::new(camera.origin(), Vec3::Z);
+        for k in 0..PACKET {
+            let d = camera.direction(filter_sample(filter, self.pixel[k], self.u[k]));
+            ray.set(k, &Ray { d, ..o });
         }
     }
 
     /// [`Lanes::rays_portable`] compiled for AVX-512 (16 lanes = one vector).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
-    fn rays_avx512(&self, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+    fn rays_avx512(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
         self.rays_portable(camera, filter, ray)
     }
 
     /// [`Lanes::rays_portable`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn rays_avx2(&self, camera: &CameraRays, filter: &Filter, ray: &mut [Ray; PACKET]) {
+    fn rays_avx2(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
         self.rays_portable(camera, filter, ray)
     }
 }
@@ -277,13 +273,13 @@ mod tests {
                         lanes.pixel[k] = UVec2::new(n % 97, (n / 3) % 61);
                         lanes.u[k] = pattern.sample_2d(lanes.pixel[k], 0, n, 1 << 20);
                     }
-                    let mut out = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
+                    let mut out = RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]);
                     lanes.rays(isa, &rays, &filter, &mut out);
-                    for (k, r) in out.iter().enumerate() {
+                    for (k, r) in (0..PACKET).map(|k| (k, out.ray(k))) {
                         let want =
                             rays.generate(filter_sample(&filter, lanes.pixel[k], lanes.u[k]));
                         let bits = |r: &Ray| [r.o, r.d].map(|v| v.to_array().map(f32::to_bits));
-                        assert_eq!(bits(r), bits(&want), "{isa:?} {filter:?} lane {k}");
+                        assert_eq!(bits(&r), bits(&want), "{isa:?} {filter:?} lane {k}");
                         assert_eq!(r.t_max, want.t_max);
                     }
                 }
