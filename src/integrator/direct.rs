@@ -332,15 +332,15 @@ impl<'a> DirectLighting<'a> {
         }
         scene
             .geometry
-            .intersect_packet(&cam.ray, cam.active(), hits);
+            .intersect_packet_cols(&cam.ray, cam.active(), hits, &mut rx.cols);
         let mut rays = n as u64;
         let isa = scene.geometry.isa();
         // The hits' shading geometry for all lanes at once, then each lane's emission and
         // BSDF; Lambertian receivers go to the lane kernels (their light samples when triangle
         // lights, and their BSDF rays).
         for (k, (hit, ray)) in hits.iter().zip(&cam.ray).enumerate().take(n) {
-            if let Some(hit) = hit {
-                rx.stage(k, hit, ray.d);
+            if hit.is_some() {
+                rx.stage(k, ray.d);
             }
         }
         rx.shade(isa);

@@ -13,7 +13,7 @@ use super::MisHeuristic;
 use super::direct::{BsdfRay, bsdf_ray_of, light_estimate};
 use crate::Rgb;
 use crate::bsdf::{Bxdf, Lambert, LobeSampling};
-use crate::geometry::{Geometry, PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
+use crate::geometry::{Geometry, HitColumns, PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
 use crate::isa::Isa;
 use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
 use crate::sampling::Frame;
@@ -50,6 +50,12 @@ impl V3 {
     }
 }
 
+/// Lane k of a column triple.
+#[inline(always)]
+fn col(c: &[Lanes; 3], k: usize) -> Vec3 {
+    Vec3::new(c[0][k], c[1][k], c[2][k])
+}
+
 /// The receivers of a packet: each hit's shading geometry (computed for all lanes at once by
 /// [`Self::shade`]) and, for the Lambertian ones, what the kernels read. Bit k of `diffuse`
 /// marks lane k as a Lambertian receiver.
@@ -57,11 +63,9 @@ impl V3 {
 pub(super) struct Receivers {
     /// Lanes whose receiver is Lambertian with cosine sampling.
     pub(super) diffuse: u32,
-    p: V3,
-    ng: V3,
-    p_error: Lanes,
-    /// Shading normal and ray direction (inputs of [`Self::shade`]).
-    ns: V3,
+    /// The hits' points, normals and error bounds, written by the camera-ray query itself.
+    pub(super) cols: HitColumns,
+    /// Ray direction (with `cols`' normals the input of [`Self::shade`]).
     d: V3,
     wo: V3,
     front: [bool; PACKET],
@@ -79,10 +83,7 @@ impl Receivers {
     pub(super) fn new() -> Self {
         Self {
             diffuse: 0,
-            p: V3::ZERO,
-            ng: V3::ZERO,
-            p_error: [0.0; PACKET],
-            ns: V3::ZERO,
+            cols: HitColumns::new(),
             d: V3::ZERO,
             wo: V3::ZERO,
             front: [false; PACKET],
@@ -95,13 +96,9 @@ impl Receivers {
         }
     }
 
-    /// Stage lane k: `hit` seen along ray direction `d`.
+    /// Stage lane k: its hit (already in `cols`) seen along ray direction `d`.
     #[inline]
-    pub(super) fn stage(&mut self, k: usize, hit: &SurfaceHit, d: Vec3) {
-        self.p.set(k, hit.p);
-        self.ng.set(k, hit.ng);
-        self.p_error[k] = hit.p_error;
-        self.ns.set(k, hit.ns);
+    pub(super) fn stage(&mut self, k: usize, d: Vec3) {
         self.d.set(k, d);
     }
 
@@ -137,7 +134,8 @@ impl Receivers {
     #[inline(always)]
     fn shade_body(&mut self) {
         for k in 0..PACKET {
-            let g = ShadingGeometry::new(self.d.get(k), self.ng.get(k), self.ns.get(k));
+            let g =
+                ShadingGeometry::new(self.d.get(k), col(&self.cols.ng, k), col(&self.cols.ns, k));
             self.wo.set(k, g.wo);
             self.front[k] = g.front;
             self.n.set(k, g.n);
@@ -180,11 +178,11 @@ impl Receivers {
     fn lane(&self, k: usize) -> (SurfaceHit, LightSampleContext, Frame, Vec3, Lambert) {
         let hit = SurfaceHit {
             t: 0.0,
-            p: self.p.get(k),
-            ng: self.ng.get(k),
+            p: col(&self.cols.p, k),
+            ng: col(&self.cols.ng, k),
             ns: Vec3::ZERO,
             uv: Vec2::ZERO,
-            p_error: self.p_error[k],
+            p_error: self.cols.p_error[k],
             prim: 0,
             material: 0,
             light: 0,
