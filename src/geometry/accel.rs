@@ -4,7 +4,7 @@
 
 use super::bvh::Bvh;
 use super::float::gamma;
-use super::packet::{PACKET, PacketHits, PacketRays, bits};
+use super::packet::{ColumnSink, PACKET, PacketHits, PacketRays, bits};
 use super::quadric::Quadric;
 #[cfg(target_arch = "x86_64")]
 use super::simd16::{Avx2, Avx512};
@@ -345,61 +345,65 @@ impl Geometry {
 impl Geometry {
     /// The hit records of the rays `lanes` of a packet query (`hits` finished), into `out`,
     /// on backend `isa` (one this CPU runs): `out[i] = Some(self.surface_hit(..))` for each,
-    /// bit for bit.
-    pub(super) fn hit_records<R: PacketRays + ?Sized>(
+    /// bit for bit, and its point, normals and error bound to lane i of `cols`.
+    pub(super) fn hit_records<R: PacketRays + ?Sized, C: ColumnSink>(
         &self,
         isa: Isa,
         rays: &R,
         hits: &PacketHits,
         lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut C,
     ) {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
-            Isa::Avx512 => unsafe { self.hit_records_avx512(rays, hits, lanes, out) },
+            Isa::Avx512 => unsafe { self.hit_records_avx512(rays, hits, lanes, out, cols) },
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above: the CPU runs AVX2.
-            Isa::Avx2 => unsafe { self.hit_records_avx2(rays, hits, lanes, out) },
-            _ => self.hit_records_impl::<Portable, R>(rays, hits, lanes, out),
+            Isa::Avx2 => unsafe { self.hit_records_avx2(rays, hits, lanes, out, cols) },
+            _ => self.hit_records_impl::<Portable, R, C>(rays, hits, lanes, out, cols),
         }
     }
 
     /// [`Self::hit_records_impl`] on AVX-512.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    fn hit_records_avx512<R: PacketRays + ?Sized>(
+    fn hit_records_avx512<R: PacketRays + ?Sized, C: ColumnSink>(
         &self,
         rays: &R,
         hits: &PacketHits,
         lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut C,
     ) {
-        self.hit_records_impl::<Avx512, R>(rays, hits, lanes, out)
+        self.hit_records_impl::<Avx512, R, C>(rays, hits, lanes, out, cols)
     }
 
     /// [`Self::hit_records_impl`] on AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn hit_records_avx2<R: PacketRays + ?Sized>(
+    fn hit_records_avx2<R: PacketRays + ?Sized, C: ColumnSink>(
         &self,
         rays: &R,
         hits: &PacketHits,
         lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut C,
     ) {
-        self.hit_records_impl::<Avx2, R>(rays, hits, lanes, out)
+        self.hit_records_impl::<Avx2, R, C>(rays, hits, lanes, out, cols)
     }
 
     /// Rays that hit the same triangle (most of a coherent packet) get their records on the
     /// vector lanes at once; single rays and quadric hits go through [`Self::surface_hit`].
     #[inline(always)]
-    fn hit_records_impl<S: Simd, R: PacketRays + ?Sized>(
+    fn hit_records_impl<S: Simd, R: PacketRays + ?Sized, C: ColumnSink>(
         &self,
         rays: &R,
         hits: &PacketHits,
         mut lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut C,
     ) {
         let ids = S::load(&hits.id);
         while lanes != 0 {
@@ -411,12 +415,14 @@ impl Geometry {
             let p = unsafe { self.prims.get_unchecked(id) };
             match p.kind {
                 PrimKind::Triangle { mesh, v } if group & (group - 1) != 0 => {
-                    self.triangle_records::<S>(id, p, mesh, v, hits, group, out);
+                    self.triangle_records::<S, C>(id, p, mesh, v, hits, group, out, cols);
                 }
                 _ => {
                     for i in bits(group) {
                         let (id, t, b) = hits.hit(i);
-                        out[i] = Some(self.surface_hit(id, &rays.ray(i), t, b));
+                        let h = self.surface_hit(id, &rays.ray(i), t, b);
+                        cols.set_lane(i, &h);
+                        out[i] = Some(h);
                     }
                 }
             }
@@ -429,7 +435,7 @@ impl Geometry {
     /// are the same bits.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn triangle_records<S: Simd>(
+    fn triangle_records<S: Simd, C: ColumnSink>(
         &self,
         id: usize,
         p: &Primitive,
@@ -438,6 +444,7 @@ impl Geometry {
         hits: &PacketHits,
         group: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut C,
     ) {
         let sp = S::splat;
         let zero = sp(0.0);
@@ -521,6 +528,7 @@ impl Geometry {
             None => [b[1] + b[2], b[2]],
         };
         let p_error = err[0] * S::abs(ng[0]) + err[1] * S::abs(ng[1]) + err[2] * S::abs(ng[2]);
+        cols.set_group::<S>(group, &pos, &ng, &ns, p_error);
         // The fields in `SurfaceHit`'s order, transposed to one row per ray.
         let rows = S::transpose([
             S::load(&hits.t),

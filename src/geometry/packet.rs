@@ -84,6 +84,98 @@ impl RayPacket {
     }
 }
 
+/// The camera-hit fields the integrator's lane kernels read, in structure-of-arrays form
+/// (lane i = ray i), filled by the `*_cols` packet queries next to the hit records: for every
+/// lane with a hit they are that record's fields bit for bit (other lanes: unspecified).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct HitColumns {
+    /// Hit points: `p[axis][lane]`.
+    pub p: [[f32; PACKET]; 3],
+    /// Geometric normals: `ng[axis][lane]`.
+    pub ng: [[f32; PACKET]; 3],
+    /// Shading normals: `ns[axis][lane]`.
+    pub ns: [[f32; PACKET]; 3],
+    /// Error bounds of the hit points.
+    pub p_error: [f32; PACKET],
+}
+
+impl HitColumns {
+    /// All zero (the lanes of a query's misses stay as they are).
+    pub const fn new() -> Self {
+        HitColumns {
+            p: [[0.0; PACKET]; 3],
+            ng: [[0.0; PACKET]; 3],
+            ns: [[0.0; PACKET]; 3],
+            p_error: [0.0; PACKET],
+        }
+    }
+}
+
+impl Default for HitColumns {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Where the packet queries put the columns of their hits: nowhere (`()`, the plain queries,
+/// whose code then has no trace of it) or a [`HitColumns`].
+pub(super) trait ColumnSink {
+    /// Lanes `group` (of the vectors `p`, `ng`, `ns`, `p_error`) are hits.
+    fn set_group<S: Simd>(
+        &mut self,
+        group: u32,
+        p: &[S::F; 3],
+        ng: &[S::F; 3],
+        ns: &[S::F; 3],
+        p_error: S::F,
+    );
+    /// Lane `i` is the hit `h`.
+    fn set_lane(&mut self, i: usize, h: &SurfaceHit);
+}
+
+impl ColumnSink for () {
+    #[inline(always)]
+    fn set_group<S: Simd>(&mut self, _: u32, _: &[S::F; 3], _: &[S::F; 3], _: &[S::F; 3], _: S::F) {
+    }
+    #[inline(always)]
+    fn set_lane(&mut self, _: usize, _: &SurfaceHit) {}
+}
+
+impl ColumnSink for HitColumns {
+    #[inline(always)]
+    fn set_group<S: Simd>(
+        &mut self,
+        group: u32,
+        p: &[S::F; 3],
+        ng: &[S::F; 3],
+        ns: &[S::F; 3],
+        p_error: S::F,
+    ) {
+        // A blend with the old lanes: the other lanes may hold other hits already.
+        let m = S::mask(group);
+        for a in 0..3 {
+            S::store(S::select(m, p[a], S::load(&self.p[a])), &mut self.p[a]);
+            S::store(S::select(m, ng[a], S::load(&self.ng[a])), &mut self.ng[a]);
+            S::store(S::select(m, ns[a], S::load(&self.ns[a])), &mut self.ns[a]);
+        }
+        S::store(
+            S::select(m, p_error, S::load(&self.p_error)),
+            &mut self.p_error,
+        );
+    }
+    #[inline(always)]
+    fn set_lane(&mut self, i: usize, h: &SurfaceHit) {
+        let i = i & (PACKET - 1);
+        for a in 0..3 {
+            self.p[a][i] = h.p[a];
+            self.ng[a][i] = h.ng[a];
+            self.ns[a][i] = h.ns[a];
+        }
+        self.p_error[i] = h.p_error;
+    }
+}
+
 /// The two forms of a packet's rays the kernels read: `[Ray; PACKET]` and [`RayPacket`].
 pub(super) trait PacketRays {
     /// `[o.x, o.y, o.z, d.x, d.y, d.z, t_max]` as lanes (see [`Simd::rays`]).
@@ -181,7 +273,7 @@ impl Geometry {
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.intersect_packet_with(self.isa, rays, active, out);
+        self.intersect_packet_with(self.isa, rays, active, out, &mut ());
     }
 
     /// [`Self::intersect_packet`] on a chosen vector backend (for tests and benchmarks; one
@@ -193,7 +285,7 @@ impl Geometry {
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.intersect_packet_with(isa.supported(), rays, active, out);
+        self.intersect_packet_with(isa.supported(), rays, active, out, &mut ());
     }
 
     /// [`Self::intersect_packet`] for rays already in lanes: out[i] equals
@@ -204,7 +296,7 @@ impl Geometry {
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.intersect_packet_with(self.isa, rays, active, out);
+        self.intersect_packet_with(self.isa, rays, active, out, &mut ());
     }
 
     /// [`Self::intersect_packet_soa`] on a chosen vector backend (see
@@ -216,16 +308,69 @@ impl Geometry {
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.intersect_packet_with(isa.supported(), rays, active, out);
+        self.intersect_packet_with(isa.supported(), rays, active, out, &mut ());
     }
 
-    /// [`Self::intersect_packet`] on `isa`, a set this CPU runs.
-    fn intersect_packet_with<R: PacketRays + ?Sized>(
+    /// [`Self::intersect_packet`] that also writes the hits' points, normals and error bounds
+    /// to `cols` (see [`HitColumns`]): for each lane i with `out[i] = Some(h)`, the columns'
+    /// lane i holds `h.p`, `h.ng`, `h.ns`, `h.p_error` bit for bit.
+    pub fn intersect_packet_cols(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut HitColumns,
+    ) {
+        self.intersect_packet_with(self.isa, rays, active, out, cols);
+    }
+
+    /// [`Self::intersect_packet_cols`] on a chosen vector backend (see
+    /// [`Self::intersect_packet_on`]).
+    pub fn intersect_packet_cols_on(
+        &self,
+        isa: Isa,
+        rays: &[Ray; PACKET],
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut HitColumns,
+    ) {
+        self.intersect_packet_with(isa.supported(), rays, active, out, cols);
+    }
+
+    /// [`Self::intersect_packet_soa`] that also fills `cols` (as
+    /// [`Self::intersect_packet_cols`] does).
+    pub fn intersect_packet_soa_cols(
+        &self,
+        rays: &RayPacket,
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut HitColumns,
+    ) {
+        self.intersect_packet_with(self.isa, rays, active, out, cols);
+    }
+
+    /// [`Self::intersect_packet_soa_cols`] on a chosen vector backend (see
+    /// [`Self::intersect_packet_on`]).
+    pub fn intersect_packet_soa_cols_on(
+        &self,
+        isa: Isa,
+        rays: &RayPacket,
+        active: u32,
+        out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut HitColumns,
+    ) {
+        self.intersect_packet_with(isa.supported(), rays, active, out, cols);
+    }
+
+    /// [`Self::intersect_packet`] on `isa`, a set this CPU runs, with the hits' columns to
+    /// `cols`.
+    fn intersect_packet_with<R: PacketRays + ?Sized, C: ColumnSink>(
         &self,
         isa: Isa,
         rays: &R,
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
+        cols: &mut C,
     ) {
         let active = active & PACKET_MASK;
         *out = [None; PACKET];
@@ -234,6 +379,7 @@ impl Geometry {
         let Some(bvh) = self.wide() else {
             for i in bits(active) {
                 if let Some(h) = self.intersect(&rays.ray(i)) {
+                    cols.set_lane(i, &h);
                     out[i] = Some(h);
                 }
             }
@@ -245,6 +391,7 @@ impl Geometry {
             // for the rays that enter the box.
             for i in bits(bvh.root_box_packet(isa, rays, active)) {
                 if let Some(h) = self.intersect_full(&rays.ray(i)) {
+                    cols.set_lane(i, &h);
                     out[i] = Some(h);
                 }
             }
@@ -255,9 +402,12 @@ impl Geometry {
             self.quadric_t_outlined(id, ray.o, ray.d, t_max)
         });
         let ties = hits.ties;
-        self.hit_records(isa, rays, &hits, hits.found & !ties, out);
+        self.hit_records(isa, rays, &hits, hits.found & !ties, out, cols);
         for i in bits(ties) {
             out[i] = self.intersect(&rays.ray(i));
+            if let Some(h) = &out[i] {
+                cols.set_lane(i, h);
+            }
         }
     }
 

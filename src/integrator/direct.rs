@@ -334,18 +334,13 @@ impl<'a> DirectLighting<'a> {
         }
         scene
             .geometry
-            .intersect_packet_soa(&cam.rays, cam.active(), hits);
+            .intersect_packet_soa_cols(&cam.rays, cam.active(), hits, &mut rx.cols);
         let mut rays = n as u64;
         let isa = scene.geometry.isa();
         // The hits' shading geometry for all lanes at once, then each lane's emission and
         // BSDF; Lambertian receivers go to the lane kernels (their light samples when triangle
         // lights, and their BSDF rays).
-        for (k, hit) in hits.iter().enumerate().take(n) {
-            if let Some(hit) = hit {
-                rx.stage(k, hit, cam.rays.ray(k).d);
-            }
-        }
-        rx.shade(isa);
+        rx.shade(&cam.rays, isa);
         rx.diffuse = 0;
         for k in 0..n {
             out[k] = match &hits[k] {

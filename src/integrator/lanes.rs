@@ -13,7 +13,7 @@ use super::MisHeuristic;
 use super::direct::{BsdfRay, bsdf_ray_of, light_estimate};
 use crate::Rgb;
 use crate::bsdf::{Bxdf, Lambert, LobeSampling};
-use crate::geometry::{Geometry, PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
+use crate::geometry::{Geometry, HitColumns, PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
 use crate::isa::Isa;
 use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
 use crate::sampling::Frame;
@@ -50,6 +50,12 @@ impl V3 {
     }
 }
 
+/// Lane k of a column triple.
+#[inline(always)]
+fn col(c: &[Lanes; 3], k: usize) -> Vec3 {
+    Vec3::new(c[0][k], c[1][k], c[2][k])
+}
+
 /// The receivers of a packet: each hit's shading geometry (computed for all lanes at once by
 /// [`Self::shade`]) and, for the Lambertian ones, what the kernels read. Bit k of `diffuse`
 /// marks lane k as a Lambertian receiver.
@@ -57,12 +63,8 @@ impl V3 {
 pub(super) struct Receivers {
     /// Lanes whose receiver is Lambertian with cosine sampling.
     pub(super) diffuse: u32,
-    p: V3,
-    ng: V3,
-    p_error: Lanes,
-    /// Shading normal and ray direction (inputs of [`Self::shade`]).
-    ns: V3,
-    d: V3,
+    /// The hits' points, normals and error bounds, written by the camera-ray query itself.
+    pub(super) cols: HitColumns,
     wo: V3,
     front: [bool; PACKET],
     /// Geometric normal facing the viewer (the light-sample context's).
@@ -79,11 +81,7 @@ impl Receivers {
     pub(super) fn new() -> Self {
         Self {
             diffuse: 0,
-            p: V3::ZERO,
-            ng: V3::ZERO,
-            p_error: [0.0; PACKET],
-            ns: V3::ZERO,
-            d: V3::ZERO,
+            cols: HitColumns::new(),
             wo: V3::ZERO,
             front: [false; PACKET],
             n: V3::ZERO,
@@ -95,49 +93,44 @@ impl Receivers {
         }
     }
 
-    /// Stage lane k: `hit` seen along ray direction `d`.
-    #[inline]
-    pub(super) fn stage(&mut self, k: usize, hit: &SurfaceHit, d: Vec3) {
-        self.p.set(k, hit.p);
-        self.ng.set(k, hit.ng);
-        self.p_error[k] = hit.p_error;
-        self.ns.set(k, hit.ns);
-        self.d.set(k, d);
-    }
-
-    /// Every lane's [`ShadingGeometry`] (staged or not: the others' are ignored), on `isa`.
-    pub(super) fn shade(&mut self, isa: Isa) {
+    /// Every lane's [`ShadingGeometry`] seen along `rays` (lanes without a hit too: theirs
+    /// are ignored), on `isa`.
+    pub(super) fn shade(&mut self, rays: &RayPacket, isa: Isa) {
         match isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx512 => {
                 // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.shade_avx512() }
+                unsafe { self.shade_avx512(rays) }
             }
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => {
                 // SAFETY: as above.
-                unsafe { self.shade_avx2() }
+                unsafe { self.shade_avx2(rays) }
             }
-            _ => self.shade_body(),
+            _ => self.shade_body(rays),
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn shade_avx512(&mut self) {
-        self.shade_body()
+    unsafe fn shade_avx512(&mut self, rays: &RayPacket) {
+        self.shade_body(rays)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn shade_avx2(&mut self) {
-        self.shade_body()
+    unsafe fn shade_avx2(&mut self, rays: &RayPacket) {
+        self.shade_body(rays)
     }
 
     #[inline(always)]
-    fn shade_body(&mut self) {
+    fn shade_body(&mut self, rays: &RayPacket) {
         for k in 0..PACKET {
-            let g = ShadingGeometry::new(self.d.get(k), self.ng.get(k), self.ns.get(k));
+            let g = ShadingGeometry::new(
+                col(&rays.d, k),
+                col(&self.cols.ng, k),
+                col(&self.cols.ns, k),
+            );
             self.wo.set(k, g.wo);
             self.front[k] = g.front;
             self.n.set(k, g.n);
@@ -180,11 +173,11 @@ impl Receivers {
     fn lane(&self, k: usize) -> (SurfaceHit, LightSampleContext, Frame, Vec3, Lambert) {
         let hit = SurfaceHit {
             t: 0.0,
-            p: self.p.get(k),
-            ng: self.ng.get(k),
+            p: col(&self.cols.p, k),
+            ng: col(&self.cols.ng, k),
             ns: Vec3::ZERO,
             uv: Vec2::ZERO,
-            p_error: self.p_error[k],
+            p_error: self.cols.p_error[k],
             prim: 0,
             material: 0,
             light: 0,
