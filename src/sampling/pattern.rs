@@ -775,26 +775,41 @@ fn jitters_avx512(
 ) -> (std::arch::x86_64::__m512i, std::arch::x86_64::__m512i) {
     use super::hash::mix64_avx512;
     use std::arch::x86_64::*;
-    let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    // u32 indices (wrapping, as the scalar `base.wrapping_add(k)`), then zero-extended.
-    let idx = _mm512_add_epi32(_mm512_set1_epi32(base as i32), lanes);
-    let mul = _mm512_set1_epi64(HASH_INIT as i64);
-    let add = _mm512_set1_epi64(jitter_fast as i64);
-    let hash = |i: __m256i| {
-        let i = _mm512_cvtepu32_epi64(i);
-        mix64_avx512(_mm512_add_epi64(add, _mm512_mullo_epi64(i, mul)))
-    };
-    let h0 = hash(_mm512_castsi512_si256(idx));
-    let h1 = hash(_mm512_extracti64x4_epi64::<1>(idx));
-    // Low u32 of each lane (truncation, as `h as u32`), 16 lanes in one vector.
-    let join = |a: __m512i, b: __m512i| {
-        _mm512_inserti64x4::<1>(
-            _mm512_castsi256_si512(_mm512_cvtepi64_epi32(a)),
-            _mm512_cvtepi64_epi32(b),
-        )
-    };
-    let jx = _mm512_srli_epi32::<8>(join(h0, h1));
-    let jy = join(_mm512_srli_epi64::<40>(h0), _mm512_srli_epi64::<40>(h1));
+    debug_assert!(base.is_multiple_of(CHUNK as u32));
+    // `base` is a multiple of 16, so `base + k` (k < 16) never wraps a u32 and the hashed
+    // `jitter_fast + (base + k) · H` is `(jitter_fast + base · H) + k · H` (mod 2^64): one
+    // scalar start and constant steps instead of a conversion and a 64-bit multiply per lane.
+    let start = jitter_fast.wrapping_add((base as u64).wrapping_mul(HASH_INIT));
+    let start = _mm512_set1_epi64(start as i64);
+    let step = |k: u64| k.wrapping_mul(HASH_INIT) as i64;
+    let lo = _mm512_setr_epi64(
+        step(0),
+        step(1),
+        step(2),
+        step(3),
+        step(4),
+        step(5),
+        step(6),
+        step(7),
+    );
+    let hi = _mm512_setr_epi64(
+        step(8),
+        step(9),
+        step(10),
+        step(11),
+        step(12),
+        step(13),
+        step(14),
+        step(15),
+    );
+    let h0 = mix64_avx512(_mm512_add_epi64(start, lo));
+    let h1 = mix64_avx512(_mm512_add_epi64(start, hi));
+    // The low (`h as u32`) and high (`(h >> 32) as u32`) halves of the 16 hashes: the even
+    // and odd u32 words of (h0, h1); `(h >> 40) as u32` is the high half shifted by 8.
+    let even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+    let odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+    let jx = _mm512_srli_epi32::<8>(_mm512_permutex2var_epi32(h0, even, h1));
+    let jy = _mm512_srli_epi32::<8>(_mm512_permutex2var_epi32(h0, odd, h1));
     (jx, jy)
 }
 
