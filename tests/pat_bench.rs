@@ -9,7 +9,12 @@ use std::time::Instant;
 #[ignore]
 fn pattern_hot_path_timing() {
     let pat = make_pattern(PatternKind::Stratified, 0x5eed);
+    // PAT_SPP=64 times one count only (for profiling).
+    let only: Option<u32> = std::env::var("PAT_SPP").ok().and_then(|s| s.parse().ok());
     for spp in [16u32, 64, 100] {
+        if only.is_some_and(|o| o != spp) {
+            continue;
+        }
         let mut pxs: Vec<_> = (0..16).map(|_| pat.pixel(UVec2::ZERO)).collect();
         let mut best = f64::MAX;
         let mut sink = 0u32;
