@@ -1388,6 +1388,69 @@ mod tests {
     }
 
     #[test]
+    fn group_fills_serve_every_access_order() {
+        // Raw-mode misses fill every dimension last seen with the same count: the values must
+        // not depend on the order of the requests (renderer order with two counts, dimension
+        // after dimension, and backwards), on each instruction set.
+        for isa in Isa::available() {
+            let pat = Pattern {
+                seed: 3,
+                kind: PatternKind::Stratified,
+                isa,
+            };
+            let mut px = pat.pixel(UVec2::ZERO);
+            for (p, pixel) in [UVec2::new(4, 5), UVec2::new(6, 5), UVec2::new(9, 1)]
+                .into_iter()
+                .enumerate()
+            {
+                pat.pixel_into(pixel, &mut px);
+                let check_1d = |dim, i, n| {
+                    assert_eq!(
+                        px.sample_1d(dim, i, n).to_bits(),
+                        pat.sample_1d(pixel, dim, i, n).to_bits(),
+                        "{isa:?} pixel {pixel} 1d dim {dim} index {i} count {n}"
+                    )
+                };
+                let check_2d = |dim, i, n| {
+                    assert_eq!(
+                        px.sample_2d(dim, i, n).to_array().map(f32::to_bits),
+                        pat.sample_2d(pixel, dim, i, n).to_array().map(f32::to_bits),
+                        "{isa:?} pixel {pixel} 2d dim {dim} index {i} count {n}"
+                    )
+                };
+                let (spp, m) = (40u32, 3u32);
+                match p {
+                    0 => {
+                        for i in 0..spp {
+                            check_2d(0, i, spp);
+                            for j in 0..m {
+                                check_1d(1, i * m + j, spp * m);
+                                check_2d(2, i * m + j, spp * m);
+                                check_2d(4, i * m + j, spp * m);
+                            }
+                        }
+                    }
+                    1 => {
+                        for dim in [0u32, 4, 1, 2] {
+                            for i in 0..spp * m {
+                                check_2d(dim, i, spp * m);
+                                check_1d(dim, i, spp * m);
+                            }
+                        }
+                    }
+                    _ => {
+                        for i in (0..spp).rev() {
+                            check_1d(3, i, spp);
+                            check_2d(2, i, spp);
+                            check_2d(0, i, spp * m);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn non_power_of_two_chunks_equal_the_pattern_values() {
         // Every index of non-power-of-two counts through the chunk fills (cycle-walking
         // permutation, divided cell split), on each instruction set: small and large strata,
