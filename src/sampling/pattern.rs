@@ -297,6 +297,30 @@ impl SetKeys {
     }
 }
 
+/// The key material of one tag's (1D or 2D) sets of a pixel's [`CACHED_DIMS`] dimensions
+/// in the `stratified` AVX-512 path: per dimension the permutation's mixed keys (`k`, `k2`
+/// of [`Permutation::from_mixed`]) and the jitter key, as the vector hashes produce them.
+#[derive(Clone, Copy, Debug, Default)]
+struct RawSets {
+    k: [u64; CACHED_DIMS],
+    k2: [u64; CACHED_DIMS],
+    jitter: [u64; CACHED_DIMS],
+}
+
+impl RawSets {
+    /// The [`SetKeys`] of dimension `d` (< [`CACHED_DIMS`]): what `SetKeys::new` makes for a
+    /// `stratified` set (its `key` is only read by `sobol`).
+    #[inline]
+    fn set(&self, d: usize) -> SetKeys {
+        SetKeys {
+            perm: Permutation::from_mixed(self.k[d], self.k2[d]),
+            jitter: self.jitter[d],
+            jitter_fast: self.jitter[d].wrapping_add(HASH_INIT),
+            ..Default::default()
+        }
+    }
+}
+
 /// What a sample set of `count` points needs besides its keys (grid shape, permutation
 /// width), computed once per count instead of for every sample.
 #[derive(Clone, Copy, Debug, Default)]
@@ -384,9 +408,10 @@ impl SamplePattern for Pattern {
     fn pixel_into(&self, pixel: UVec2, out: &mut PixelSamples) {
         out.reset(*self, pixel);
         #[cfg(target_arch = "x86_64")]
-        if self.kind == PatternKind::Stratified && self.isa == Isa::Avx512 {
-            // SAFETY: `Isa::detect` returned Avx512 only if the CPU has these features.
-            unsafe { self.sets_stratified_avx512(pixel, &mut out.sets_1d, &mut out.sets_2d) };
+        if out.raw_mode {
+            // SAFETY: raw mode means `self.isa` is Avx512 (from `Isa::detect`, or in tests
+            // one of `Isa::available`): the CPU has these features.
+            unsafe { self.raw_stratified_avx512(pixel, &mut out.raw) };
             return;
         }
         let prefix = self.pixel_hash(pixel);
@@ -399,46 +424,40 @@ impl SamplePattern for Pattern {
 }
 
 impl Pattern {
-    /// The set keys of [`SamplePattern::pixel`] of a `stratified` pattern on AVX-512, into
-    /// `sets_1d` / `sets_2d`: the keys of the 8 cached dimensions are 8 u64 lanes, so every
-    /// hash of a pixel's set keys is one vector op.
+    /// The raw set keys of [`SamplePattern::pixel`] of a `stratified` pattern on AVX-512
+    /// ([`RawSets`]): the keys of the 8 cached dimensions are 8 u64 lanes, so every hash of a
+    /// pixel's set keys is one vector op, and they are stored as they come (6 vector stores;
+    /// the round keys of a dimension are derived when its chunk is filled, for the few
+    /// dimensions an integrator uses).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    fn sets_stratified_avx512(
-        &self,
-        pixel: UVec2,
-        sets_1d: &mut [SetKeys; CACHED_DIMS],
-        sets_2d: &mut [SetKeys; CACHED_DIMS],
-    ) {
+    fn raw_stratified_avx512(&self, pixel: UVec2, raw: &mut [RawSets; 2]) {
         use super::hash::{hash_step_avx512, mix64_avx512};
         use std::arch::x86_64::*;
         const _: () = assert!(CACHED_DIMS == 8, "one 8-lane vector of dimensions");
         let prefix = _mm512_set1_epi64(self.pixel_hash(pixel) as i64);
         let dims = hash_step_avx512(prefix, _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
-        // The `stratified` arm of `SetKeys::new` for the 8 keys of one tag.
-        let sets = |tag: u64, out: &mut [SetKeys; CACHED_DIMS]| {
+        for (tag, out) in [TAG_1D, TAG_2D].into_iter().zip(raw.iter_mut()) {
+            // The `stratified` arm of `SetKeys::new` for the 8 keys of one tag.
             let key = hash_step_avx512(dims, _mm512_set1_epi64(tag as i64));
             let k = mix64_avx512(key);
             let k2 = mix64_avx512(k);
             let jitter = hash_step_avx512(key, _mm512_set1_epi64(TAG_JITTER as i64));
-            let mut lanes = [[0u64; CACHED_DIMS]; 4];
-            for (o, v) in lanes.iter_mut().zip([key, k, k2, jitter]) {
+            for (o, v) in [&mut out.k, &mut out.k2, &mut out.jitter]
+                .into_iter()
+                .zip([k, k2, jitter])
+            {
                 // SAFETY: `o` is 8 u64 = 64 bytes, the width of the unaligned store.
                 unsafe { _mm512_storeu_si512(o.as_mut_ptr() as *mut __m512i, v) };
             }
-            let [key, k, k2, jitter] = lanes;
-            for (d, o) in out.iter_mut().enumerate() {
-                *o = SetKeys {
-                    perm: Permutation::from_mixed(k[d], k2[d]),
-                    jitter: jitter[d],
-                    jitter_fast: jitter[d].wrapping_add(HASH_INIT),
-                    key: key[d],
-                    ..Default::default()
-                };
-            }
-        };
-        sets(TAG_1D, sets_1d);
-        sets(TAG_2D, sets_2d);
+        }
+    }
+
+    /// Whether [`PixelSamples`] of this pattern hold raw keys (see `PixelSamples::raw_mode`).
+    fn raw_mode(&self) -> bool {
+        cfg!(target_arch = "x86_64")
+            && self.kind == PatternKind::Stratified
+            && self.isa == Isa::Avx512
     }
 
     /// The [`PixelSamples`] of `pixel` with these sets' keys and empty caches.
@@ -454,6 +473,9 @@ impl Pattern {
             pixel,
             sets_1d,
             sets_2d,
+            raw_mode: self.raw_mode(),
+            raw: Default::default(),
+            learned: Default::default(),
             strata: Cell::default(),
             fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
             chunks_1d: Default::default(),
@@ -630,29 +652,59 @@ impl FastStrata {
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     fn chunk_1d_avx512(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
         use std::arch::x86_64::*;
-        let strata = set.perm.apply_16_avx512(base, &self.dom);
-        let (jx, _) = jitters_avx512(set, base);
-        let v = if self.small_1d {
-            fixed_small_avx512(strata, jx, self.div_1d)
-        } else {
-            fixed_wide_avx512(strata, jx, self.div_1d)
-        };
+        let v = self.chunk_1d_vec_avx512(&set.perm, set.jitter_fast, base);
         let mut out = [0.0f32; CHUNK];
         // SAFETY: `out` is 16 f32 = 64 bytes, the width of the unaligned store.
         unsafe { _mm512_storeu_ps(out.as_mut_ptr(), v) };
         out
     }
 
+    /// The values of [`FastStrata::chunk_1d_avx512`] in one vector, from the set's
+    /// permutation and `jitter_fast` key.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn chunk_1d_vec_avx512(
+        &self,
+        perm: &Permutation,
+        jitter_fast: u64,
+        base: u32,
+    ) -> std::arch::x86_64::__m512 {
+        let strata = perm.apply_16_avx512(base, &self.dom);
+        let (jx, _) = jitters_avx512(jitter_fast, base);
+        if self.small_1d {
+            fixed_small_avx512(strata, jx, self.div_1d)
+        } else {
+            fixed_wide_avx512(strata, jx, self.div_1d)
+        }
+    }
+
     /// [`FastStrata::chunk_2d`] on AVX-512 (see [`FastStrata::chunk_1d_avx512`]).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     fn chunk_2d_avx512(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
-        use std::arch::x86_64::*;
         if !self.small_2d {
             return self.chunk_2d(set, base);
         }
-        let strata = set.perm.apply_16_avx512(base, &self.dom);
-        let (jx, jy) = jitters_avx512(set, base);
+        let mut out = [Vec2::ZERO; CHUNK];
+        let (x, y) = self.chunk_2d_vec_avx512(&set.perm, set.jitter_fast, base);
+        // SAFETY: `out` is 16 `Vec2`.
+        unsafe { store_2d_avx512(out.as_mut_ptr(), x, y) };
+        out
+    }
+
+    /// The x and y values of [`FastStrata::chunk_2d_avx512`] as two vectors (`small_2d` only),
+    /// from the set's permutation and `jitter_fast` key.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn chunk_2d_vec_avx512(
+        &self,
+        perm: &Permutation,
+        jitter_fast: u64,
+        base: u32,
+    ) -> (std::arch::x86_64::__m512, std::arch::x86_64::__m512) {
+        use std::arch::x86_64::*;
+        let strata = perm.apply_16_avx512(base, &self.dom);
+        let (jx, jy) = jitters_avx512(jitter_fast, base);
         let (sx, sy) = if self.nx_log2 != u32::MAX {
             (
                 _mm512_and_si512(strata, _mm512_set1_epi32(self.nx_mask as i32)),
@@ -667,20 +719,10 @@ impl FastStrata {
             ));
             (_mm512_sub_epi32(strata, _mm512_mullo_epi32(q, nx)), q)
         };
-        let x = fixed_small_avx512(sx, jx, self.div_x);
-        let y = fixed_small_avx512(sy, jy, self.div_y);
-        // Interleave to (x0, y0, x1, y1, ...): lanes ≥ 16 of the index pick from `y`.
-        let lo = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
-        let hi = _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
-        let mut out = [Vec2::ZERO; CHUNK];
-        let p = out.as_mut_ptr() as *mut f32;
-        // SAFETY: `Vec2` is `repr(C)` (x, y), so `out` is 32 contiguous f32 = two 64-byte
-        // unaligned stores.
-        unsafe {
-            _mm512_storeu_ps(p, _mm512_permutex2var_ps(x, lo, y));
-            _mm512_storeu_ps(p.add(16), _mm512_permutex2var_ps(x, hi, y));
-        }
-        out
+        (
+            fixed_small_avx512(sx, jx, self.div_x),
+            fixed_small_avx512(sy, jy, self.div_y),
+        )
     }
 
     /// [`FastStrata::chunk_1d`] compiled for AVX2.
@@ -698,36 +740,76 @@ impl FastStrata {
     }
 }
 
-/// The 24-bit jitters (x, y) of indices `base..base + 16` of `set` on AVX-512: the same
-/// hashes as [`FastStrata::jitter_hashes`], 8 u64 lanes at a time.
+/// The 16 values (x, y) of a 2D chunk written to `out` as 16 `Vec2`, interleaved
+/// (x0, y0, x1, y1, ...).
+///
+/// # Safety
+/// `out` must be valid for writing 16 `Vec2` (no alignment needed).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn store_2d_avx512(
+    out: *mut Vec2,
+    x: std::arch::x86_64::__m512,
+    y: std::arch::x86_64::__m512,
+) {
+    use std::arch::x86_64::*;
+    // Lanes ≥ 16 of the index pick from `y`.
+    let lo = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+    let hi = _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
+    let p = out as *mut f32;
+    // SAFETY: `Vec2` is `repr(C)` (x, y), so 16 of them are 32 contiguous f32 = two 64-byte
+    // unaligned stores, valid by the caller's contract.
+    unsafe {
+        _mm512_storeu_ps(p, _mm512_permutex2var_ps(x, lo, y));
+        _mm512_storeu_ps(p.add(16), _mm512_permutex2var_ps(x, hi, y));
+    }
+}
+
+/// The 24-bit jitters (x, y) of indices `base..base + 16` of a set with key `jitter_fast` on
+/// AVX-512: the same hashes as [`FastStrata::jitter_hashes`], 8 u64 lanes at a time.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
 fn jitters_avx512(
-    set: &SetKeys,
+    jitter_fast: u64,
     base: u32,
 ) -> (std::arch::x86_64::__m512i, std::arch::x86_64::__m512i) {
     use super::hash::mix64_avx512;
     use std::arch::x86_64::*;
-    let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    // u32 indices (wrapping, as the scalar `base.wrapping_add(k)`), then zero-extended.
-    let idx = _mm512_add_epi32(_mm512_set1_epi32(base as i32), lanes);
-    let mul = _mm512_set1_epi64(HASH_INIT as i64);
-    let add = _mm512_set1_epi64(set.jitter_fast as i64);
-    let hash = |i: __m256i| {
-        let i = _mm512_cvtepu32_epi64(i);
-        mix64_avx512(_mm512_add_epi64(add, _mm512_mullo_epi64(i, mul)))
-    };
-    let h0 = hash(_mm512_castsi512_si256(idx));
-    let h1 = hash(_mm512_extracti64x4_epi64::<1>(idx));
-    // Low u32 of each lane (truncation, as `h as u32`), 16 lanes in one vector.
-    let join = |a: __m512i, b: __m512i| {
-        _mm512_inserti64x4::<1>(
-            _mm512_castsi256_si512(_mm512_cvtepi64_epi32(a)),
-            _mm512_cvtepi64_epi32(b),
-        )
-    };
-    let jx = _mm512_srli_epi32::<8>(join(h0, h1));
-    let jy = join(_mm512_srli_epi64::<40>(h0), _mm512_srli_epi64::<40>(h1));
+    debug_assert!(base.is_multiple_of(CHUNK as u32));
+    // `base` is a multiple of 16, so `base + k` (k < 16) never wraps a u32 and the hashed
+    // `jitter_fast + (base + k) · H` is `(jitter_fast + base · H) + k · H` (mod 2^64): one
+    // scalar start and constant steps instead of a conversion and a 64-bit multiply per lane.
+    let start = jitter_fast.wrapping_add((base as u64).wrapping_mul(HASH_INIT));
+    let start = _mm512_set1_epi64(start as i64);
+    let step = |k: u64| k.wrapping_mul(HASH_INIT) as i64;
+    let lo = _mm512_setr_epi64(
+        step(0),
+        step(1),
+        step(2),
+        step(3),
+        step(4),
+        step(5),
+        step(6),
+        step(7),
+    );
+    let hi = _mm512_setr_epi64(
+        step(8),
+        step(9),
+        step(10),
+        step(11),
+        step(12),
+        step(13),
+        step(14),
+        step(15),
+    );
+    let h0 = mix64_avx512(_mm512_add_epi64(start, lo));
+    let h1 = mix64_avx512(_mm512_add_epi64(start, hi));
+    // The low (`h as u32`) and high (`(h >> 32) as u32`) halves of the 16 hashes: the even
+    // and odd u32 words of (h0, h1); `(h >> 40) as u32` is the high half shifted by 8.
+    let even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+    let odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+    let jx = _mm512_srli_epi32::<8>(_mm512_permutex2var_epi32(h0, even, h1));
+    let jy = _mm512_srli_epi32::<8>(_mm512_permutex2var_epi32(h0, odd, h1));
     (jx, jy)
 }
 
@@ -875,6 +957,29 @@ impl<T: Copy> Chunk<T> {
         self.len.set(len);
         v[(index - base) as usize % CHUNK]
     }
+
+    /// Whether this chunk holds the values of the chunk at `base` of `count`.
+    #[inline(always)]
+    fn holds(&self, base: u32, count: u32) -> bool {
+        self.count.get() == count && self.base.get() == base && self.len.get() != 0
+    }
+
+    /// Where the values go: `v` as plain `T`s, for vector stores.
+    #[inline(always)]
+    fn values_ptr(&self) -> *mut T {
+        // `Cell<T>` has the layout of `T`, and a `Cell` may be written through a shared
+        // reference: this pointer may be written while no reference to a value is live.
+        self.v.as_ptr().cast::<T>().cast_mut()
+    }
+
+    /// Mark the values (written through [`Chunk::values_ptr`]) as those of the chunk at
+    /// `base` (a multiple of [`CHUNK`], < count) of `count`.
+    #[inline(always)]
+    fn mark(&self, base: u32, count: u32) {
+        self.count.set(count);
+        self.base.set(base);
+        self.len.set((count - base).min(CHUNK as u32));
+    }
 }
 
 /// One pixel's sample sets with the keys of the first [`CACHED_DIMS`] dimensions precomputed;
@@ -885,6 +990,17 @@ pub struct PixelSamples {
     pixel: UVec2,
     sets_1d: [SetKeys; CACHED_DIMS],
     sets_2d: [SetKeys; CACHED_DIMS],
+    /// The `stratified` AVX-512 form: `raw` holds the keys instead of `sets_1d` / `sets_2d`
+    /// (which are then unused), and a miss fills a whole group of chunks (see `learned`).
+    raw_mode: bool,
+    /// Raw keys of the 1D and 2D sets (raw mode).
+    raw: [RawSets; 2],
+    /// Per 1D / 2D cached dimension: the count of its last chunk fill (0: never), kept from
+    /// pixel to pixel. In raw mode a miss at (base, count) (count a multiple of 16) fills the
+    /// chunks at (base, count) of every dimension whose last count was `count`: an integrator draws the same
+    /// dimensions for each sample index, so the chunks of one 16-index block are computed
+    /// together, their independent hash chains overlapping, with one call and one setup.
+    learned: [[Cell<u32>; CACHED_DIMS]; 2],
     /// The two most recently used sample counts' [`Strata`] (an integrator asks for two: N for
     /// the pixel filter, N·M for the shading dimensions).
     strata: Cell<[Strata; 2]>,
@@ -903,6 +1019,7 @@ impl PixelSamples {
     fn reset(&mut self, pattern: Pattern, pixel: UVec2) {
         self.pattern = pattern;
         self.pixel = pixel;
+        self.raw_mode = pattern.raw_mode();
         for c in &self.chunks_1d {
             c.len.set(0);
         }
@@ -964,8 +1081,20 @@ impl PixelSamples {
     /// [`PixelSamples::sample_1d`] when no chunk holds the value (see [`PixelSamples::miss`]).
     #[inline(never)]
     fn sample_1d_miss(&self, dim: u32, index: u32, count: u32) -> f32 {
+        #[cfg(target_arch = "x86_64")]
+        if self.raw_mode
+            && let Some(v) = self.miss_raw(0, dim, index, count)
+        {
+            // SAFETY: the 1D chunk of `dim` holds `index` now; it stores f32s.
+            return unsafe {
+                *self.chunks_1d[dim as usize]
+                    .values_ptr()
+                    .cast::<f32>()
+                    .add(v)
+            };
+        }
         self.miss(
-            self.sets_1d.get(dim as usize),
+            self.set_keys(0, dim),
             &self.chunks_1d,
             Arity {
                 dim,
@@ -994,8 +1123,15 @@ impl PixelSamples {
     /// [`PixelSamples::sample_2d`] when no chunk holds the value (see [`PixelSamples::miss`]).
     #[inline(never)]
     fn sample_2d_miss(&self, dim: u32, index: u32, count: u32) -> Vec2 {
+        #[cfg(target_arch = "x86_64")]
+        if self.raw_mode
+            && let Some(v) = self.miss_raw(1, dim, index, count)
+        {
+            // SAFETY: the 2D chunk of `dim` holds `index` now.
+            return unsafe { *self.chunks_2d[dim as usize].values_ptr().add(v) };
+        }
         self.miss(
-            self.sets_2d.get(dim as usize),
+            self.set_keys(1, dim),
             &self.chunks_2d,
             Arity {
                 dim,
@@ -1010,13 +1146,98 @@ impl PixelSamples {
         )
     }
 
+    /// The keys of the 1D (`arity` 0) or 2D (1) set of `dim`, if it is a cached dimension.
+    #[inline]
+    fn set_keys(&self, arity: usize, dim: u32) -> Option<SetKeys> {
+        let d = dim as usize;
+        if d >= CACHED_DIMS {
+            return None;
+        }
+        Some(if self.raw_mode {
+            self.raw[arity].set(d)
+        } else if arity == 0 {
+            self.sets_1d[d]
+        } else {
+            self.sets_2d[d]
+        })
+    }
+
+    /// A raw-mode miss of the 1D (`arity` 0) or 2D (1) value `index` of `count` of `dim`:
+    /// if the AVX-512 fill serves it, fill its chunk and the group's (see `learned`) and
+    /// return `index`'s offset in the chunk; else `None` (the general path serves it).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn miss_raw(&self, arity: usize, dim: u32, index: u32, count: u32) -> Option<usize> {
+        let d = dim as usize;
+        if d >= CACHED_DIMS || index >= count {
+            return None;
+        }
+        let f = self.fast(count);
+        if !f.valid || (arity == 1 && !f.small_2d) {
+            return None;
+        }
+        let base = index & !(CHUNK as u32 - 1);
+        self.learned[arity][d].set(count);
+        let mut masks = [0u32; 2];
+        masks[arity] = 1 << d;
+        // Group fills only for counts that are whole blocks: the renderer's 16-lane packets
+        // then stay in step with the blocks. Otherwise a packet spans two blocks and the pixel
+        // filter's walk runs ahead of the shading dimensions: a group fill of its next block
+        // would evict the block they still read, and every block would be filled 2–3 times.
+        for k in (0..CACHED_DIMS).filter(|_| count.is_multiple_of(CHUNK as u32)) {
+            if self.learned[0][k].get() == count && !self.chunks_1d[k].holds(base, count) {
+                masks[0] |= 1 << k;
+            }
+            if f.small_2d
+                && self.learned[1][k].get() == count
+                && !self.chunks_2d[k].holds(base, count)
+            {
+                masks[1] |= 1 << k;
+            }
+        }
+        // SAFETY: raw mode means the pattern's isa is Avx512, a set this CPU runs.
+        unsafe { self.fill_avx512(&f, base, count, masks) };
+        Some((index - base) as usize)
+    }
+
+    /// Fill the 1D chunks of the dimensions in `masks[0]` and the 2D chunks of those in
+    /// `masks[1]` (`small_2d` only) with their values at `base` of `count`, from the raw keys.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn fill_avx512(&self, f: &FastStrata, base: u32, count: u32, masks: [u32; 2]) {
+        use std::arch::x86_64::*;
+        let [mut m1, mut m2] = masks;
+        while m1 != 0 {
+            let d = m1.trailing_zeros() as usize;
+            m1 &= m1 - 1;
+            let r = &self.raw[0];
+            let perm = Permutation::from_mixed(r.k[d], r.k2[d]);
+            let v = f.chunk_1d_vec_avx512(&perm, r.jitter[d].wrapping_add(HASH_INIT), base);
+            let c = &self.chunks_1d[d];
+            // SAFETY: the chunk's values are 16 f32 = 64 bytes, the width of the store.
+            unsafe { _mm512_storeu_ps(c.values_ptr(), v) };
+            c.mark(base, count);
+        }
+        while m2 != 0 {
+            let d = m2.trailing_zeros() as usize;
+            m2 &= m2 - 1;
+            let r = &self.raw[1];
+            let perm = Permutation::from_mixed(r.k[d], r.k2[d]);
+            let (x, y) = f.chunk_2d_vec_avx512(&perm, r.jitter[d].wrapping_add(HASH_INIT), base);
+            let c = &self.chunks_2d[d];
+            // SAFETY: the chunk's values are 16 `Vec2`.
+            unsafe { store_2d_avx512(c.values_ptr(), x, y) };
+            c.mark(base, count);
+        }
+    }
+
     /// A value no chunk holds: refill the chunk of `index` (< count; the `stratified` fast form
     /// where it applies) or evaluate the general way (uncached dimension, wrapped index).
     /// Written once for 1D and 2D; inlined into each so that every loop is specialised.
     #[inline(always)]
     fn miss<T, G, E, F>(
         &self,
-        set: Option<&SetKeys>,
+        set: Option<SetKeys>,
         chunks: &[Chunk<T>; CACHED_DIMS],
         a: Arity<G, E, F>,
     ) -> T
@@ -1037,6 +1258,7 @@ impl PixelSamples {
         let Some(set) = set else {
             return general(&self.pattern);
         };
+        let set = &set;
         let kind = self.pattern.kind;
         if index >= count {
             return eval(set, kind, index, &self.strata(count));
@@ -1163,6 +1385,70 @@ mod tests {
                                     .map(f32::to_bits),
                                 "{kind} {isa:?} 2d count {count} index {index}"
                             );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn group_fills_serve_every_access_order() {
+        // Raw-mode misses fill every dimension last seen with the same count: the values must
+        // not depend on the order of the requests (renderer order with two counts, dimension
+        // after dimension, and backwards; counts 32 and 96 are whole blocks, so the group
+        // fills take part), on each instruction set.
+        for isa in Isa::available() {
+            let pat = Pattern {
+                seed: 3,
+                kind: PatternKind::Stratified,
+                isa,
+            };
+            let mut px = pat.pixel(UVec2::ZERO);
+            for (p, pixel) in [UVec2::new(4, 5), UVec2::new(6, 5), UVec2::new(9, 1)]
+                .into_iter()
+                .enumerate()
+            {
+                pat.pixel_into(pixel, &mut px);
+                let check_1d = |dim, i, n| {
+                    assert_eq!(
+                        px.sample_1d(dim, i, n).to_bits(),
+                        pat.sample_1d(pixel, dim, i, n).to_bits(),
+                        "{isa:?} pixel {pixel} 1d dim {dim} index {i} count {n}"
+                    )
+                };
+                let check_2d = |dim, i, n| {
+                    assert_eq!(
+                        px.sample_2d(dim, i, n).to_array().map(f32::to_bits),
+                        pat.sample_2d(pixel, dim, i, n).to_array().map(f32::to_bits),
+                        "{isa:?} pixel {pixel} 2d dim {dim} index {i} count {n}"
+                    )
+                };
+                let (spp, m) = (32u32, 3u32);
+                match p {
+                    0 => {
+                        for i in 0..spp {
+                            check_2d(0, i, spp);
+                            for j in 0..m {
+                                check_1d(1, i * m + j, spp * m);
+                                check_2d(2, i * m + j, spp * m);
+                                check_2d(4, i * m + j, spp * m);
+                            }
+                        }
+                    }
+                    1 => {
+                        for dim in [0u32, 4, 1, 2] {
+                            for i in 0..spp * m {
+                                check_2d(dim, i, spp * m);
+                                check_1d(dim, i, spp * m);
+                            }
+                        }
+                    }
+                    _ => {
+                        for i in (0..spp).rev() {
+                            check_1d(3, i, spp);
+                            check_2d(2, i, spp);
+                            check_2d(0, i, spp * m);
                         }
                     }
                 }
