@@ -6,7 +6,9 @@
 
 mod geometry_support;
 
-use geometry_support::{brute_force_t, random_rays, soup_with_quadrics};
+use geometry_support::{
+    brute_force_t, builtin_scene, camera_packet_rays, random_rays, soup_with_quadrics,
+};
 use glam::{UVec2, Vec3};
 use penumbra::geometry::{Geometry, PACKET, Ray, RayPacket, RayQuery, SurfaceHit};
 use penumbra::isa::Isa;
@@ -79,35 +81,6 @@ fn check(g: &Geometry, rays: &[Ray]) -> (u32, u32) {
     counts
 }
 
-fn load(name: &str, triangles: Option<u32>) -> Scene {
-    let opts = penumbra::scene::load::LoadOptions {
-        builtin: penumbra::scene::builtin::BuiltinOptions {
-            triangles,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    penumbra::scene::load::load(name, &opts)
-        .expect("built-in scene")
-        .scene
-}
-
-/// 16 jittered camera rays per pixel for `pixels` pixels spread over the image.
-fn camera_rays(scene: &Scene, pixels: u32) -> Vec<Ray> {
-    let res = UVec2::new(64, 64);
-    let cam = scene.camera.rays(res);
-    let pat = make_pattern(PatternKind::Random, 21);
-    let mut rays = Vec::new();
-    for k in 0..pixels {
-        let px = UVec2::new((k * 37) % res.x, (k * 101 / res.x) % res.y);
-        for s in 0..PACKET as u32 {
-            let j = pat.sample_2d(px, 0, s, PACKET as u32);
-            rays.push(cam.generate(px.as_vec2() + j));
-        }
-    }
-    rays
-}
-
 /// A shadow ray from each closest hit of `rays` to a random point of an emitter triangle.
 fn shadow_rays(scene: &Scene, rays: &[Ray]) -> Vec<Ray> {
     let (g, em) = (&scene.geometry, &scene.emitters);
@@ -152,8 +125,8 @@ fn ray_packet_lanes_round_trip() {
 
 #[test]
 fn soa_packets_match_aos_packets_on_cornell() {
-    let scene = load("cornell", None);
-    let cam = camera_rays(&scene, 300);
+    let scene = builtin_scene("cornell", None);
+    let cam = camera_packet_rays(&scene, 300, 21);
     let (hits, _) = check(&scene.geometry, &cam);
     assert!(hits > 1500, "{hits} camera hits");
     let shadow = shadow_rays(&scene, &cam);
@@ -168,7 +141,7 @@ fn soa_packets_match_aos_packets_on_cornell() {
 
 #[test]
 fn soa_packets_match_aos_packets_with_ties_and_quadrics() {
-    let scene = load("dense", Some(5_000));
+    let scene = builtin_scene("dense", Some(5_000));
     let g = &scene.geometry;
     // Coherent packets aimed at shared vertices and edge midpoints: exact ties on equal t.
     let pat = make_pattern(PatternKind::Random, 23);

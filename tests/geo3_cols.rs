@@ -6,13 +6,14 @@
 
 mod geometry_support;
 
-use geometry_support::{brute_force_t, random_rays, soup_with_quadrics};
+use geometry_support::{
+    brute_force_t, builtin_scene, camera_packet_rays, random_rays, soup_with_quadrics,
+};
 use glam::{UVec2, Vec3};
 use penumbra::geometry::RayQuery;
 use penumbra::geometry::{Geometry, HitColumns, PACKET, Ray, RayPacket, SurfaceHit};
 use penumbra::isa::Isa;
 use penumbra::sampling::{PatternKind, make_pattern};
-use penumbra::scene::Scene;
 
 /// Active masks cycled through the packets: full, partial, single lanes, none.
 const MASKS: [u32; 6] = [0xffff, 0xa5c3, 0x0001, 0x8000, 0x7ffe, 0];
@@ -115,39 +116,10 @@ fn check(g: &Geometry, rays: &[Ray]) -> u32 {
     hits
 }
 
-fn load(name: &str, triangles: Option<u32>) -> Scene {
-    let opts = penumbra::scene::load::LoadOptions {
-        builtin: penumbra::scene::builtin::BuiltinOptions {
-            triangles,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    penumbra::scene::load::load(name, &opts)
-        .expect("built-in scene")
-        .scene
-}
-
-/// 16 jittered camera rays per pixel for `pixels` pixels spread over the image.
-fn camera_rays(scene: &Scene, pixels: u32) -> Vec<Ray> {
-    let res = UVec2::new(64, 64);
-    let cam = scene.camera.rays(res);
-    let pat = make_pattern(PatternKind::Random, 31);
-    let mut rays = Vec::new();
-    for k in 0..pixels {
-        let px = UVec2::new((k * 37) % res.x, (k * 101 / res.x) % res.y);
-        for s in 0..PACKET as u32 {
-            let j = pat.sample_2d(px, 0, s, PACKET as u32);
-            rays.push(cam.generate(px.as_vec2() + j));
-        }
-    }
-    rays
-}
-
 #[test]
 fn hit_columns_match_rows_on_cornell() {
-    let scene = load("cornell", None);
-    let cam = camera_rays(&scene, 300);
+    let scene = builtin_scene("cornell", None);
+    let cam = camera_packet_rays(&scene, 300, 31);
     assert!(check(&scene.geometry, &cam) > 1500);
     let random = random_rays(scene.geometry.bounds(), 16 * 200, 5);
     assert!(check(&scene.geometry, &random) > 400);
@@ -157,7 +129,7 @@ fn hit_columns_match_rows_on_cornell() {
 
 #[test]
 fn hit_columns_match_rows_with_ties_and_quadrics() {
-    let scene = load("dense", Some(5_000));
+    let scene = builtin_scene("dense", Some(5_000));
     let g = &scene.geometry;
     // Coherent packets aimed at shared vertices and edge midpoints: exact ties on equal t.
     let pat = make_pattern(PatternKind::Random, 33);

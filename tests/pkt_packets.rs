@@ -7,7 +7,10 @@
 
 mod geometry_support;
 
-use geometry_support::{brute_force_t, random_rays, soup_with_quadrics, triangle_soup};
+use geometry_support::{
+    brute_force_t, builtin_scene, camera_packet_rays, random_rays, soup_with_quadrics,
+    triangle_soup,
+};
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::{Backend, Geometry, MeshShading, PACKET, Primitive, Ray, RayQuery};
 use penumbra::isa::Isa;
@@ -73,22 +76,6 @@ fn check_on(g: &Geometry, rays: &[Ray], isa: Isa) -> u32 {
     hits
 }
 
-/// 16 jittered camera rays per pixel for `pixels` pixels spread over the image.
-fn camera_packets(scene: &Scene, pixels: u32) -> Vec<Ray> {
-    let res = UVec2::new(64, 64);
-    let cam = scene.camera.rays(res);
-    let pat = make_pattern(PatternKind::Random, 11);
-    let mut rays = Vec::new();
-    for k in 0..pixels {
-        let px = UVec2::new((k * 37) % res.x, (k * 101 / res.x) % res.y);
-        for s in 0..PACKET as u32 {
-            let j = pat.sample_2d(px, 0, s, PACKET as u32);
-            rays.push(cam.generate(px.as_vec2() + j));
-        }
-    }
-    rays
-}
-
 /// For each closest hit of `rays`: a shadow ray to a random point of an emitter triangle
 /// (t_max < 1) and a ray leaving the surface exactly at the hit point.
 fn secondary_rays(scene: &Scene, rays: &[Ray]) -> Vec<Ray> {
@@ -121,23 +108,10 @@ fn secondary_rays(scene: &Scene, rays: &[Ray]) -> Vec<Ray> {
     out
 }
 
-fn load(name: &str, triangles: Option<u32>) -> Scene {
-    let opts = penumbra::scene::load::LoadOptions {
-        builtin: penumbra::scene::builtin::BuiltinOptions {
-            triangles,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    penumbra::scene::load::load(name, &opts)
-        .expect("built-in scene")
-        .scene
-}
-
 #[test]
 fn packets_match_scalar_queries_on_cornell_for_every_backend() {
-    let scene = load("cornell", None);
-    let cam = camera_packets(&scene, 400);
+    let scene = builtin_scene("cornell", None);
+    let cam = camera_packet_rays(&scene, 400, 11);
     let shadow = secondary_rays(&scene, &cam);
     let random = random_rays(scene.geometry.bounds(), 16 * 400, 3);
     for backend in [Backend::Wide, Backend::Own, Backend::Obvhs] {
@@ -153,9 +127,9 @@ fn packets_match_scalar_queries_on_cornell_for_every_backend() {
 
 #[test]
 fn packets_match_scalar_queries_on_a_dense_mesh_with_ties() {
-    let scene = load("dense", Some(20_000));
+    let scene = builtin_scene("dense", Some(20_000));
     let g = &scene.geometry;
-    let cam = camera_packets(&scene, 200);
+    let cam = camera_packet_rays(&scene, 200, 11);
     assert!(check(g, &cam) > 1000);
     assert!(check(g, &secondary_rays(&scene, &cam)) > 100);
     // Coherent packets aimed at shared vertices and edge midpoints: exact ties on equal t.

@@ -4,6 +4,7 @@ use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::triangle::intersect_triangle;
 use penumbra::geometry::{Geometry, PrimKind, Primitive, Ray};
 use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere};
+use penumbra::scene::Scene;
 
 /// Uniform random rays from points in the (enlarged) scene box, a third of them finite.
 pub fn random_rays(bounds: (Vec3, Vec3), n: u32, seed: u64) -> Vec<Ray> {
@@ -106,4 +107,37 @@ pub fn soup_with_quadrics(tris: u32, sphere_radius: f32, disk_radius: f32) -> Ge
         });
     }
     Geometry::new(prims, vec![MeshShading::default()], quadrics)
+}
+
+/// Built-in scene `name` (`triangles` for the procedural meshes of `dense`).
+#[allow(dead_code)] // Not every test file that shares this module loads scenes.
+pub fn builtin_scene(name: &str, triangles: Option<u32>) -> Scene {
+    let opts = penumbra::scene::load::LoadOptions {
+        builtin: penumbra::scene::builtin::BuiltinOptions {
+            triangles,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    penumbra::scene::load::load(name, &opts)
+        .expect("built-in scene")
+        .scene
+}
+
+/// 16 jittered camera rays per pixel (one packet each, as the renderer makes them) for
+/// `pixels` pixels spread over a 64² image of `scene`, jittered by pattern seed `seed`.
+#[allow(dead_code)] // As above.
+pub fn camera_packet_rays(scene: &Scene, pixels: u32, seed: u64) -> Vec<Ray> {
+    let res = UVec2::new(64, 64);
+    let cam = scene.camera.rays(res);
+    let pat = make_pattern(PatternKind::Random, seed);
+    let mut rays = Vec::new();
+    for k in 0..pixels {
+        let px = UVec2::new((k * 37) % res.x, (k * 101 / res.x) % res.y);
+        for s in 0..penumbra::geometry::PACKET as u32 {
+            let j = pat.sample_2d(px, 0, s, penumbra::geometry::PACKET as u32);
+            rays.push(cam.generate(px.as_vec2() + j));
+        }
+    }
+    rays
 }
