@@ -582,3 +582,153 @@ impl Sampled {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::hash::{next_f32, pcg_from_keys};
+    use rand_pcg::Pcg32;
+
+    fn unit(rng: &mut Pcg32) -> Vec3 {
+        loop {
+            let v = Vec3::new(next_f32(rng), next_f32(rng), next_f32(rng)) * 2.0 - Vec3::ONE;
+            if v.length_squared() > 1e-3 && v.length_squared() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+
+    /// A packet of random receivers (points, normals slightly off the geometric ones, rays from
+    /// either side, albedos) with their shading computed on `isa`.
+    fn receivers(rng: &mut Pcg32, isa: Isa) -> (Receivers, RayPacket) {
+        let mut rx = Receivers::new();
+        let mut rays = RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]);
+        for k in 0..PACKET {
+            let p = unit(rng) * next_f32(rng);
+            let ng = unit(rng);
+            let ns = (ng + unit(rng) * 0.2).normalize();
+            for a in 0..3 {
+                rx.cols.p[a][k] = p[a];
+                rx.cols.ng[a][k] = ng[a];
+                rx.cols.ns[a][k] = ns[a];
+            }
+            rx.cols.p_error[k] = 1e-6 * next_f32(rng);
+            rays.set(k, &Ray::new(Vec3::new(0.0, 0.0, -5.0), p - unit(rng) * 3.0));
+            let albedo = Vec3::new(next_f32(rng), next_f32(rng), next_f32(rng));
+            rx.set_diffuse(k, &Lambert::new(albedo));
+        }
+        rx.shade(&rays, isa);
+        (rx, rays)
+    }
+
+    /// Lane k's per-lane state, made the way the per-lane path makes it.
+    fn scalar_lane(
+        rx: &Receivers,
+        rays: &RayPacket,
+        k: usize,
+    ) -> (SurfaceHit, LightSampleContext, ShadingGeometry, Lambert) {
+        let hit = SurfaceHit {
+            t: 1.0,
+            p: col(&rx.cols.p, k),
+            ng: col(&rx.cols.ng, k),
+            ns: col(&rx.cols.ns, k),
+            uv: Vec2::ZERO,
+            p_error: rx.cols.p_error[k],
+            prim: 0,
+            material: 0,
+            light: 0,
+        };
+        let g = ShadingGeometry::new(rays.ray(k).d, hit.ng, hit.ns);
+        let ctx = LightSampleContext { p: hit.p, n: g.n };
+        (hit, ctx, g, Lambert::new(rx.albedo.get(k)))
+    }
+
+    fn bits(v: Vec3) -> [u32; 3] {
+        v.to_array().map(f32::to_bits)
+    }
+
+    #[test]
+    fn light_kernel_lanes_equal_the_per_lane_functions_on_every_isa() {
+        // The kernel's loop must compile to exactly the per-lane functions' float operations
+        // on every instruction set (no contraction, no reassociation, nothing dropped).
+        let mut checked = 0;
+        for isa in Isa::available() {
+            for round in 0..24u64 {
+                let mut rng = pcg_from_keys(&[7, round]);
+                let (rx, rays) = receivers(&mut rng, isa);
+                let mut lanes = TriangleLightLanes::new();
+                let mut tris = Vec::new();
+                for k in 0..PACKET {
+                    let c = Vec3::new(0.0, 2.0, 0.0) + unit(&mut rng) * 0.5;
+                    let v = [c + unit(&mut rng), c + unit(&mut rng), c + unit(&mut rng)];
+                    let tri = TriangleLight::new(v, unit(&mut rng), Vec3::splat(4.0), k % 3 == 0)
+                        .expect("a random triangle has an area");
+                    let (pmf, u) = (0.5, Vec2::new(next_f32(&mut rng), next_f32(&mut rng)));
+                    lanes.load(k, &tri, pmf, u);
+                    tris.push((tri, pmf, u));
+                }
+                let mode = [SamplingMode::Area, SamplingMode::SolidAngle][round as usize % 2];
+                let mis = [None, Some(MisHeuristic::Power), Some(MisHeuristic::Balance)]
+                    [round as usize % 3];
+                let mut out = Pending::new();
+                let n = lanes.run(&rx, mis, mode, isa, &mut out);
+                assert_eq!(n, out.active.count_ones());
+                for (k, (tri, pmf, u)) in tris.iter().enumerate() {
+                    let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
+                    let want = tri.sample_li(&ctx, *u, mode).and_then(|ls| {
+                        light_estimate(&ls, *pmf, &lambert, &g.frame, g.wo_local, &ctx, &hit, mis)
+                    });
+                    let what = format!("{isa:?} round {round} lane {k}");
+                    assert_eq!(out.active >> k & 1 != 0, want.is_some(), "{what}");
+                    if let Some((ray, value)) = want {
+                        let got = out.rays.ray(k);
+                        assert_eq!(bits(got.o), bits(ray.o), "{what}");
+                        assert_eq!(bits(got.d), bits(ray.d), "{what}");
+                        assert_eq!(got.t_max.to_bits(), ray.t_max.to_bits(), "{what}");
+                        assert_eq!(bits(out.value.get(k)), bits(value), "{what}");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        // Enough lanes face their light for the comparison to mean something.
+        assert!(checked > 100, "only {checked} lanes had an estimate");
+    }
+
+    #[test]
+    fn bsdf_kernel_lanes_equal_the_per_lane_functions_on_every_isa() {
+        let mut checked = 0;
+        for isa in Isa::available() {
+            for round in 0..16u64 {
+                let mut rng = pcg_from_keys(&[8, round]);
+                let (rx, rays) = receivers(&mut rng, isa);
+                let mut lanes = DiffuseBsdfLanes::new();
+                let u: Vec<Vec2> = (0..PACKET)
+                    .map(|_| Vec2::new(next_f32(&mut rng), next_f32(&mut rng)))
+                    .collect();
+                for (k, &u) in u.iter().enumerate() {
+                    lanes.load(k, u);
+                }
+                let mut out = Sampled::new();
+                lanes.run(&rx, isa, &mut out);
+                for (k, &u) in u.iter().enumerate() {
+                    let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
+                    let want = lambert
+                        .sample(g.wo_local, 0.0, u)
+                        .and_then(|bs| bsdf_ray_of(&bs, &g.frame, ctx.n, &hit));
+                    let what = format!("{isa:?} round {round} lane {k}");
+                    assert_eq!(out.active >> k & 1 != 0, want.is_some(), "{what}");
+                    if let Some(b) = want {
+                        let got = out.get(k);
+                        assert_eq!(bits(got.ray.o), bits(b.ray.o), "{what}");
+                        assert_eq!(bits(got.ray.d), bits(b.ray.d), "{what}");
+                        assert_eq!(bits(got.weight), bits(b.weight), "{what}");
+                        assert_eq!(got.pdf.to_bits(), b.pdf.to_bits(), "{what}");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 100, "only {checked} lanes had a ray");
+    }
+}
