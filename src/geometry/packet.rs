@@ -180,7 +180,12 @@ impl ColumnSink for HitColumns {
 /// ([`Geometry::intersect_packet`], [`Geometry::occluded_packet`] and their variants):
 /// `[Ray; PACKET]` (one ray per element) or [`RayPacket`] (already in lanes, read without the
 /// transpose). Sealed: implemented only for these two, since the kernels read the rays through
-/// the crate's private vector types.
+/// the crate's private vector types:
+///
+/// ```compile_fail
+/// struct Mine;
+/// impl penumbra::geometry::PacketRayForm for Mine {}
+/// ```
 pub trait PacketRayForm: sealed::PacketRays {}
 
 impl PacketRayForm for [Ray; PACKET] {}
