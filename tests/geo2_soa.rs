@@ -1,4 +1,4 @@
-//! The structure-of-arrays packet queries (`intersect_packet_soa`, `occluded_packet_soa` on a
+//! The packet queries on the structure-of-arrays form (`intersect_packet`, `occluded_packet` on a
 //! [`RayPacket`]) answer every lane exactly like the `[Ray; PACKET]` ones and the scalar
 //! queries: camera, shadow and random rays on cornell, rays aimed at shared vertices of a dense
 //! mesh (exact ties, redone by the scalar query), triangles with quadrics, the single-leaf
@@ -60,10 +60,10 @@ fn check(g: &Geometry, rays: &[Ray]) -> (u32, u32) {
             let active = MASKS[k % MASKS.len()];
             let (mut a, mut s) = ([None; PACKET], [None; PACKET]);
             g.intersect_packet_on(isa, &aos, active, &mut a);
-            g.intersect_packet_soa_on(isa, &soa, active, &mut s);
+            g.intersect_packet_on(isa, &soa, active, &mut s);
             let blocked = g.occluded_packet_on(isa, &aos, active);
             assert_eq!(
-                g.occluded_packet_soa_on(isa, &soa, active),
+                g.occluded_packet_on(isa, &soa, active),
                 blocked,
                 "any-hit packet {k} on {isa:?}"
             );

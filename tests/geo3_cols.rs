@@ -89,7 +89,7 @@ fn check(g: &Geometry, rays: &[Ray]) -> u32 {
             let (mut want, mut a, mut s) = ([None; PACKET], [None; PACKET], [None; PACKET]);
             g.intersect_packet_on(isa, &aos, active, &mut want);
             g.intersect_packet_cols_on(isa, &aos, active, &mut a, &mut ca);
-            g.intersect_packet_soa_cols_on(isa, &soa, active, &mut s, &mut cs);
+            g.intersect_packet_cols_on(isa, &soa, active, &mut s, &mut cs);
             for i in 0..PACKET {
                 let w = bits(&want[i]);
                 assert_eq!(bits(&a[i]), w, "rows, lane {i} of packet {k} on {isa:?}");

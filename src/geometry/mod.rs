@@ -17,7 +17,7 @@ pub mod wide;
 
 pub use accel::{Backend, Geometry, MeshShading, PrimKind, Primitive};
 pub use interaction::{ShadingGeometry, SurfaceHit};
-pub use packet::{HitColumns, PACKET, RayPacket};
+pub use packet::{HitColumns, PACKET, PacketRayForm, RayPacket};
 pub use quadric::{Quadric, QuadricKind};
 pub use ray::{Ray, random_query_rays};
 pub use transform::Transform;

@@ -34,8 +34,8 @@ use std::mem::MaybeUninit;
 pub const PACKET: usize = 16;
 
 /// [`PACKET`] rays in structure-of-arrays form (lane i = ray i), for callers whose rays are
-/// already in vector lanes: the `*_soa` queries read them without the transpose that
-/// `[Ray; PACKET]` needs.
+/// already in vector lanes: the packet queries read them without the transpose that
+/// `[Ray; PACKET]` needs (both are a [`PacketRayForm`]).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct RayPacket {
@@ -176,42 +176,67 @@ impl ColumnSink for HitColumns {
     }
 }
 
-/// The two forms of a packet's rays the kernels read: `[Ray; PACKET]` and [`RayPacket`].
-pub(super) trait PacketRays {
-    /// `[o.x, o.y, o.z, d.x, d.y, d.z, t_max]` as lanes (see [`Simd::rays`]).
-    fn lanes<S: Simd>(&self) -> [S::F; 7];
-    /// Ray `i` (for the scalar steps).
-    fn ray(&self, i: usize) -> Ray;
-}
+/// The forms a packet's rays can be passed in to the packet queries
+/// ([`Geometry::intersect_packet`], [`Geometry::occluded_packet`] and their variants):
+/// `[Ray; PACKET]` (one ray per element) or [`RayPacket`] (already in lanes, read without the
+/// transpose). Sealed: implemented only for these two, since the kernels read the rays through
+/// the crate's private vector types:
+///
+/// ```compile_fail
+/// struct Mine;
+/// impl penumbra::geometry::PacketRayForm for Mine {}
+/// ```
+pub trait PacketRayForm: sealed::PacketRays {}
 
-impl PacketRays for [Ray; PACKET] {
-    #[inline(always)]
-    fn lanes<S: Simd>(&self) -> [S::F; 7] {
-        S::rays(self)
-    }
-    #[inline(always)]
-    fn ray(&self, i: usize) -> Ray {
-        self[i & (PACKET - 1)]
-    }
-}
+impl PacketRayForm for [Ray; PACKET] {}
 
-impl PacketRays for RayPacket {
-    #[inline(always)]
-    fn lanes<S: Simd>(&self) -> [S::F; 7] {
-        let (o, d) = (&self.o, &self.d);
-        [
-            S::load(&o[0]),
-            S::load(&o[1]),
-            S::load(&o[2]),
-            S::load(&d[0]),
-            S::load(&d[1]),
-            S::load(&d[2]),
-            S::load(&self.t_max),
-        ]
+impl PacketRayForm for RayPacket {}
+
+pub(super) use sealed::PacketRays;
+
+/// The kernels' view of a [`PacketRayForm`]; nominally `pub` inside a private module so that
+/// it can be the public trait's supertrait while no other crate can name or implement it.
+mod sealed {
+    use super::super::simd16::Simd;
+    use super::{PACKET, Ray, RayPacket};
+
+    /// The two forms of a packet's rays the kernels read: `[Ray; PACKET]` and [`RayPacket`].
+    pub trait PacketRays {
+        /// `[o.x, o.y, o.z, d.x, d.y, d.z, t_max]` as lanes (see [`Simd::rays`]).
+        fn lanes<S: Simd>(&self) -> [S::F; 7];
+        /// Ray `i` (for the scalar steps).
+        fn ray(&self, i: usize) -> Ray;
     }
-    #[inline(always)]
-    fn ray(&self, i: usize) -> Ray {
-        RayPacket::ray(self, i)
+
+    impl PacketRays for [Ray; PACKET] {
+        #[inline(always)]
+        fn lanes<S: Simd>(&self) -> [S::F; 7] {
+            S::rays(self)
+        }
+        #[inline(always)]
+        fn ray(&self, i: usize) -> Ray {
+            self[i & (PACKET - 1)]
+        }
+    }
+
+    impl PacketRays for RayPacket {
+        #[inline(always)]
+        fn lanes<S: Simd>(&self) -> [S::F; 7] {
+            let (o, d) = (&self.o, &self.d);
+            [
+                S::load(&o[0]),
+                S::load(&o[1]),
+                S::load(&o[2]),
+                S::load(&d[0]),
+                S::load(&d[1]),
+                S::load(&d[2]),
+                S::load(&self.t_max),
+            ]
+        }
+        #[inline(always)]
+        fn ray(&self, i: usize) -> Ray {
+            RayPacket::ray(self, i)
+        }
     }
 }
 
@@ -265,11 +290,12 @@ impl PacketHits {
 }
 
 impl Geometry {
-    /// Closest hit of each active ray (bit i of `active` ⇒ rays[i] is traced); out[i] = None for
-    /// inactive lanes and misses. Equal, lane by lane, to `self.intersect(&rays[i])`.
-    pub fn intersect_packet(
+    /// Closest hit of each active ray (bit i of `active` ⇒ ray i is traced); out[i] = None for
+    /// inactive lanes and misses. Equal, lane by lane, to `self.intersect(&ray_i)`. `rays` is
+    /// either form of [`PacketRayForm`]: `[Ray; PACKET]` or [`RayPacket`].
+    pub fn intersect_packet<R: PacketRayForm>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
@@ -278,33 +304,10 @@ impl Geometry {
 
     /// [`Self::intersect_packet`] on a chosen vector backend (for tests and benchmarks; one
     /// this CPU does not run falls back to the widest it does).
-    pub fn intersect_packet_on(
+    pub fn intersect_packet_on<R: PacketRayForm>(
         &self,
         isa: Isa,
-        rays: &[Ray; PACKET],
-        active: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-    ) {
-        self.intersect_packet_with(isa.supported(), rays, active, out, &mut ());
-    }
-
-    /// [`Self::intersect_packet`] for rays already in lanes: out[i] equals
-    /// `self.intersect(&rays.ray(i))` for each active lane i.
-    pub fn intersect_packet_soa(
-        &self,
-        rays: &RayPacket,
-        active: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-    ) {
-        self.intersect_packet_with(self.isa, rays, active, out, &mut ());
-    }
-
-    /// [`Self::intersect_packet_soa`] on a chosen vector backend (see
-    /// [`Self::intersect_packet_on`]).
-    pub fn intersect_packet_soa_on(
-        &self,
-        isa: Isa,
-        rays: &RayPacket,
+        rays: &R,
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
@@ -314,9 +317,9 @@ impl Geometry {
     /// [`Self::intersect_packet`] that also writes the hits' points, normals and error bounds
     /// to `cols` (see [`HitColumns`]): for each lane i with `out[i] = Some(h)`, the columns'
     /// lane i holds `h.p`, `h.ng`, `h.ns`, `h.p_error` bit for bit.
-    pub fn intersect_packet_cols(
+    pub fn intersect_packet_cols<R: PacketRayForm>(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &R,
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
         cols: &mut HitColumns,
@@ -326,35 +329,10 @@ impl Geometry {
 
     /// [`Self::intersect_packet_cols`] on a chosen vector backend (see
     /// [`Self::intersect_packet_on`]).
-    pub fn intersect_packet_cols_on(
+    pub fn intersect_packet_cols_on<R: PacketRayForm>(
         &self,
         isa: Isa,
-        rays: &[Ray; PACKET],
-        active: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-        cols: &mut HitColumns,
-    ) {
-        self.intersect_packet_with(isa.supported(), rays, active, out, cols);
-    }
-
-    /// [`Self::intersect_packet_soa`] that also fills `cols` (as
-    /// [`Self::intersect_packet_cols`] does).
-    pub fn intersect_packet_soa_cols(
-        &self,
-        rays: &RayPacket,
-        active: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-        cols: &mut HitColumns,
-    ) {
-        self.intersect_packet_with(self.isa, rays, active, out, cols);
-    }
-
-    /// [`Self::intersect_packet_soa_cols`] on a chosen vector backend (see
-    /// [`Self::intersect_packet_on`]).
-    pub fn intersect_packet_soa_cols_on(
-        &self,
-        isa: Isa,
-        rays: &RayPacket,
+        rays: &R,
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
         cols: &mut HitColumns,
@@ -411,30 +389,19 @@ impl Geometry {
         }
     }
 
-    /// Bit i set ⇔ ray i is active and `self.occluded(&rays.ray(i))`.
+    /// Bit i set ⇔ ray i is active and `self.occluded(&ray_i)`; `rays` is either form of
+    /// [`PacketRayForm`].
     ///
     /// One traversal of the wide BVH for the packet; a subtree that at most [`SPARSE`] of the
     /// rays enter is finished by the scalar query of each (incoherent shadow rays, e.g. on
     /// `dense`, would otherwise make the packet visit the union of the rays' subtrees).
-    pub fn occluded_packet(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+    pub fn occluded_packet<R: PacketRayForm>(&self, rays: &R, active: u32) -> u32 {
         self.occluded_packet_with(self.isa, rays, active)
     }
 
     /// [`Self::occluded_packet`] on a chosen vector backend (for tests and benchmarks; one
     /// this CPU does not run falls back to the widest it does).
-    pub fn occluded_packet_on(&self, isa: Isa, rays: &[Ray; PACKET], active: u32) -> u32 {
-        self.occluded_packet_with(isa.supported(), rays, active)
-    }
-
-    /// [`Self::occluded_packet`] for rays already in lanes: bit i set ⇔ lane i is active and
-    /// `self.occluded(&rays.ray(i))`.
-    pub fn occluded_packet_soa(&self, rays: &RayPacket, active: u32) -> u32 {
-        self.occluded_packet_with(self.isa, rays, active)
-    }
-
-    /// [`Self::occluded_packet_soa`] on a chosen vector backend (see
-    /// [`Self::occluded_packet_on`]).
-    pub fn occluded_packet_soa_on(&self, isa: Isa, rays: &RayPacket, active: u32) -> u32 {
+    pub fn occluded_packet_on<R: PacketRayForm>(&self, isa: Isa, rays: &R, active: u32) -> u32 {
         self.occluded_packet_with(isa.supported(), rays, active)
     }
 

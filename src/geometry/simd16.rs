@@ -20,8 +20,10 @@ pub const LANES: usize = 16;
 /// One f32 per ray, in memory.
 pub type Lanes = [f32; LANES];
 
-/// A 16-lane f32 vector type with lane masks (see the module docs).
-pub(super) trait Simd: Copy {
+/// A 16-lane f32 vector type with lane masks (see the module docs). Nominally `pub` (the module
+/// is private, so no other crate can name it) because the sealed supertrait of the public
+/// `packet::PacketRayForm` names it.
+pub trait Simd: Copy {
     /// Sixteen f32 lanes.
     type F: Copy + Add<Output = Self::F> + Sub<Output = Self::F> + Mul<Output = Self::F>;
     /// A lane mask.

@@ -334,7 +334,7 @@ impl<'a> DirectLighting<'a> {
         }
         scene
             .geometry
-            .intersect_packet_soa_cols(&cam.rays, cam.active(), hits, &mut rx.cols);
+            .intersect_packet_cols(&cam.rays, cam.active(), hits, &mut rx.cols);
         let mut rays = n as u64;
         let isa = scene.geometry.isa();
         // The hits' shading geometry for all lanes at once, then each lane's emission and
@@ -442,7 +442,7 @@ impl<'a> DirectLighting<'a> {
             if sampled.active != 0 {
                 scene
                     .emitters
-                    .intersect_packet_soa(&sampled.rays, sampled.active, emitter_hits);
+                    .intersect_packet(&sampled.rays, sampled.active, emitter_hits);
                 for k in bits(sampled.active) {
                     let hit = emitter_hits[k].as_ref();
                     // Most BSDF rays reach no light: nothing to gather, no view to build.

@@ -502,7 +502,7 @@ impl Pending {
     /// Trace the active rays: afterwards [`Self::value`] is the value where the ray is clear.
     pub(super) fn resolve(&mut self, geometry: &Geometry) {
         let blocked = if self.active != 0 {
-            geometry.occluded_packet_soa(&self.rays, self.active)
+            geometry.occluded_packet(&self.rays, self.active)
         } else {
             0
         };
