@@ -7,13 +7,12 @@
 mod geometry_support;
 
 use geometry_support::{
-    brute_force_t, builtin_scene, camera_packet_rays, random_rays, soup_with_quadrics,
+    brute_force_t, builtin_scene, camera_packet_rays, random_rays, secondary_rays,
+    soup_with_quadrics, tie_rays,
 };
-use glam::{UVec2, Vec3};
+use glam::Vec3;
 use penumbra::geometry::{Geometry, PACKET, Ray, RayPacket, RayQuery, SurfaceHit};
 use penumbra::isa::Isa;
-use penumbra::sampling::{PatternKind, make_pattern};
-use penumbra::scene::Scene;
 
 /// Active masks cycled through the packets: full, partial, single lanes, none.
 const MASKS: [u32; 6] = [0xffff, 0xa5c3, 0x0001, 0x8000, 0x7ffe, 0];
@@ -81,32 +80,6 @@ fn check(g: &Geometry, rays: &[Ray]) -> (u32, u32) {
     counts
 }
 
-/// A shadow ray from each closest hit of `rays` to a random point of an emitter triangle.
-fn shadow_rays(scene: &Scene, rays: &[Ray]) -> Vec<Ray> {
-    let (g, em) = (&scene.geometry, &scene.emitters);
-    let pat = make_pattern(PatternKind::Random, 22);
-    let mut out = Vec::new();
-    for (i, ray) in rays.iter().enumerate() {
-        let (Some(h), Some(p)) = (g.intersect(ray), em.primitive((i % em.len()) as u32)) else {
-            continue;
-        };
-        let u = pat.sample_2d(UVec2::new(i as u32, 0), 0, 0, 1);
-        let (a, b) = if u.x + u.y > 1.0 {
-            (1.0 - u.x, 1.0 - u.y)
-        } else {
-            (u.x, u.y)
-        };
-        let target = p.p[0] + (p.p[1] - p.p[0]) * a + (p.p[2] - p.p[0]) * b;
-        let o = h.spawn_origin(target - h.p);
-        out.push(Ray {
-            o,
-            d: target - o,
-            t_max: 1.0 - 1e-4,
-        });
-    }
-    out
-}
-
 #[test]
 fn ray_packet_lanes_round_trip() {
     let rays = random_rays((Vec3::ZERO, Vec3::ONE), PACKET as u32, 3);
@@ -129,7 +102,7 @@ fn soa_packets_match_aos_packets_on_cornell() {
     let cam = camera_packet_rays(&scene, 300, 21);
     let (hits, _) = check(&scene.geometry, &cam);
     assert!(hits > 1500, "{hits} camera hits");
-    let shadow = shadow_rays(&scene, &cam);
+    let shadow = secondary_rays(&scene, &cam, false, 22);
     let (_, blocked) = check(&scene.geometry, &shadow);
     assert!(blocked > 50, "{blocked} blocked shadow rays");
     let random = random_rays(scene.geometry.bounds(), 16 * 200, 4);
@@ -144,25 +117,7 @@ fn soa_packets_match_aos_packets_with_ties_and_quadrics() {
     let scene = builtin_scene("dense", Some(5_000));
     let g = &scene.geometry;
     // Coherent packets aimed at shared vertices and edge midpoints: exact ties on equal t.
-    let pat = make_pattern(PatternKind::Random, 23);
-    let (lo, hi) = g.bounds();
-    let mut aimed = Vec::new();
-    for k in 0..200u32 {
-        let a = pat.sample_2d(UVec2::new(k, 0), 0, 0, 1);
-        let b = pat.sample_2d(UVec2::new(k, 0), 1, 0, 1);
-        let o = lo + (hi - lo) * Vec3::new(a.x, a.y, b.x);
-        for s in 0..PACKET as u32 {
-            let p = g
-                .primitive((k * 131 + s * 7) % g.len() as u32)
-                .expect("index below len");
-            let target = if s % 2 == 0 {
-                p.p[0]
-            } else {
-                (p.p[0] + p.p[1]) * 0.5
-            };
-            aimed.push(Ray::new(o, target - o));
-        }
-    }
+    let aimed = tie_rays(g, 200, 23);
     assert!(check(g, &aimed).0 > 1000);
     let q = soup_with_quadrics(1000, 0.6, 0.8);
     let random = random_rays(q.bounds(), 16 * 200, 8);

@@ -7,13 +7,12 @@
 mod geometry_support;
 
 use geometry_support::{
-    brute_force_t, builtin_scene, camera_packet_rays, random_rays, soup_with_quadrics,
+    brute_force_t, builtin_scene, camera_packet_rays, random_rays, soup_with_quadrics, tie_rays,
 };
-use glam::{UVec2, Vec3};
+use glam::Vec3;
 use penumbra::geometry::RayQuery;
 use penumbra::geometry::{Geometry, HitColumns, PACKET, Ray, RayPacket, SurfaceHit};
 use penumbra::isa::Isa;
-use penumbra::sampling::{PatternKind, make_pattern};
 
 /// Active masks cycled through the packets: full, partial, single lanes, none.
 const MASKS: [u32; 6] = [0xffff, 0xa5c3, 0x0001, 0x8000, 0x7ffe, 0];
@@ -132,25 +131,7 @@ fn hit_columns_match_rows_with_ties_and_quadrics() {
     let scene = builtin_scene("dense", Some(5_000));
     let g = &scene.geometry;
     // Coherent packets aimed at shared vertices and edge midpoints: exact ties on equal t.
-    let pat = make_pattern(PatternKind::Random, 33);
-    let (lo, hi) = g.bounds();
-    let mut aimed = Vec::new();
-    for k in 0..200u32 {
-        let a = pat.sample_2d(UVec2::new(k, 0), 0, 0, 1);
-        let b = pat.sample_2d(UVec2::new(k, 0), 1, 0, 1);
-        let o = lo + (hi - lo) * Vec3::new(a.x, a.y, b.x);
-        for s in 0..PACKET as u32 {
-            let p = g
-                .primitive((k * 131 + s * 7) % g.len() as u32)
-                .expect("index below len");
-            let target = if s % 2 == 0 {
-                p.p[0]
-            } else {
-                (p.p[0] + p.p[1]) * 0.5
-            };
-            aimed.push(Ray::new(o, target - o));
-        }
-    }
+    let aimed = tie_rays(g, 200, 33);
     assert!(check(g, &aimed) > 1000);
     let q = soup_with_quadrics(1000, 0.6, 0.8);
     let random = random_rays(q.bounds(), 16 * 200, 9);

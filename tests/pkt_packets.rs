@@ -8,14 +8,13 @@
 mod geometry_support;
 
 use geometry_support::{
-    brute_force_t, builtin_scene, camera_packet_rays, random_rays, soup_with_quadrics,
-    triangle_soup,
+    brute_force_t, builtin_scene, camera_packet_rays, random_rays, secondary_rays,
+    soup_with_quadrics, tie_rays, triangle_soup,
 };
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::{Backend, Geometry, MeshShading, PACKET, Primitive, Ray, RayQuery};
 use penumbra::isa::Isa;
 use penumbra::sampling::{PatternKind, make_pattern};
-use penumbra::scene::Scene;
 
 /// Active masks cycled through the packets: full, partial, single lanes.
 const MASKS: [u32; 5] = [0xffff, 0xa5c3, 0x0001, 0x8000, 0x7ffe];
@@ -76,43 +75,11 @@ fn check_on(g: &Geometry, rays: &[Ray], isa: Isa) -> u32 {
     hits
 }
 
-/// For each closest hit of `rays`: a shadow ray to a random point of an emitter triangle
-/// (t_max < 1) and a ray leaving the surface exactly at the hit point.
-fn secondary_rays(scene: &Scene, rays: &[Ray]) -> Vec<Ray> {
-    let g = &scene.geometry;
-    let em = &scene.emitters;
-    let pat = make_pattern(PatternKind::Random, 12);
-    let mut out = Vec::new();
-    for (i, ray) in rays.iter().enumerate() {
-        let Some(h) = g.intersect(ray) else {
-            continue;
-        };
-        let u = pat.sample_2d(UVec2::new(i as u32, 0), 0, 0, 1);
-        let Some(p) = em.primitive((i % em.len().max(1)) as u32) else {
-            continue;
-        };
-        let (a, b) = if u.x + u.y > 1.0 {
-            (1.0 - u.x, 1.0 - u.y)
-        } else {
-            (u.x, u.y)
-        };
-        let target = p.p[0] + (p.p[1] - p.p[0]) * a + (p.p[2] - p.p[0]) * b;
-        let o = h.spawn_origin(target - h.p);
-        out.push(Ray {
-            o,
-            d: target - o,
-            t_max: 1.0 - 1e-4,
-        });
-        out.push(Ray::new(h.p, -ray.d.reflect(h.ng)));
-    }
-    out
-}
-
 #[test]
 fn packets_match_scalar_queries_on_cornell_for_every_backend() {
     let scene = builtin_scene("cornell", None);
     let cam = camera_packet_rays(&scene, 400, 11);
-    let shadow = secondary_rays(&scene, &cam);
+    let shadow = secondary_rays(&scene, &cam, true, 12);
     let random = random_rays(scene.geometry.bounds(), 16 * 400, 3);
     for backend in [Backend::Wide, Backend::Own, Backend::Obvhs] {
         let g = scene.geometry.rebuild(backend);
@@ -131,27 +98,9 @@ fn packets_match_scalar_queries_on_a_dense_mesh_with_ties() {
     let g = &scene.geometry;
     let cam = camera_packet_rays(&scene, 200, 11);
     assert!(check(g, &cam) > 1000);
-    assert!(check(g, &secondary_rays(&scene, &cam)) > 100);
+    assert!(check(g, &secondary_rays(&scene, &cam, true, 12)) > 100);
     // Coherent packets aimed at shared vertices and edge midpoints: exact ties on equal t.
-    let pat = make_pattern(PatternKind::Random, 9);
-    let (lo, hi) = g.bounds();
-    let mut aimed = Vec::new();
-    for k in 0..400u32 {
-        let a = pat.sample_2d(UVec2::new(k, 0), 0, 0, 1);
-        let b = pat.sample_2d(UVec2::new(k, 0), 1, 0, 1);
-        let o = lo + (hi - lo) * Vec3::new(a.x, a.y, b.x);
-        for s in 0..PACKET as u32 {
-            let Some(p) = g.primitive((k * 131 + s * 7) % g.len() as u32) else {
-                continue;
-            };
-            let target = if s % 2 == 0 {
-                p.p[0]
-            } else {
-                (p.p[0] + p.p[1]) * 0.5
-            };
-            aimed.push(Ray::new(o, target - o));
-        }
-    }
+    let aimed = tie_rays(g, 400, 9);
     assert!(check(g, &aimed) > 1000);
     let own = g.rebuild(Backend::Own);
     assert!(check(&own, &aimed[..16 * 50]) > 100);

@@ -2,8 +2,9 @@
 
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::triangle::intersect_triangle;
-use penumbra::geometry::{Geometry, PrimKind, Primitive, Ray};
-use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere};
+use penumbra::geometry::{Geometry, PrimKind, Primitive, Ray, RayQuery};
+use penumbra::integrator::direct::shadow_ray;
+use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere, uniform_triangle_point};
 use penumbra::scene::Scene;
 
 /// Uniform random rays from points in the (enlarged) scene box, a third of them finite.
@@ -140,4 +141,57 @@ pub fn camera_packet_rays(scene: &Scene, pixels: u32, seed: u64) -> Vec<Ray> {
         }
     }
     rays
+}
+
+/// For each closest hit of `rays` in `scene`: a shadow ray (as the integrator makes them) to a
+/// random point of an emitter triangle, and with `reflected` also a ray leaving the surface
+/// exactly at the hit point; patterns of seed `seed`.
+#[allow(dead_code)] // As above.
+pub fn secondary_rays(scene: &Scene, rays: &[Ray], reflected: bool, seed: u64) -> Vec<Ray> {
+    let (g, em) = (&scene.geometry, &scene.emitters);
+    let pat = make_pattern(PatternKind::Random, seed);
+    let mut out = Vec::new();
+    for (i, ray) in rays.iter().enumerate() {
+        let Some(h) = g.intersect(ray) else {
+            continue;
+        };
+        let Some(p) = em.primitive((i % em.len().max(1)) as u32) else {
+            continue;
+        };
+        let u = pat.sample_2d(UVec2::new(i as u32, 0), 0, 0, 1);
+        out.push(shadow_ray(
+            &h,
+            uniform_triangle_point(u, p.p[0], p.p[1], p.p[2]),
+        ));
+        if reflected {
+            out.push(Ray::new(h.p, -ray.d.reflect(h.ng)));
+        }
+    }
+    out
+}
+
+/// `packets` coherent packets from random points of `g`'s box aimed at shared vertices and
+/// edge midpoints of its primitives: rays with exact ties between primitives at equal t.
+#[allow(dead_code)] // As above.
+pub fn tie_rays(g: &Geometry, packets: u32, seed: u64) -> Vec<Ray> {
+    let pat = make_pattern(PatternKind::Random, seed);
+    let (lo, hi) = g.bounds();
+    let mut aimed = Vec::new();
+    for k in 0..packets {
+        let a = pat.sample_2d(UVec2::new(k, 0), 0, 0, 1);
+        let b = pat.sample_2d(UVec2::new(k, 0), 1, 0, 1);
+        let o = lo + (hi - lo) * Vec3::new(a.x, a.y, b.x);
+        for s in 0..penumbra::geometry::PACKET as u32 {
+            let Some(p) = g.primitive((k * 131 + s * 7) % g.len().max(1) as u32) else {
+                continue;
+            };
+            let target = if s % 2 == 0 {
+                p.p[0]
+            } else {
+                (p.p[0] + p.p[1]) * 0.5
+            };
+            aimed.push(Ray::new(o, target - o));
+        }
+    }
+    aimed
 }
