@@ -425,9 +425,9 @@ pub const SPARSE: u32 = 4;
 /// The lanes of a packet as a mask.
 const PACKET_MASK: u32 = ((1u64 << PACKET) - 1) as u32;
 
-/// Indices of the set bits of `m`, lowest first.
+/// Indices of the set bits of `m`, lowest first: the lanes of a packet mask.
 #[inline(always)]
-pub(super) fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+pub fn bits(mut m: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         if m == 0 {
             return None;

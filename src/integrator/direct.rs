@@ -11,6 +11,7 @@ use super::{MisHeuristic, Strategy};
 use crate::Rgb;
 use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
+use crate::geometry::packet::bits;
 use crate::geometry::{PACKET, Ray, RayPacket, SurfaceHit};
 use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
 use crate::lights::{Emitter, Light, LightLiSample, LightSampleContext, LightSource, SamplingMode};
@@ -174,7 +175,8 @@ impl BsdfRay {
 /// The working arrays of [`DirectLighting::li_packet`], made once per render thread's tile
 /// instead of per packet (every lane a packet reads is written first by that packet).
 pub struct PacketScratch {
-    first: [Draws; PACKET],
+    /// Each lane's draws for the current round of shadow rays.
+    drawn: [Draws; PACKET],
     hits: [Option<SurfaceHit>; PACKET],
     lanes: [Option<LaneShading>; PACKET],
     emitter_hits: [Option<SurfaceHit>; PACKET],
@@ -196,7 +198,7 @@ impl PacketScratch {
     /// Fresh working arrays.
     pub fn new() -> Self {
         Self {
-            first: [Draws::default(); PACKET],
+            drawn: [Draws::default(); PACKET],
             hits: [None; PACKET],
             lanes: [const { None }; PACKET],
             emitter_hits: [None; PACKET],
@@ -295,7 +297,7 @@ impl<'a> DirectLighting<'a> {
     ) -> u64 {
         let scene = self.scene;
         let PacketScratch {
-            first,
+            drawn,
             hits,
             lanes,
             emitter_hits,
@@ -327,9 +329,9 @@ impl<'a> DirectLighting<'a> {
                 )
             };
         }
-        // The first sample's draws are pure arithmetic that does not depend on the hits:
+        // The first round's draws are pure arithmetic that does not depend on the hits:
         // issued before the camera rays' traversal, they overlap with its memory-bound work.
-        for (k, d) in first.iter_mut().enumerate().take(n) {
+        for (k, d) in drawn.iter_mut().enumerate().take(n) {
             *d = draws!(k, 0);
         }
         scene
@@ -338,8 +340,8 @@ impl<'a> DirectLighting<'a> {
         let mut rays = n as u64;
         let isa = scene.geometry.isa();
         // The hits' shading geometry for all lanes at once, then each lane's emission and
-        // BSDF; Lambertian receivers go to the lane kernels (their light samples when triangle
-        // lights, and their BSDF rays).
+        // BSDF; Lambertian receivers go to the lane kernels (their triangle-light samples and
+        // their BSDF rays).
         rx.shade(&cam.rays, isa);
         rx.diffuse = 0;
         for k in 0..n {
@@ -377,9 +379,9 @@ impl<'a> DirectLighting<'a> {
                 let Some(lane) = &lanes[k] else { continue };
                 let Some(hit) = &hits[k] else { continue };
                 if j > 0 {
-                    first[k] = draws!(k, j);
+                    drawn[k] = draws!(k, j);
                 }
-                let d = &first[k];
+                let d = &drawn[k];
                 let diffuse = rx.diffuse >> k & 1 != 0;
                 if use_light {
                     let sel = match uniform {
@@ -423,7 +425,7 @@ impl<'a> DirectLighting<'a> {
                     continue;
                 };
                 let sh = lane.view(k, hit, rx);
-                if let Some((r, v)) = self.light_sample(&sh, picked[k], first[k].light, mis) {
+                if let Some((r, v)) = self.light_sample(&sh, picked[k], drawn[k].light, mis) {
                     light.set(k, &r, v);
                     rays += 1;
                 }
@@ -434,7 +436,7 @@ impl<'a> DirectLighting<'a> {
                 };
                 let px = &pxs[cam.pixel[k] as usize];
                 let lobe = px.sample_1d(DIM_LOBE, cam.eye[k] * m + j, count);
-                if let Some(b) = self.bsdf_ray(&lane.view(k, hit, rx), lobe, first[k].bsdf) {
+                if let Some(b) = self.bsdf_ray(&lane.view(k, hit, rx), lobe, drawn[k].bsdf) {
                     rays += 1;
                     sampled.set(k, &b);
                 }
@@ -690,18 +692,6 @@ pub(super) fn bsdf_ray_of(
         weight,
         pdf: bs.pdf,
         delta: bs.delta,
-    })
-}
-
-/// Indices of the set bits of `m`, lowest first.
-#[inline]
-fn bits(mut m: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (m != 0).then(|| {
-            let k = m.trailing_zeros() as usize;
-            m &= m - 1;
-            k
-        })
     })
 }
 
