@@ -41,25 +41,3 @@ fn sin_cos_turn_exact_at_quadrants() {
     let (s, c) = sin_cos_turn(0.75);
     assert_eq!((s, c.abs()), (-1.0, 0.0));
 }
-
-/// The f64 sincos of the spherical-triangle sampler matches libm to a few f64 ulps over the
-/// solid angles it sees (0 ≤ x ≤ 4π), and defers to libm outside its range.
-#[test]
-fn sin_cos_small_f64_matches_libm() {
-    use penumbra::sampling::warps::sin_cos_small_f64;
-    let n = 1 << 20;
-    let mut max_err = 0.0f64;
-    for i in 0..=n {
-        let x = 8.0 * i as f64 / n as f64;
-        let (s, c) = sin_cos_small_f64(x);
-        let (se, ce) = x.sin_cos();
-        max_err = max_err.max((s - se).abs()).max((c - ce).abs());
-    }
-    println!("max abs error {max_err:e}");
-    assert!(max_err <= 1e-15, "max abs error {max_err:e} > 1e-15");
-    for x in [-1.0, 9.0, 100.0, f64::NAN] {
-        let (s, c) = sin_cos_small_f64(x);
-        let (se, ce) = x.sin_cos();
-        assert!(s.to_bits() == se.to_bits() && c.to_bits() == ce.to_bits() || x.is_nan());
-    }
-}

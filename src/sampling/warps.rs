@@ -59,16 +59,6 @@ pub fn sin_cos_turn(t: f32) -> (f32, f32) {
     )
 }
 
-/// `(sin x, cos x)` in f64 for 0 ≤ x ≤ 8 (solid angles: at most 4π), without the libm
-/// `sincos` call (≈ 85 instructions per spherical-triangle sample); other x go to libm.
-/// The arithmetic is [`sin_cos_0_8_f64`]'s; only the range check and fallback are added.
-pub fn sin_cos_small_f64(x: f64) -> (f64, f64) {
-    if !(0.0..=8.0).contains(&x) {
-        return x.sin_cos();
-    }
-    sin_cos_0_8_f64(x)
-}
-
 /// `(sin x, cos x)` in f64 for 0 ≤ x ≤ 8 only (the caller guarantees the range; outside it
 /// the result is inaccurate, never UB). Pure arithmetic and selects, always inlined, so a loop
 /// over lanes of Arvo's sampler (x = ξ₁Ω ∈ [0, 2π]) vectorises.
