@@ -126,7 +126,7 @@ pub fn render(
                     };
                 // Per lane: the pixel and filter draw; the camera rays of a full packet are then
                 // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
-                let mut lanes = Lanes::new();
+                let mut lanes = CameraLanes::new();
                 for y in y0..y1 {
                     for x in x0..x1 {
                         let pixel = UVec2::new(x, y);
@@ -187,14 +187,14 @@ pub fn render(
 }
 
 /// The camera samples of a packet's lanes before their rays are made.
-struct Lanes {
+struct CameraLanes {
     /// Per lane: the pixel.
     pixel: [UVec2; PACKET],
     /// Per lane: the pixel-filter draw.
     u: [Vec2; PACKET],
 }
 
-impl Lanes {
+impl CameraLanes {
     fn new() -> Self {
         Self {
             pixel: [UVec2::ZERO; PACKET],
@@ -218,7 +218,7 @@ impl Lanes {
         }
     }
 
-    /// [`Lanes::rays`] as plain loops over the lanes, which the compiler vectorises.
+    /// [`CameraLanes::rays`] as plain loops over the lanes, which the compiler vectorises.
     #[inline(always)]
     fn rays_portable(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
         let o = Ray::new(camera.origin(), Vec3::Z);
@@ -228,14 +228,14 @@ impl Lanes {
         }
     }
 
-    /// [`Lanes::rays_portable`] compiled for AVX-512 (16 lanes = one vector).
+    /// [`CameraLanes::rays_portable`] compiled for AVX-512 (16 lanes = one vector).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
     fn rays_avx512(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
         self.rays_portable(camera, filter, ray)
     }
 
-    /// [`Lanes::rays_portable`] compiled for AVX2.
+    /// [`CameraLanes::rays_portable`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn rays_avx2(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
@@ -267,7 +267,7 @@ mod tests {
         for filter in [Filter::Box { radius }, Filter::Triangle { radius }] {
             for isa in Isa::available() {
                 for packet in 0..8u32 {
-                    let mut lanes = Lanes::new();
+                    let mut lanes = CameraLanes::new();
                     for k in 0..PACKET {
                         let n = packet * PACKET as u32 + k as u32;
                         lanes.pixel[k] = UVec2::new(n % 97, (n / 3) % 61);
