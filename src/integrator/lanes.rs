@@ -1,98 +1,34 @@
-//! Structure-of-arrays kernels for the packet estimator's commonest case: a Lambertian
-//! receiver lit by a triangle light (sampled by area or by solid angle), and its
+//! The vector kernels of the commonest work items: a Lambertian receiver's shading geometry,
+//! its light samples of triangle lights (by area or by solid angle, with MIS) and its
 //! cosine-sampled BSDF rays.
 //!
-//! Lane by lane these run the very functions the per-lane path runs (the triangle's
-//! `sample_li`, [`light_estimate`], the Lambertian `sample`, [`bsdf_ray_of`]), so each lane's
-//! bits are the per-lane path's. What changes is the layout: each input and output is an array
-//! over the packet's lanes, so the loop over lanes compiles to 16-wide (AVX-512), 8-wide (AVX2)
-//! or 4-wide (SSE2) vector code instead of one lane at a time, whose chains of square roots
-//! and divisions left the CPU waiting.
+//! Lane by lane these run the very functions of the per-lane path (`ShadingGeometry::new`, the
+//! triangle's `sample_li`, [`light_estimate`], the Lambertian `sample`, [`bsdf_ray_of`]), so
+//! each lane's bits are the per-lane path's; they hold no maths of their own. What changes is
+//! the layout: each input and output is an array over the packet's lanes, so the loop over
+//! lanes compiles to 16-wide (AVX-512), 8-wide (AVX2) or 4-wide (SSE2) vector code instead of
+//! one lane at a time, whose chains of square roots and divisions left the CPU waiting.
+//!
+//! Which work item goes to a kernel is decided by the light ([`Light::lane_kind`]) and the BSDF
+//! ([`Bsdf::lane_kind`]); the kernels' input queues ([`TriangleLightLanes`],
+//! [`DiffuseBsdfLanes`]) live here, their outputs are the stages' queues.
+//!
+//! [`Light::lane_kind`]: crate::lights::Light::lane_kind
+//! [`Bsdf::lane_kind`]: crate::bsdf::Bsdf::lane_kind
 
 use super::MisHeuristic;
-use super::direct::{BsdfRay, bsdf_ray_of, light_estimate};
+use super::estimator::{BsdfRay, bsdf_ray_of, light_estimate};
+use super::queues::{BsdfRays, Lanes, Receivers, ShadowRays, V3, col};
 use crate::Rgb;
-use crate::bsdf::{Bxdf, Lambert, LobeSampling};
-use crate::geometry::{Geometry, HitColumns, PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
+use crate::bsdf::{Bxdf, Lambert};
+use crate::geometry::packet::bits;
+use crate::geometry::{PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
 use crate::isa::Isa;
 use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
 use crate::sampling::Frame;
 use glam::{Vec2, Vec3};
 
-/// One f32 per lane.
-type Lanes = [f32; PACKET];
-
-/// One `Vec3` per lane, as three coordinate arrays (contiguous across lanes).
-#[derive(Clone, Copy)]
-struct V3 {
-    x: Lanes,
-    y: Lanes,
-    z: Lanes,
-}
-
-impl V3 {
-    const ZERO: V3 = V3 {
-        x: [0.0; PACKET],
-        y: [0.0; PACKET],
-        z: [0.0; PACKET],
-    };
-
-    #[inline(always)]
-    fn get(&self, k: usize) -> Vec3 {
-        Vec3::new(self.x[k], self.y[k], self.z[k])
-    }
-
-    #[inline(always)]
-    fn set(&mut self, k: usize, v: Vec3) {
-        self.x[k] = v.x;
-        self.y[k] = v.y;
-        self.z[k] = v.z;
-    }
-}
-
-/// Lane k of a column triple.
-#[inline(always)]
-fn col(c: &[Lanes; 3], k: usize) -> Vec3 {
-    Vec3::new(c[0][k], c[1][k], c[2][k])
-}
-
-/// The receivers of a packet: each hit's shading geometry (computed for all lanes at once by
-/// [`Self::shade`]) and, for the Lambertian ones, what the kernels read. Bit k of `diffuse`
-/// marks lane k as a Lambertian receiver.
-#[derive(Clone, Copy)]
-pub(super) struct Receivers {
-    /// Lanes whose receiver is Lambertian with cosine sampling.
-    pub(super) diffuse: u32,
-    /// The hits' points, normals and error bounds, written by the camera-ray query itself.
-    pub(super) cols: HitColumns,
-    wo: V3,
-    front: [bool; PACKET],
-    /// Geometric normal facing the viewer (the light-sample context's).
-    n: V3,
-    s: V3,
-    t: V3,
-    sn: V3,
-    wo_local: V3,
-    albedo: V3,
-}
-
 impl Receivers {
-    /// No lanes loaded.
-    pub(super) fn new() -> Self {
-        Self {
-            diffuse: 0,
-            cols: HitColumns::new(),
-            wo: V3::ZERO,
-            front: [false; PACKET],
-            n: V3::ZERO,
-            s: V3::ZERO,
-            t: V3::ZERO,
-            sn: V3::ZERO,
-            wo_local: V3::ZERO,
-            albedo: V3::ZERO,
-        }
-    }
-
     /// Every lane's [`ShadingGeometry`] seen along `rays` (lanes without a hit too: theirs
     /// are ignored), on `isa`.
     pub(super) fn shade(&mut self, rays: &RayPacket, isa: Isa) {
@@ -157,16 +93,6 @@ impl Receivers {
         }
     }
 
-    /// Mark lane k as diffuse if its BSDF `b` is one the kernels evaluate (Lambertian, not
-    /// sampled uniformly).
-    #[inline]
-    pub(super) fn set_diffuse(&mut self, k: usize, b: &Lambert) {
-        if b.sampling != LobeSampling::Uniform {
-            self.diffuse |= 1 << k;
-            self.albedo.set(k, b.r);
-        }
-    }
-
     /// Lane k's hit, context, frame, local wo and BSDF as the per-lane path has them (fields
     /// the estimators do not read are left zero).
     #[inline(always)]
@@ -191,12 +117,7 @@ impl Receivers {
             t: self.t.get(k),
             n: self.sn.get(k),
         };
-        // Importance and cosine sampling coincide for a Lambertian BSDF.
-        let lambert = Lambert {
-            r: self.albedo.get(k),
-            sampling: LobeSampling::Importance,
-        };
-        (hit, ctx, frame, self.wo_local.get(k), lambert)
+        (hit, ctx, frame, self.wo_local.get(k), self.lambert(k))
     }
 }
 
@@ -256,7 +177,7 @@ impl TriangleLightLanes {
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
         isa: Isa,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) -> u32 {
         match isa {
             #[cfg(target_arch = "x86_64")]
@@ -283,7 +204,7 @@ impl TriangleLightLanes {
         rx: &Receivers,
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) {
         self.dispatch(rx, mis, mode, out)
     }
@@ -295,7 +216,7 @@ impl TriangleLightLanes {
         rx: &Receivers,
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) {
         self.dispatch(rx, mis, mode, out)
     }
@@ -308,7 +229,7 @@ impl TriangleLightLanes {
         rx: &Receivers,
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) {
         use SamplingMode::{Area, SolidAngle};
         match (mis, mode) {
@@ -336,7 +257,7 @@ impl TriangleLightLanes {
         rx: &Receivers,
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
@@ -392,18 +313,21 @@ impl DiffuseBsdfLanes {
         }
     }
 
-    /// Load lane k with direction draw `u`.
-    #[inline]
-    pub(super) fn load(&mut self, k: usize, u: Vec2) {
-        self.active |= 1 << k;
-        self.u[0][k] = u.x;
-        self.u[1][k] = u.y;
+    /// Load the lanes `on` (and no others), lane k with direction draw `u(k)`.
+    #[inline(always)]
+    pub(super) fn load(&mut self, on: u32, u: impl Fn(usize) -> Vec2) {
+        self.active = on;
+        for k in bits(on) {
+            let u = u(k);
+            self.u[0][k] = u.x;
+            self.u[1][k] = u.y;
+        }
     }
 
     /// Every lane's ray (loaded or not) on instruction set `isa`, written to all the lanes of
     /// `out` (so before any lane's own); the loaded lanes with a ray become active there.
     /// Returns their number.
-    pub(super) fn run(&mut self, rx: &Receivers, isa: Isa, out: &mut Sampled) -> u32 {
+    pub(super) fn run(&mut self, rx: &Receivers, isa: Isa, out: &mut BsdfRays) -> u32 {
         match isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx512 => {
@@ -424,19 +348,19 @@ impl DiffuseBsdfLanes {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn run_avx512(&mut self, rx: &Receivers, out: &mut Sampled) {
+    unsafe fn run_avx512(&mut self, rx: &Receivers, out: &mut BsdfRays) {
         self.body(rx, out)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&mut self, rx: &Receivers, out: &mut Sampled) {
+    unsafe fn run_avx2(&mut self, rx: &Receivers, out: &mut BsdfRays) {
         self.body(rx, out)
     }
 
     /// The lane loop.
     #[inline(always)]
-    fn body(&mut self, rx: &Receivers, out: &mut Sampled) {
+    fn body(&mut self, rx: &Receivers, out: &mut BsdfRays) {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let u = Vec2::new(self.u[0][k], self.u[1][k]);
@@ -461,126 +385,6 @@ fn mask_of(b: &[bool; PACKET]) -> u32 {
     b.iter()
         .enumerate()
         .fold(0, |m, (k, &on)| m | (on as u32) << k)
-}
-
-/// One value per lane that counts unless its ray is blocked: the rays go to the geometry as
-/// one packet query, in the lanes the kernels write them to.
-pub(super) struct Pending {
-    /// Lanes with a ray.
-    pub(super) active: u32,
-    rays: RayPacket,
-    value: V3,
-    /// After [`Self::resolve`]: the active lanes whose rays are clear.
-    clear: u32,
-}
-
-impl Pending {
-    /// No lanes active.
-    pub(super) fn new() -> Self {
-        Self {
-            active: 0,
-            rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
-            value: V3::ZERO,
-            clear: 0,
-        }
-    }
-
-    /// Lane k's ray and value, not (yet) active.
-    #[inline(always)]
-    fn put(&mut self, k: usize, ray: &Ray, value: Rgb) {
-        self.rays.set(k, ray);
-        self.value.set(k, value);
-    }
-
-    /// Make lane k active with `ray` and `value`.
-    #[inline]
-    pub(super) fn set(&mut self, k: usize, ray: &Ray, value: Rgb) {
-        self.active |= 1 << k;
-        self.put(k, ray, value);
-    }
-
-    /// Trace the active rays: afterwards [`Self::value`] is the value where the ray is clear.
-    pub(super) fn resolve(&mut self, geometry: &Geometry) {
-        let blocked = if self.active != 0 {
-            geometry.occluded_packet(&self.rays, self.active)
-        } else {
-            0
-        };
-        self.clear = self.active & !blocked;
-    }
-
-    /// Add to `sums` each lane's value where its ray is clear, zero elsewhere, for the lanes
-    /// `on` (valid after [`Self::resolve`]).
-    #[inline]
-    pub(super) fn add_to(&self, on: u32, sums: &mut [Rgb; PACKET]) {
-        for (k, s) in sums.iter_mut().enumerate() {
-            if on >> k & 1 != 0 {
-                let clear = self.clear >> k & 1 != 0;
-                *s += if clear { self.value.get(k) } else { Rgb::ZERO };
-            }
-        }
-    }
-}
-
-/// The BSDF rays of a packet's lanes (bit k of `active`: lane k has one), field by field: the
-/// rays go to the emitter query as they are, and the rest is read only for lanes that reach
-/// an emitter.
-pub(super) struct Sampled {
-    /// Lanes with a ray.
-    pub(super) active: u32,
-    /// The rays.
-    pub(super) rays: RayPacket,
-    weight: V3,
-    pdf: Lanes,
-    /// Bit k: lane k's sample is from a delta lobe.
-    delta: u32,
-}
-
-impl Sampled {
-    /// No lanes active.
-    pub(super) fn new() -> Self {
-        Self {
-            active: 0,
-            rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
-            weight: V3::ZERO,
-            pdf: [0.0; PACKET],
-            delta: 0,
-        }
-    }
-
-    /// Start a new round: no lanes active.
-    #[inline]
-    pub(super) fn clear(&mut self) {
-        self.active = 0;
-        self.delta = 0;
-    }
-
-    /// Lane k's ray, not (yet) active (and not from a delta lobe).
-    #[inline(always)]
-    fn put(&mut self, k: usize, b: &BsdfRay) {
-        self.rays.set(k, &b.ray);
-        self.weight.set(k, b.weight);
-        self.pdf[k] = b.pdf;
-    }
-
-    /// Make lane k active with ray `b`.
-    #[inline]
-    pub(super) fn set(&mut self, k: usize, b: &BsdfRay) {
-        self.active |= 1 << k;
-        self.put(k, b);
-        self.delta |= (b.delta as u32) << k;
-    }
-
-    /// Lane k's ray.
-    #[inline]
-    pub(super) fn get(&self, k: usize) -> BsdfRay {
-        BsdfRay {
-            ray: self.rays.ray(k),
-            weight: self.weight.get(k),
-            pdf: self.pdf[k],
-            delta: self.delta >> k & 1 != 0,
-        }
-    }
 }
 
 #[cfg(test)]
@@ -615,7 +419,7 @@ mod tests {
             rx.cols.p_error[k] = 1e-6 * next_f32(rng);
             rays.set(k, &Ray::new(Vec3::new(0.0, 0.0, -5.0), p - unit(rng) * 3.0));
             let albedo = Vec3::new(next_f32(rng), next_f32(rng), next_f32(rng));
-            rx.set_diffuse(k, &Lambert::new(albedo));
+            rx.set_diffuse(k, albedo);
         }
         rx.shade(&rays, isa);
         (rx, rays)
@@ -670,7 +474,7 @@ mod tests {
                 let mode = [SamplingMode::Area, SamplingMode::SolidAngle][round as usize % 2];
                 let mis = [None, Some(MisHeuristic::Power), Some(MisHeuristic::Balance)]
                     [round as usize % 3];
-                let mut out = Pending::new();
+                let mut out = ShadowRays::new();
                 let n = lanes.run(&rx, mis, mode, isa, &mut out);
                 assert_eq!(n, out.active.count_ones());
                 for (k, (tri, pmf, u)) in tris.iter().enumerate() {
@@ -685,7 +489,7 @@ mod tests {
                         assert_eq!(bits(got.o), bits(ray.o), "{what}");
                         assert_eq!(bits(got.d), bits(ray.d), "{what}");
                         assert_eq!(got.t_max.to_bits(), ray.t_max.to_bits(), "{what}");
-                        assert_eq!(bits(out.value.get(k)), bits(value), "{what}");
+                        assert_eq!(bits(out.value(k)), bits(value), "{what}");
                         checked += 1;
                     }
                 }
@@ -706,10 +510,8 @@ mod tests {
                 let u: Vec<Vec2> = (0..PACKET)
                     .map(|_| Vec2::new(next_f32(&mut rng), next_f32(&mut rng)))
                     .collect();
-                for (k, &u) in u.iter().enumerate() {
-                    lanes.load(k, u);
-                }
-                let mut out = Sampled::new();
+                lanes.load(u32::MAX >> (32 - PACKET), |k| u[k]);
+                let mut out = BsdfRays::new();
                 lanes.run(&rx, isa, &mut out);
                 for (k, &u) in u.iter().enumerate() {
                     let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
