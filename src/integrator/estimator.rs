@@ -281,3 +281,30 @@ pub(super) fn escaped_radiance(
     }
     sum
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn emission_weight_counts_each_direction_once_across_the_two_techniques() {
+        let pdfs = || (2.0, 0.5);
+        let never = || -> (f32, f32) { panic!("pdfs read where no heuristic needs them") };
+        // After the camera or a delta lobe no light sample can produce the direction.
+        for t in [
+            Techniques::Bsdf,
+            Techniques::Light,
+            Techniques::Mis(MisHeuristic::Power),
+        ] {
+            assert_eq!(emission_weight(t, true, never), 1.0, "{t:?}");
+        }
+        assert_eq!(emission_weight(Techniques::Bsdf, false, never), 1.0);
+        assert_eq!(emission_weight(Techniques::Light, false, never), 0.0);
+        for h in [MisHeuristic::Power, MisHeuristic::Balance] {
+            let w = emission_weight(Techniques::Mis(h), false, pdfs);
+            assert_eq!(w, h.weight(2.0, 0.5));
+            // The light sample of the same direction takes the complement.
+            assert!((w + h.weight(0.5, 2.0) - 1.0).abs() < 1e-6, "{h:?}");
+        }
+    }
+}

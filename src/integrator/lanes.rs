@@ -390,6 +390,7 @@ fn mask_of(b: &[bool; PACKET]) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::LobeSampling;
     use crate::sampling::hash::{next_f32, pcg_from_keys};
     use rand_pcg::Pcg32;
 
@@ -449,6 +450,35 @@ mod tests {
 
     fn bits(v: Vec3) -> [u32; 3] {
         v.to_array().map(f32::to_bits)
+    }
+
+    #[test]
+    fn kernels_take_exactly_the_bsdfs_and_lights_they_reproduce() {
+        use crate::bsdf::{Bsdf, LaneBsdf, Mirror};
+        use crate::lights::{LaneLight, Light, PointLight};
+        // The BSDF kernel draws cosine-weighted directions: importance and cosine sampling of a
+        // Lambertian BSDF are that density, uniform sampling is not.
+        let r = Vec3::new(0.2, 0.5, 0.7);
+        for (s, kernel) in [
+            (LobeSampling::Importance, true),
+            (LobeSampling::Cosine, true),
+            (LobeSampling::Uniform, false),
+        ] {
+            let b = Bsdf::Lambert(Lambert { r, sampling: s });
+            match b.lane_kind() {
+                Some(LaneBsdf::Lambert(a)) => assert!(kernel && a == r, "{s:?}"),
+                None => assert!(!kernel, "{s:?}"),
+            }
+        }
+        assert!(Bsdf::Mirror(Mirror { r: Vec3::ONE }).lane_kind().is_none());
+        let v = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let tri = TriangleLight::new(v, Vec3::Z, Vec3::ONE, false).expect("has an area");
+        assert!(matches!(
+            Light::Triangle(tri).lane_kind(),
+            Some(LaneLight::Triangle(_))
+        ));
+        let point = Light::Point(PointLight::new(Vec3::ZERO, Vec3::ONE));
+        assert!(point.lane_kind().is_none());
     }
 
     #[test]
