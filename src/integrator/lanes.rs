@@ -21,7 +21,6 @@ use super::estimator::{BsdfRay, bsdf_ray_of, light_estimate};
 use super::queues::{BsdfRays, Lanes, Receivers, ShadowRays, V3, col};
 use crate::Rgb;
 use crate::bsdf::{Bxdf, Lambert};
-use crate::geometry::packet::bits;
 use crate::geometry::{PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
 use crate::isa::Isa;
 use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
@@ -126,7 +125,6 @@ impl Receivers {
 pub(super) struct TriangleLightLanes {
     /// Loaded lanes.
     pub(super) active: u32,
-    u: [Lanes; 2],
     pmf: Lanes,
     v: [V3; 3],
     n: V3,
@@ -141,7 +139,6 @@ impl TriangleLightLanes {
     pub(super) fn new() -> Self {
         Self {
             active: 0,
-            u: [[0.0; PACKET]; 2],
             pmf: [0.0; PACKET],
             v: [V3::ZERO; 3],
             n: V3::ZERO,
@@ -152,12 +149,10 @@ impl TriangleLightLanes {
         }
     }
 
-    /// Load lane k: light `tri` picked with probability `pmf`, sampled with `u`.
+    /// Load lane k: light `tri` picked with probability `pmf`.
     #[inline]
-    pub(super) fn load(&mut self, k: usize, tri: &TriangleLight, pmf: f32, u: Vec2) {
+    pub(super) fn load(&mut self, k: usize, tri: &TriangleLight, pmf: f32) {
         self.active |= 1 << k;
-        self.u[0][k] = u.x;
-        self.u[1][k] = u.y;
         self.pmf[k] = pmf;
         for (v, p) in self.v.iter_mut().zip(tri.p) {
             v.set(k, p);
@@ -168,12 +163,15 @@ impl TriangleLightLanes {
         self.two_sided[k] = tri.two_sided;
     }
 
-    /// Every lane's estimate (loaded or not) sampled in `mode`, MIS-weighted by `mis` when
-    /// given, on instruction set `isa`, written to all the lanes of `out` (so before any lane's
-    /// own); the loaded lanes with an estimate become active there. Returns their number.
+    /// Every lane's estimate (loaded or not) sampled in `mode` with the draws `u` (lane k:
+    /// `(u[0][k], u[1][k])`), MIS-weighted by `mis` when given, on instruction set `isa`,
+    /// written to all the lanes of `out` (so before any lane's own); the loaded lanes with an
+    /// estimate become active there. Returns their number.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn run(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
         isa: Isa,
@@ -183,14 +181,14 @@ impl TriangleLightLanes {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx512 => {
                 // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx, mis, mode, out) }
+                unsafe { self.run_avx512(rx, u, mis, mode, out) }
             }
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => {
                 // SAFETY: as above.
-                unsafe { self.run_avx2(rx, mis, mode, out) }
+                unsafe { self.run_avx2(rx, u, mis, mode, out) }
             }
-            _ => self.dispatch(rx, mis, mode, out),
+            _ => self.dispatch(rx, u, mis, mode, out),
         }
         let ok = mask_of(&self.ok) & self.active;
         out.active |= ok;
@@ -202,11 +200,12 @@ impl TriangleLightLanes {
     unsafe fn run_avx512(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
         out: &mut ShadowRays,
     ) {
-        self.dispatch(rx, mis, mode, out)
+        self.dispatch(rx, u, mis, mode, out)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -214,11 +213,12 @@ impl TriangleLightLanes {
     unsafe fn run_avx2(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
         out: &mut ShadowRays,
     ) {
-        self.dispatch(rx, mis, mode, out)
+        self.dispatch(rx, u, mis, mode, out)
     }
 
     /// One copy of the lane loop per (`mis`, `mode`), each with both constant, so each loop
@@ -227,25 +227,26 @@ impl TriangleLightLanes {
     fn dispatch(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
         out: &mut ShadowRays,
     ) {
         use SamplingMode::{Area, SolidAngle};
         match (mis, mode) {
-            (None, Area) => self.body(rx, None, Area, out),
-            (None, SolidAngle) => self.body(rx, None, SolidAngle, out),
+            (None, Area) => self.body(rx, u, None, Area, out),
+            (None, SolidAngle) => self.body(rx, u, None, SolidAngle, out),
             (Some(MisHeuristic::Power), Area) => {
-                self.body(rx, Some(MisHeuristic::Power), Area, out)
+                self.body(rx, u, Some(MisHeuristic::Power), Area, out)
             }
             (Some(MisHeuristic::Power), SolidAngle) => {
-                self.body(rx, Some(MisHeuristic::Power), SolidAngle, out)
+                self.body(rx, u, Some(MisHeuristic::Power), SolidAngle, out)
             }
             (Some(MisHeuristic::Balance), Area) => {
-                self.body(rx, Some(MisHeuristic::Balance), Area, out)
+                self.body(rx, u, Some(MisHeuristic::Balance), Area, out)
             }
             (Some(MisHeuristic::Balance), SolidAngle) => {
-                self.body(rx, Some(MisHeuristic::Balance), SolidAngle, out)
+                self.body(rx, u, Some(MisHeuristic::Balance), SolidAngle, out)
             }
         }
     }
@@ -255,6 +256,7 @@ impl TriangleLightLanes {
     fn body(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
         out: &mut ShadowRays,
@@ -268,7 +270,7 @@ impl TriangleLightLanes {
                 l: self.l.get(k),
                 two_sided: self.two_sided[k],
             };
-            let u = Vec2::new(self.u[0][k], self.u[1][k]);
+            let u = Vec2::new(u[0][k], u[1][k]);
             // A match, not `and_then`: the closure is not always inlined, and one call in
             // the loop keeps it from vectorising.
             let est = match tri.sample_li(&ctx, u, mode) {
@@ -299,7 +301,6 @@ impl TriangleLightLanes {
 pub(super) struct DiffuseBsdfLanes {
     /// Loaded lanes.
     pub(super) active: u32,
-    u: [Lanes; 2],
     ok: [bool; PACKET],
 }
 
@@ -308,38 +309,32 @@ impl DiffuseBsdfLanes {
     pub(super) fn new() -> Self {
         Self {
             active: 0,
-            u: [[0.0; PACKET]; 2],
             ok: [false; PACKET],
         }
     }
 
-    /// Load the lanes `on` (and no others), lane k with direction draw `u(k)`.
-    #[inline(always)]
-    pub(super) fn load(&mut self, on: u32, u: impl Fn(usize) -> Vec2) {
-        self.active = on;
-        for k in bits(on) {
-            let u = u(k);
-            self.u[0][k] = u.x;
-            self.u[1][k] = u.y;
-        }
-    }
-
-    /// Every lane's ray (loaded or not) on instruction set `isa`, written to all the lanes of
-    /// `out` (so before any lane's own); the loaded lanes with a ray become active there.
-    /// Returns their number.
-    pub(super) fn run(&mut self, rx: &Receivers, isa: Isa, out: &mut BsdfRays) -> u32 {
+    /// Every lane's ray (loaded or not) with direction draws `u` (lane k: `(u[0][k],
+    /// u[1][k])`) on instruction set `isa`, written to all the lanes of `out` (so before any
+    /// lane's own); the lanes of `active` with a ray become active there. Returns their number.
+    pub(super) fn run(
+        &mut self,
+        rx: &Receivers,
+        u: &[Lanes; 2],
+        isa: Isa,
+        out: &mut BsdfRays,
+    ) -> u32 {
         match isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx512 => {
                 // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx, out) }
+                unsafe { self.run_avx512(rx, u, out) }
             }
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => {
                 // SAFETY: as above.
-                unsafe { self.run_avx2(rx, out) }
+                unsafe { self.run_avx2(rx, u, out) }
             }
-            _ => self.body(rx, out),
+            _ => self.body(rx, u, out),
         }
         let ok = mask_of(&self.ok) & self.active;
         out.active |= ok;
@@ -348,22 +343,22 @@ impl DiffuseBsdfLanes {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn run_avx512(&mut self, rx: &Receivers, out: &mut BsdfRays) {
-        self.body(rx, out)
+    unsafe fn run_avx512(&mut self, rx: &Receivers, u: &[Lanes; 2], out: &mut BsdfRays) {
+        self.body(rx, u, out)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&mut self, rx: &Receivers, out: &mut BsdfRays) {
-        self.body(rx, out)
+    unsafe fn run_avx2(&mut self, rx: &Receivers, u: &[Lanes; 2], out: &mut BsdfRays) {
+        self.body(rx, u, out)
     }
 
     /// The lane loop.
     #[inline(always)]
-    fn body(&mut self, rx: &Receivers, out: &mut BsdfRays) {
+    fn body(&mut self, rx: &Receivers, u: &[Lanes; 2], out: &mut BsdfRays) {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
-            let u = Vec2::new(self.u[0][k], self.u[1][k]);
+            let u = Vec2::new(u[0][k], u[1][k]);
             // A match, not `and_then`, as in the light kernel: the closure may be outlined.
             let b = match lambert.sample(wo_local, 0.0, u) {
                 Some(bs) => bsdf_ray_of(&bs, &frame, ctx.n, &hit),
@@ -498,14 +493,15 @@ mod tests {
                     let tri = TriangleLight::new(v, unit(&mut rng), Vec3::splat(4.0), k % 3 == 0)
                         .expect("a random triangle has an area");
                     let (pmf, u) = (0.5, Vec2::new(next_f32(&mut rng), next_f32(&mut rng)));
-                    lanes.load(k, &tri, pmf, u);
+                    lanes.load(k, &tri, pmf);
                     tris.push((tri, pmf, u));
                 }
+                let draws = [0, 1].map(|a| std::array::from_fn(|k| tris[k].2[a]));
                 let mode = [SamplingMode::Area, SamplingMode::SolidAngle][round as usize % 2];
                 let mis = [None, Some(MisHeuristic::Power), Some(MisHeuristic::Balance)]
                     [round as usize % 3];
                 let mut out = ShadowRays::new();
-                let n = lanes.run(&rx, mis, mode, isa, &mut out);
+                let n = lanes.run(&rx, &draws, mis, mode, isa, &mut out);
                 assert_eq!(n, out.active.count_ones());
                 for (k, (tri, pmf, u)) in tris.iter().enumerate() {
                     let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
@@ -540,9 +536,10 @@ mod tests {
                 let u: Vec<Vec2> = (0..PACKET)
                     .map(|_| Vec2::new(next_f32(&mut rng), next_f32(&mut rng)))
                     .collect();
-                lanes.load(u32::MAX >> (32 - PACKET), |k| u[k]);
+                lanes.active = u32::MAX >> (32 - PACKET);
+                let draws = [0, 1].map(|a| std::array::from_fn(|k| u[k][a]));
                 let mut out = BsdfRays::new();
-                lanes.run(&rx, isa, &mut out);
+                lanes.run(&rx, &draws, isa, &mut out);
                 for (k, &u) in u.iter().enumerate() {
                     let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
                     let want = lambert

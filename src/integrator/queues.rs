@@ -20,7 +20,7 @@ use crate::bsdf::{Bsdf, Lambert};
 use crate::geometry::{Geometry, HitColumns, PACKET, Ray, RayPacket};
 use crate::light_selection::ShadingPoint;
 use crate::lights::LightSampleContext;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// One f32 per lane.
 pub(super) type Lanes = [f32; PACKET];
@@ -190,6 +190,40 @@ impl PathLanes {
             pdf: self.prev_pdf[k],
             at: self.prev_at[k],
         }
+    }
+}
+
+/// The pattern values of a round's light and BSDF samples, per lane (written by the draw
+/// stage, read by the per-lane paths and, as columns, by the kernels).
+pub(super) struct Draws {
+    /// Light-selection numbers.
+    pub(super) light_select: Lanes,
+    /// Points on the lights: `light[axis][lane]`.
+    pub(super) light: [Lanes; 2],
+    /// BSDF directions: `bsdf[axis][lane]`.
+    pub(super) bsdf: [Lanes; 2],
+}
+
+impl Draws {
+    /// All zero.
+    pub(super) fn new() -> Self {
+        Self {
+            light_select: [0.0; PACKET],
+            light: [[0.0; PACKET]; 2],
+            bsdf: [[0.0; PACKET]; 2],
+        }
+    }
+
+    /// Lane k's point-on-light draw.
+    #[inline(always)]
+    pub(super) fn light(&self, k: usize) -> Vec2 {
+        Vec2::new(self.light[0][k], self.light[1][k])
+    }
+
+    /// Lane k's BSDF-direction draw.
+    #[inline(always)]
+    pub(super) fn bsdf(&self, k: usize) -> Vec2 {
+        Vec2::new(self.bsdf[0][k], self.bsdf[1][k])
     }
 }
 

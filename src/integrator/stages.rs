@@ -25,7 +25,7 @@ use super::estimator::{
     light_estimate, nee_pdf,
 };
 use super::lanes::{DiffuseBsdfLanes, TriangleLightLanes};
-use super::queues::{BsdfRays, CameraPacket, LaneShading, PathLanes, Receivers, ShadowRays};
+use super::queues::{BsdfRays, CameraPacket, Draws, LaneShading, PathLanes, Receivers, ShadowRays};
 use super::{MisHeuristic, Strategy};
 use crate::Rgb;
 use crate::bsdf::{Bsdf, Bxdf, LaneBsdf, LobeSampling};
@@ -60,28 +60,13 @@ pub struct Integrator<'a> {
     pub mis_light: SamplingMode,
 }
 
-/// The pattern values one light sample and one BSDF sample consume, drawn together up front:
-/// the permutation hash chains of the dimensions are independent, so evaluating them back to
-/// back lets the CPU overlap them instead of waiting on each behind a ray query. The lobe
-/// choice is drawn later, only for receivers whose BSDF has lobes to choose (values are pure
-/// functions of pixel, dimension and index, so skipping it changes nothing).
-#[derive(Clone, Copy, Default)]
-struct Draws {
-    /// Light-selection number.
-    light_select: f32,
-    /// Point on the light.
-    light: Vec2,
-    /// BSDF direction.
-    bsdf: Vec2,
-}
-
 /// The work queues of one render thread (made once per tile, not per packet: every lane a
 /// stage reads was written first by an earlier stage of the same packet).
 pub struct Queues {
     /// The paths' state.
     paths: PathLanes,
     /// Each lane's draws for the current round.
-    drawn: [Draws; PACKET],
+    drawn: Draws,
     /// The closest hits of the paths' rays.
     hits: [Option<SurfaceHit>; PACKET],
     /// The hits' shading geometry, as columns.
@@ -122,7 +107,7 @@ impl Queues {
     pub fn new() -> Self {
         Self {
             paths: PathLanes::new(),
-            drawn: [Draws::default(); PACKET],
+            drawn: Draws::new(),
             hits: [None; PACKET],
             rx: Receivers::new(),
             shading: [const { None }; PACKET],
@@ -255,7 +240,11 @@ impl<'a> Integrator<'a> {
     }
 
     /// Stage *draw*: round `j`'s light and BSDF draws of the lanes `on` (only the dimensions
-    /// the techniques read), at the vertex's dimensions and sample index (`dims.rs`).
+    /// the techniques read), at the vertex's dimensions and sample index (`dims.rs`). The
+    /// permutation hash chains of the dimensions are independent, so drawing them back to back
+    /// lets the CPU overlap them instead of waiting on each behind a ray query; the lobe choice
+    /// is drawn later, only for receivers whose BSDF has lobes to choose (values are pure
+    /// functions of pixel, dimension and index, so skipping it changes nothing).
     // Forced inline: out of line, the draws came back through memory after a call.
     #[inline(always)]
     fn draw(&self, pxs: &[PixelSamples], q: &mut Queues, t: Techniques, j: u32, on: u32) {
@@ -265,13 +254,15 @@ impl<'a> Integrator<'a> {
         for k in bits(on) {
             let px = &pxs[q.paths.pixel[k] as usize];
             let (index, count) = sample_index(depth, q.paths.sample[k], j, n, m);
-            let d = &mut q.drawn[k];
+            let d = &mut q.drawn;
             if light {
-                d.light_select = px.sample_1d(dims.light_select, index, count);
-                d.light = px.sample_2d(dims.light, index, count);
+                d.light_select[k] = px.sample_1d(dims.light_select, index, count);
+                let u = px.sample_2d(dims.light, index, count);
+                [d.light[0][k], d.light[1][k]] = [u.x, u.y];
             }
             if bsdf {
-                d.bsdf = px.sample_2d(dims.bsdf, index, count);
+                let u = px.sample_2d(dims.bsdf, index, count);
+                [d.bsdf[0][k], d.bsdf[1][k]] = [u.x, u.y];
             }
         }
     }
@@ -329,7 +320,7 @@ impl<'a> Integrator<'a> {
         q.lone_light = 0;
         let uniform = self.selector.uniform_count();
         for k in bits(q.shaded) {
-            let u = q.drawn[k].light_select;
+            let u = q.drawn.light_select[k];
             let sel = match uniform {
                 Some(count) => UniformSelector::pick(count, u),
                 None => match q.view(k) {
@@ -340,9 +331,7 @@ impl<'a> Integrator<'a> {
             let Some(sel) = sel else { continue };
             let diffuse = q.rx.diffuse >> k & 1 != 0;
             match scene.lights[sel.index as usize].lane_kind() {
-                Some(LaneLight::Triangle(tri)) if diffuse => {
-                    q.tri_lanes.load(k, tri, sel.pmf, q.drawn[k].light)
-                }
+                Some(LaneLight::Triangle(tri)) if diffuse => q.tri_lanes.load(k, tri, sel.pmf),
                 _ => {
                     q.picked[k] = sel;
                     q.lone_light |= 1 << k;
@@ -354,14 +343,13 @@ impl<'a> Integrator<'a> {
         // then fills in its own lanes.
         if q.tri_lanes.active != 0 {
             let isa = scene.geometry.isa();
-            rays += u64::from(
-                q.tri_lanes
-                    .run(&q.rx, t.mis(), self.mode(), isa, &mut q.nee),
-            );
+            let (mis, mode) = (t.mis(), self.mode());
+            let u = &q.drawn.light;
+            rays += u64::from(q.tri_lanes.run(&q.rx, u, mis, mode, isa, &mut q.nee));
         }
         for k in bits(q.lone_light) {
             let Some(sh) = q.view(k) else { continue };
-            if let Some((r, v)) = self.light_sample(&sh, q.picked[k], q.drawn[k].light, t) {
+            if let Some((r, v)) = self.light_sample(&sh, q.picked[k], q.drawn.light(k), t) {
                 q.nee.set(k, &r, v);
                 rays += 1;
             }
@@ -379,15 +367,16 @@ impl<'a> Integrator<'a> {
         if !t.bsdf() {
             return 0;
         }
-        let drawn = &q.drawn;
-        q.bsdf_lanes
-            .load(q.shaded & q.rx.diffuse, |k| drawn[k].bsdf);
+        q.bsdf_lanes.active = q.shaded & q.rx.diffuse;
         q.lone_bsdf = q.shaded & !q.rx.diffuse;
         let mut rays = 0;
         // The kernel goes first, as in `sample_lights`.
         if q.bsdf_lanes.active != 0 {
             let isa = self.scene.geometry.isa();
-            rays += u64::from(q.bsdf_lanes.run(&q.rx, isa, &mut q.bsdf_rays));
+            rays += u64::from(
+                q.bsdf_lanes
+                    .run(&q.rx, &q.drawn.bsdf, isa, &mut q.bsdf_rays),
+            );
         }
         let (n, m, depth) = (self.eye_rays.max(1), self.shadow_rays.max(1), q.paths.depth);
         let dim = VertexDims::at(depth).lobe;
@@ -396,7 +385,7 @@ impl<'a> Integrator<'a> {
             let px = &pxs[q.paths.pixel[k] as usize];
             let (index, count) = sample_index(depth, q.paths.sample[k], j, n, m);
             let lobe = px.sample_1d(dim, index, count);
-            if let Some(b) = self.bsdf_ray(&sh, lobe, q.drawn[k].bsdf) {
+            if let Some(b) = self.bsdf_ray(&sh, lobe, q.drawn.bsdf(k)) {
                 rays += 1;
                 q.bsdf_rays.set(k, &b);
             }
