@@ -60,7 +60,9 @@ mod tests {
             "reading m.exr: No such file (os error 2)"
         );
         assert_eq!(dedup_parts("a: b: a"), "a: b: a");
-        let e = anyhow::anyhow!("No such file").context("writing x").context("writing x");
+        let e = anyhow::anyhow!("No such file")
+            .context("writing x")
+            .context("writing x");
         assert_eq!(format_error(&e), "writing x: No such file");
     }
 

@@ -195,7 +195,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         mis_light: args.mis_light,
         progress: !args.quiet,
     };
-    anyhow::ensure!(opts.spp >= 1, "the scene's pixel samples must be at least 1");
+    anyhow::ensure!(
+        opts.spp >= 1,
+        "the scene's pixel samples must be at least 1"
+    );
     let out = match &args.output {
         Some(out) => out.clone(),
         None => {
@@ -204,7 +207,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 .filename
                 .as_ref()
                 .map_or_else(|| PathBuf::from("penumbra.png"), PathBuf::from);
-            prepare_output(&out).context("the output named by the scene (use -o to choose another)")?;
+            prepare_output(&out).map_err(|e| {
+                anyhow::anyhow!(
+                    "{} (the scene names this output; -o chooses another)",
+                    messages::format_error(&e)
+                )
+            })?;
             out
         }
     };

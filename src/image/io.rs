@@ -118,7 +118,10 @@ pub fn remove_stale_temps(path: &Path) -> Vec<PathBuf> {
         let Some(rest) = name.to_str().and_then(|n| n.strip_prefix(&prefix)) else {
             continue;
         };
-        let Some(pid) = rest.split_once('-').and_then(|(p, _)| p.parse::<u32>().ok()) else {
+        let Some(pid) = rest
+            .split_once('-')
+            .and_then(|(p, _)| p.parse::<u32>().ok())
+        else {
             continue;
         };
         if pid == std::process::id() || process_may_be_alive(pid) {
@@ -385,13 +388,13 @@ pub fn read_image(path: &Path) -> anyhow::Result<Image> {
     result.with_context(|| format!("reading {}", path.display()))
 }
 
-/// Why `path` cannot be opened as a file ("no such file", "is a folder, not a file"), or
+/// Why `path` cannot be opened as a file ("file not found", "a folder, not a file"), or
 /// `None` when it is a file: loaders say this instead of the bare OS error.
 pub fn not_a_file(path: &Path) -> Option<&'static str> {
     match std::fs::metadata(path) {
-        Ok(m) if m.is_dir() => Some("it is a folder, not a file"),
+        Ok(m) if m.is_dir() => Some("a folder, not a file"),
         Ok(_) => None,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Some("no such file"),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Some("file not found"),
         // Permission and other errors are left to the reader, which reports them.
         Err(_) => None,
     }
