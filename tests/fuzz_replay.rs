@@ -10,7 +10,10 @@ mod harness;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-const TARGETS: [(&str, fn(&[u8])); 5] = [
+/// A fuzz target's entry point.
+type Target = fn(&[u8]);
+
+const TARGETS: [(&str, Target); 5] = [
     ("pbrt", harness::pbrt),
     ("obj", harness::obj),
     ("gltf", harness::gltf),
@@ -23,7 +26,7 @@ fn files_in(dir: &Path) -> Vec<PathBuf> {
         .map(|rd| {
             rd.flatten()
                 .map(|e| e.path())
-                .filter(|p| p.is_file() && !p.file_name().is_some_and(|n| n == ".keep"))
+                .filter(|p| p.is_file() && p.file_name().is_none_or(|n| n != ".keep"))
                 .collect()
         })
         .unwrap_or_default();

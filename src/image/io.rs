@@ -419,9 +419,24 @@ fn read_with_image_crate(path: &Path, srgb: bool) -> anyhow::Result<Image> {
     })
 }
 
+/// Largest image the readers accept (16384², 3 GB as linear RGB).
+pub const MAX_READ_PIXELS: usize = 1 << 28;
+
 /// First RGB(A) layer of an EXR; falls back to a luminance-only ("Y") layer as grey.
 fn read_exr(path: &Path) -> anyhow::Result<Image> {
     use exr::prelude::{RgbaChannels, Vec2, read_first_rgba_layer_from_file};
+    // The header's size is allocated before any pixel is decoded: a corrupt or hostile header
+    // must be an error, not an allocation abort (found by fuzz/, target `image`).
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| anyhow::anyhow!("{e}"))?;
+    for h in &meta.headers {
+        let (w, h) = (h.layer_size.width(), h.layer_size.height());
+        if w.saturating_mul(h) > MAX_READ_PIXELS {
+            bail!(
+                "the header claims {w}x{h} pixels, more than the {MAX_READ_PIXELS} penumbra reads"
+            );
+        }
+    }
     let rgba = read_first_rgba_layer_from_file(
         path,
         |res: Vec2<usize>, _: &RgbaChannels| {
