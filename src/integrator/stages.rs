@@ -5,11 +5,10 @@
 //! `lanes.rs`.
 //!
 //! ```text
-//!  camera rays ─▶ intersect ─▶ shade ─▶ ┌─ round j = 0 .. M ───────────────────────────────┐
-//!  (render.rs)   closest hits  Le·w,    │ draw ─▶ sample_lights ─▶ sample_bsdfs             │
-//!                              BSDFs    │  ─▶ gather_emitters ─▶ trace_shadows ─▶ accumulate │
-//!                                       └───────────────────────────────────────────────────┘
-//!                                        ─▶ finish: L += β·Σ/M, continue or terminate
+//!  camera rays ─▶ draw ─▶ intersect ─▶ shade ─┬─▶ round j = 0 .. M: draw ─▶ sample_lights
+//!  (render.rs)           closest hits  Le·w·β, │     ─▶ sample_bsdfs ─▶ gather_emitters
+//!                                      BSDFs   │     ─▶ trace_shadows ─▶ accumulate
+//!                                              └─▶ finish: L += β·Σ/M, continue or terminate
 //! ```
 //!
 //! Direct lighting is the path with one vertex: its BSDF rays are the last of the path, so
@@ -77,8 +76,9 @@ pub struct Queues {
     shaded: u32,
     /// Light samples for the triangle-light kernel.
     tri_lanes: TriangleLightLanes,
-    /// Lanes whose light sample is taken one lane at a time, and the light each picked.
+    /// Lanes whose light sample is taken one lane at a time.
     lone_light: u32,
+    /// Per `lone_light` lane: the light it picked.
     picked: [SelectedLight; PACKET],
     /// BSDF samples for the Lambertian kernel.
     bsdf_lanes: DiffuseBsdfLanes,
