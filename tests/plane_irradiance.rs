@@ -185,7 +185,7 @@ impl Case {
     fn draw(id: u64, receiver: Receiver, light: LightKind) -> Case {
         let mut r = Rng::new(&[0x9e37, id]);
         let size = 10f32.powf(r.range(-3.0, 4.0));
-        let axis_aligned = id % 3 == 0;
+        let axis_aligned = id.is_multiple_of(3);
         let (u, v, n) = if axis_aligned {
             let axes = [Vec3::X, Vec3::Y, Vec3::Z];
             let k = (r.f() * 3.0) as usize % 3;
@@ -214,7 +214,7 @@ impl Case {
             // The plane through the origin (the y = 0 floor), whose hit points' error
             // bound along the normal is exactly zero, or close to it (its y = 0.37 floor of
             // size 19): offsets along the normal far below the size.
-            let keep = if id % 4 == 0 {
+            let keep = if id.is_multiple_of(4) {
                 0.0
             } else {
                 10f32.powf(r.range(-3.0, 0.0))
