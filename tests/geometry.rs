@@ -202,6 +202,98 @@ fn spawned_rays_do_not_reintersect_their_surface() {
 }
 
 #[test]
+fn quadric_error_bounds_cover_the_intersections_own_rounding() {
+    // Spheres and disks far from the origin, rotated, uniformly and anisotropically scaled:
+    // a spawned ray's origin is mapped back to object space (f32) to be intersected, and the
+    // hit's error bound must clear that mapping's error too, with margin (measured: at most
+    // 49% of the bound), so that no spawned ray re-hits its quadric and inward rays reach the
+    // far side.
+    use penumbra::geometry::{Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind};
+    use penumbra::sampling::concentric_disk;
+    let mut rng = pcg_from_keys(&[31]);
+    let mut u2 = || Vec2::new(next_f32(&mut rng), next_f32(&mut rng));
+    let configs = [
+        (1e4f32, 1.0f32, Vec3::ONE),
+        (3e3, 0.05, Vec3::ONE),
+        (2e4, 10.0, Vec3::ONE),
+        (1e3, 1.0, Vec3::splat(7.3)),
+        (1e3, 1.0, Vec3::splat(0.013)),
+        (1e3, 1.0, Vec3::new(1.0, 6.0, 0.15)),
+    ];
+    let (mut worst, mut rays) = (0.0f64, 0);
+    for (dist, radius, scale) in configs {
+        for sphere in [true, false] {
+            for _ in 0..40 {
+                let (a, b) = (u2(), u2());
+                let rot = glam::Quat::from_axis_angle(uniform_sphere(a), 6.0 * b.x);
+                let m = Mat4::from_scale_rotation_translation(scale, rot, uniform_sphere(b) * dist);
+                let kind = if sphere {
+                    QuadricKind::Sphere { radius }
+                } else {
+                    QuadricKind::Disk {
+                        height: 0.3,
+                        radius,
+                    }
+                };
+                let q = Quadric {
+                    kind,
+                    to_world: Transform::new(m).unwrap(),
+                    flip: false,
+                };
+                let prim = Primitive {
+                    p: [Vec3::ZERO; 3],
+                    kind: PrimKind::Quadric(0),
+                    material: 0,
+                    light: u32::MAX,
+                };
+                let g = Geometry::new(vec![prim], vec![MeshShading::default()], vec![q]);
+                let exact_inv = m.as_dmat4().inverse();
+                for _ in 0..20 {
+                    let u = u2();
+                    let local = if sphere {
+                        uniform_sphere(u) * radius
+                    } else {
+                        let d = concentric_disk(u) * (0.95 * radius);
+                        Vec3::new(d.x, d.y, 0.3)
+                    };
+                    let target = q.to_world.point(local);
+                    let n = q.to_world.normal(if sphere { local } else { Vec3::Z });
+                    let view = (n.normalize() + uniform_sphere(u2()) * 0.5).normalize();
+                    let eye = target + view * (3.0 * radius * scale.max_element());
+                    let Some(h) = g.intersect(&Ray::new(eye, target - eye)) else {
+                        continue;
+                    };
+                    for _ in 0..8 {
+                        let w = uniform_sphere(u2());
+                        let r = Ray::new(h.spawn_origin(w), w);
+                        rays += 1;
+                        // The object-space origin the intersection uses against the exact
+                        // one, seen along the normal in world space, relative to the bound.
+                        let mapped = q.to_world.m_inv.transform_point3(r.o).as_dvec3();
+                        let exact = exact_inv.transform_point3(r.o.as_dvec3());
+                        let off = m.as_dmat4().transform_vector3(mapped - exact);
+                        worst = worst.max(off.dot(h.ng.as_dvec3()).abs() / h.p_error as f64);
+                        let hit = g.intersect(&r);
+                        let cos = w.dot(h.ng);
+                        if cos >= 0.0 || !sphere {
+                            assert!(hit.is_none(), "self-hit leaving {} along {w}", h.p);
+                        } else if cos < -1e-3 {
+                            assert!(hit.is_some(), "inward ray from {} escaped", h.p);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("{rays} spawned rays; the back mapping used at most {worst:.3} of the bound");
+    assert!(rays > 10_000, "{rays} rays");
+    assert!(
+        worst < 0.75,
+        "the back mapping used {worst} of the error bound"
+    );
+}
+
+#[test]
 fn shadow_rays_no_acne_and_no_leaks_at_contacts() {
     // A floor with a closed box standing on it, touching the floor.
     let mut b = SceneBuilder::new();

@@ -1,5 +1,6 @@
 //! What a closest-hit query returns.
 
+use super::Ray;
 use crate::sampling::Frame;
 use glam::{Vec2, Vec3};
 
@@ -51,16 +52,60 @@ impl SurfaceHit {
         unsafe { std::mem::transmute::<[f32; 16], SurfaceHit>(a) }
     }
 
-    /// Origin for a ray leaving the surface toward direction `w` (offset along ±ng by the
-    /// error bound so it cannot re-hit the surface it leaves).
+    /// Origin for a ray leaving the surface toward direction `w`: `p` moved along ±ng (the
+    /// side of `w`) by the error bound, then each moved coordinate one ulp further, so that
+    /// the rounding of the sum cannot bring it back. The origin is then on the surface's
+    /// `w` side or, where the bound is zero (a hit on a plane x = c has an exact x), exactly
+    /// on it; either way the surface lies at t ≤ 0 of the spawned ray, which the
+    /// intersection tests reject (the triangles' `self_hit_bound`, the quadrics' t error),
+    /// so the ray cannot hit the surface it leaves (pbrt-v4's `OffsetRayOrigin`).
     #[inline]
     pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
         let off = self.ng * self.p_error;
-        if w.dot(self.ng) >= 0.0 {
-            self.p + off
-        } else {
-            self.p - off
+        let off = if w.dot(self.ng) >= 0.0 { off } else { -off };
+        let o = self.p + off;
+        Vec3::new(away(o.x, off.x), away(o.y, off.y), away(o.z, off.z))
+    }
+
+    /// A shadow ray from this hit to just short of `target`: leaving from
+    /// [`Self::spawn_origin`] toward `target`, with direction `target − origin` and
+    /// t_max = [`SHADOW_T_MAX`].
+    ///
+    /// The far end is shortened by a relative [`SHADOW_EPSILON`] instead of being offset by
+    /// an error bound as the near end is (pbrt-v4's `SpawnRayTo` offsets both): a light
+    /// sample carries no error bound here (solid-angle samples are not barycentric
+    /// combinations, whose bound the hit records use), and the relative gap, 1e-4 of the
+    /// distance, exceeds the few-ulp error of the sampled point (~1e-7 of its coordinates)
+    /// unless the receiver is within ~1e-3 of the light's distance from the origin —
+    /// contact, where the geometry term vanishes anyway. At the near end no relative gap
+    /// can work: there the rounding is absolute and t starts at 0.
+    #[inline]
+    pub fn spawn_ray_to(&self, target: Vec3) -> Ray {
+        let o = self.spawn_origin(target - self.p);
+        Ray {
+            o,
+            d: target - o,
+            t_max: SHADOW_T_MAX,
         }
+    }
+}
+
+/// Shadow rays stop this fraction of their length short of the light point so they do not
+/// hit the light itself.
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
+/// The `t_max` of every shadow ray (its direction spans origin to light point).
+pub const SHADOW_T_MAX: f32 = 1.0 - SHADOW_EPSILON;
+
+/// `v` one ulp further in the direction of the sign of `off` (unchanged where `off` is 0).
+#[inline(always)]
+fn away(v: f32, off: f32) -> f32 {
+    if off > 0.0 {
+        v.next_up()
+    } else if off < 0.0 {
+        v.next_down()
+    } else {
+        v
     }
 }
 

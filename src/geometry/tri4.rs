@@ -3,11 +3,12 @@
 //!
 //! Every lane performs the same f32 operations in the same order as [`RayShear::intersect`]
 //! (the shear rows there have one unit and one zero entry, so their dot products round exactly
-//! like `a[kx] + sx·a[kz]` here), hence t and the barycentrics are bit-identical. Lanes whose
+//! like `a[kx] + sx·a[kz]` here), hence t, the barycentrics and the self-hit rejection
+//! ([`self_hit_bound`]) are bit-identical. Lanes whose
 //! edge functions are exactly 0 in f32 are redone by the scalar test, whose f64 fallback keeps
 //! neighbouring triangles in agreement on shared edges (watertightness).
 
-use super::triangle::{RayShear, shear_axes};
+use super::triangle::{RayShear, self_hit_bound, shear_axes};
 use glam::{Vec3, Vec4};
 
 /// Four triangles in SoA layout, one leaf packet of the wide BVH.
@@ -74,6 +75,8 @@ pub struct RayShear4 {
     k: [usize; 3],
     o: [Vec4; 3],
     s: [Vec4; 3],
+    /// |d| along the sheared x and y axes, splatted (for `self_hit_bound`).
+    ad: [Vec4; 2],
     /// The ray, for the scalar redo of exact-zero lanes (rare, so its shear is built lazily).
     ray: (Vec3, Vec3),
 }
@@ -108,6 +111,7 @@ impl RayShear4 {
                 Vec4::splat(oa[k[2]]),
             ],
             s: [Vec4::splat(q.x), Vec4::splat(q.y), Vec4::splat(q.z)],
+            ad: [Vec4::splat(da[k[0]].abs()), Vec4::splat(da[k[1]].abs())],
             ray: (o, d),
         }
     }
@@ -154,9 +158,14 @@ impl RayShear4 {
                 inv: zero,
             };
         }
+        // Hits not provably in front of the origin (the scalar test's `self_hit_bound`).
+        let max3 = |a: Vec4, b: Vec4, c: Vec4| a.abs().max(b.abs()).max(c.abs());
+        let (mx, my, mz) = (max3(ax, bx, cx), max3(ay, by, cy), max3(az, bz, cz));
+        let bound = self_hit_bound(mx, my, mz, self.ad[0], self.ad[1], Vec4::splat);
+        let clear = ts.cmpgt(bound);
         let inv = Vec4::ONE / det;
         let t = t_scaled * inv;
-        let ok = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
+        let ok = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max)) & clear;
         Lanes {
             hit: ok.bitmask() & candidates,
             redo,
