@@ -28,7 +28,8 @@ pub struct SurfaceHit {
     pub ns: Vec3,
     /// Surface parameterisation (texture coordinates).
     pub uv: Vec2,
-    /// Conservative absolute error bound of `p`, used to offset spawned rays.
+    /// Conservative absolute error bound of `p` along `ng` (with room for the rounding of a
+    /// spawned ray's origin), the offset of spawned rays.
     pub p_error: f32,
     /// Index of the primitive in the scene's geometry.
     pub prim: u32,
@@ -53,18 +54,21 @@ impl SurfaceHit {
     }
 
     /// Origin for a ray leaving the surface toward direction `w`: `p` moved along ±ng (the
-    /// side of `w`) by the error bound, then each moved coordinate one ulp further, so that
-    /// the rounding of the sum cannot bring it back. The origin is then on the surface's
-    /// `w` side or, where the bound is zero (a hit on a plane x = c has an exact x), exactly
-    /// on it; either way the surface lies at t ≤ 0 of the spawned ray, which the
-    /// intersection tests reject (the triangles' `self_hit_bound`, the quadrics' t error),
-    /// so the ray cannot hit the surface it leaves (pbrt-v4's `OffsetRayOrigin`).
+    /// side of `w`) by `p_error`, which bounds both the point's error and the rounding of
+    /// this sum (pbrt-v4's `OffsetRayOrigin`, its step of one ulp per coordinate folded into
+    /// the bound). The origin is then on the surface's `w` side or, where the bound is zero
+    /// (a hit on the plane x = 0 has an exact x), exactly on it; either way the surface lies
+    /// at t ≤ 0 of the spawned ray, and the intersection tests reject hits that are not
+    /// provably beyond t = 0 (the triangles' `self_hit_bound`), so the ray cannot hit the
+    /// surface it leaves.
     #[inline]
     pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
         let off = self.ng * self.p_error;
-        let off = if w.dot(self.ng) >= 0.0 { off } else { -off };
-        let o = self.p + off;
-        Vec3::new(away(o.x, off.x), away(o.y, off.y), away(o.z, off.z))
+        if w.dot(self.ng) >= 0.0 {
+            self.p + off
+        } else {
+            self.p - off
+        }
     }
 
     /// A shadow ray from this hit to just short of `target`: leaving from
@@ -96,18 +100,6 @@ pub const SHADOW_EPSILON: f32 = 1e-4;
 
 /// The `t_max` of every shadow ray (its direction spans origin to light point).
 pub const SHADOW_T_MAX: f32 = 1.0 - SHADOW_EPSILON;
-
-/// `v` one ulp further in the direction of the sign of `off` (unchanged where `off` is 0).
-#[inline(always)]
-fn away(v: f32, off: f32) -> f32 {
-    if off > 0.0 {
-        v.next_up()
-    } else if off < 0.0 {
-        v.next_down()
-    } else {
-        v
-    }
-}
 
 /// How a hit is seen along a ray: the set-up every estimator does before sampling there.
 #[derive(Clone, Copy, Debug)]
