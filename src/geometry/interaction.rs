@@ -58,9 +58,10 @@ impl SurfaceHit {
     /// this sum (pbrt-v4's `OffsetRayOrigin`, its step of one ulp per coordinate folded into
     /// the bound). The origin is then on the surface's `w` side or, where the bound is zero
     /// (a hit on the plane x = 0 has an exact x), exactly on it; either way the surface lies
-    /// at t ≤ 0 of the spawned ray, and the intersection tests reject hits that are not
-    /// provably beyond t = 0 (the triangles' `self_hit_bound`), so the ray cannot hit the
-    /// surface it leaves.
+    /// at t ≤ 0 of the spawned ray, and the triangle tests reject hits that are not provably
+    /// beyond t = 0 (`self_hit_bound`), so the ray cannot hit the surface it leaves. (Quadrics
+    /// are solved in f64 after an f32 map to object space: the offset alone suffices, with
+    /// the margin over that map's error that tests/geometry.rs measures.)
     #[inline]
     pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
         let off = self.ng * self.p_error;
@@ -80,9 +81,9 @@ impl SurfaceHit {
     /// sample carries no error bound here (solid-angle samples are not barycentric
     /// combinations, whose bound the hit records use), and the relative gap, 1e-4 of the
     /// distance, exceeds the few-ulp error of the sampled point (~1e-7 of its coordinates)
-    /// unless the receiver is within ~1e-3 of the light's distance from the origin —
-    /// contact, where the geometry term vanishes anyway. At the near end no relative gap
-    /// can work: there the rounding is absolute and t starts at 0.
+    /// unless the receiver is closer to the light point than ~1e-3 of that point's distance
+    /// from the origin: receivers in contact with a light, which this rule accepts. At the
+    /// near end no relative gap can work: there the rounding is absolute and t starts at 0.
     #[inline]
     pub fn spawn_ray_to(&self, target: Vec3) -> Ray {
         let o = self.spawn_origin(target - self.p);
