@@ -265,7 +265,7 @@ mod tests {
     fn lanes_match_the_scalar_test_bit_for_bit() {
         let mut s = pcg_from_keys(&[7]);
         let rnd3 = |s: &mut Pcg32| Vec3::new(next_f32(s), next_f32(s), next_f32(s)) * 2.0 - 1.0;
-        let (mut hits, mut checked) = (0, 0);
+        let (mut hits, mut checked, mut spawned) = (0, 0, 0);
         for _ in 0..20_000 {
             let mut pk = TriPacket::EMPTY;
             let mut tris = Vec::new();
@@ -278,13 +278,27 @@ mod tests {
             let p = [tris[0][1], tris[0][0], rnd3(&mut s)];
             pk.set_triangle(3, 3, p);
             tris.push(p);
-            let o = rnd3(&mut s) * 2.0;
-            let d = if next_f32(&mut s) < 0.2 {
+            let mut o = rnd3(&mut s) * 2.0;
+            let pick = next_f32(&mut s);
+            let d = if pick < 0.2 {
                 // Rays through a shared vertex.
                 tris[0][0] - o
             } else {
                 rnd3(&mut s)
             };
+            let from_lane0 = pick > 0.8;
+            if from_lane0 {
+                // Rays leaving a point of lane 0's triangle: its own hit, at t ≈ 0 in
+                // rounding, must be rejected by both tests alike (`self_hit_bound`).
+                let (a, b) = (next_f32(&mut s), next_f32(&mut s));
+                let (a, b) = if a + b > 1.0 {
+                    (1.0 - a, 1.0 - b)
+                } else {
+                    (a, b)
+                };
+                let t = tris[0];
+                o = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
+            }
             let t_max = if next_f32(&mut s) < 0.5 {
                 f32::INFINITY
             } else {
@@ -304,6 +318,14 @@ mod tests {
                 );
             let got = r4.closest(&pk, t_max);
             checked += 1;
+            if from_lane0 {
+                spawned += 1;
+                let scalar_self = intersect_triangle(o, d, t_max, tris[0]);
+                assert!(
+                    scalar_self.is_none_or(|h| h.0 > 1e-3),
+                    "self-hit {scalar_self:?} from {o} along {d}"
+                );
+            }
             match (want, got) {
                 (None, None) => {}
                 (Some((i, (t, b0, b1, b2))), Some((lane, tg, bg))) => {
@@ -315,5 +337,9 @@ mod tests {
             assert_eq!(r4.any(&pk, t_max), want.is_some());
         }
         assert!(hits > checked / 20, "{hits} hits of {checked}");
+        assert!(
+            spawned > checked / 10,
+            "{spawned} rays from lane 0 of {checked}"
+        );
     }
 }
