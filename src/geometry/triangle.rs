@@ -22,8 +22,8 @@ use std::ops::{Add, Mul};
 /// told from t ≤ 0 and is rejected. `k` splats a constant. One definition for the one-ray,
 /// 4-wide and 16-lane tests, so all three round it identically.
 ///
-/// The error analysis of pbrt-v4's triangle test (§6.8.6 of *Physically Based Rendering*,
-/// 4th ed.), recast for this arithmetic:
+/// The error analysis of pbrt-v4's triangle test (*Physically Based Rendering*, 4th ed.,
+/// "Managing Rounding Error"), recast for this arithmetic:
 /// * sheared x = fl(X + fl(Z·sx)) with X, Z the translated coordinates: its error is at most
 ///   γ₂·|x| + γ₅·|sx·Z|, and |sx·Z| = |dx|·|z|(1 + γ₃) because z = Z/dz. Hence
 ///   δx ≤ γ₆·(mx + |dx|·mz), and likewise δy. (Written with |dx|·mz rather than pbrt's mz,
@@ -36,7 +36,7 @@ use std::ops::{Add, Mul};
 ///
 /// Collected: mz·(A·mx·my + B·mz·(|dx|·my + |dy|·mx)) with A = 3·(2γ₂ + 4γ₆ + 4γ₃(1 + γ₂))
 /// and B = 6γ₆. Replacing max|e| by its bound 2·mx·my (pbrt computes it) saves the lanes
-/// four operations for a bound at most ~1.3× larger. The bound's own rounding (six
+/// four operations for a bound at most ~1.5× larger. The bound's own rounding (six
 /// operations, ~6ε relative) is far inside the slack of the γ's.
 #[inline(always)]
 pub fn self_hit_bound<T>(mx: T, my: T, mz: T, adx: T, ady: T, k: impl Fn(f32) -> T) -> T
