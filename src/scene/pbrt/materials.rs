@@ -2,21 +2,24 @@
 //! The description keeps what the file said; the conversion says what penumbra approximates.
 
 use super::params::{ParamSet, SpecVal};
-use super::spectra::{SpectrumUse, named_glass_ior, sampled_at, to_rgb};
+use super::named_spectra;
+use super::spectra::{
+    SpectrumUse, conductor_rgb, named_glass_ior, sampled_at, spectrum_to_rgb, to_rgb,
+};
 use super::textures::{ImageCache, TextureDesc, TextureTable, Warn};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
-use crate::bsdf::{named_metal, roughness_to_alpha};
+use crate::bsdf::roughness_to_alpha;
 use crate::material::{Material, Texture};
 use glam::Vec2;
 
-/// A metal's eta or k: RGB, or one of pbrt's named spectra (`metal-Cu-eta`, …).
+/// A metal's eta or k: RGB, or a spectrum (named `metal-*`, inline or from a `.spd` file).
 #[derive(Clone, Debug, PartialEq)]
 pub enum MetalSpectrum {
     /// Explicit RGB.
     Rgb(Rgb),
-    /// pbrt named spectrum (resolved by `bsdf::named_metal`).
-    Named(String),
+    /// (λ nm, value) pairs, reduced to RGB with the other half by `spectra::conductor_rgb`.
+    Spectral(Vec<(f32, f32)>),
 }
 
 /// A material as the scene file describes it.
@@ -96,9 +99,15 @@ fn roughness(
 }
 
 fn metal(params: &ParamSet, name: &str, default: &str) -> anyhow::Result<MetalSpectrum> {
+    let table = |n: &str| named_spectra::spectrum(n).map(MetalSpectrum::Spectral);
     Ok(match params.spectrum(name)? {
-        None => MetalSpectrum::Named(default.into()),
-        Some(SpecVal::Named(n)) => MetalSpectrum::Named(n),
+        None => table(default).unwrap_or(MetalSpectrum::Rgb(Rgb::ONE)),
+        Some(SpecVal::Sampled(p)) => MetalSpectrum::Spectral(p),
+        Some(SpecVal::Named(n)) => table(&n).unwrap_or_else(|| {
+            MetalSpectrum::Rgb(
+                to_rgb(&SpecVal::Named(n), SpectrumUse::Unbounded).unwrap_or(Rgb::ONE),
+            )
+        }),
         Some(v) => MetalSpectrum::Rgb(to_rgb(&v, SpectrumUse::Unbounded).unwrap_or(Rgb::ONE)),
     })
 }
@@ -270,6 +279,19 @@ fn texture(t: &TextureDesc, images: &ImageCache) -> anyhow::Result<Texture> {
     })
 }
 
+/// RGB (η, k) of a conductor: both spectral → matched to the spectral Fresnel reflectance
+/// (`spectra::conductor_rgb`); otherwise each half on its own.
+pub fn conductor_pair(eta: &MetalSpectrum, k: &MetalSpectrum) -> (Rgb, Rgb) {
+    let one = |m: &MetalSpectrum| match m {
+        MetalSpectrum::Rgb(c) => *c,
+        MetalSpectrum::Spectral(p) => spectrum_to_rgb(|l| sampled_at(p, l)).max(Rgb::ZERO),
+    };
+    match (eta, k) {
+        (MetalSpectrum::Spectral(e), MetalSpectrum::Spectral(kk)) => conductor_rgb(e, kk),
+        _ => (one(eta), one(k)),
+    }
+}
+
 fn push_once(warnings: &mut Vec<String>, msg: String) {
     if !warnings.contains(&msg) {
         warnings.push(msg);
@@ -301,29 +323,7 @@ pub fn to_material(
             roughness,
             remap,
         } => {
-            let mut metal = |m: &MetalSpectrum, pick_k: bool| -> Rgb {
-                match m {
-                    MetalSpectrum::Rgb(c) => *c,
-                    MetalSpectrum::Named(name) => match named_metal(name) {
-                        Some((e, kk)) => {
-                            if pick_k {
-                                kk
-                            } else {
-                                e
-                            }
-                        }
-                        None => {
-                            push_once(
-                                warnings,
-                                format!("warning: unknown named spectrum \"{name}\"; using copper"),
-                            );
-                            let (e, kk) = named_metal("metal-Cu-eta").unwrap_or_default();
-                            if pick_k { kk } else { e }
-                        }
-                    },
-                }
-            };
-            let (eta, k) = (metal(eta, false), metal(k, true));
+            let (eta, k) = conductor_pair(eta, k);
             let reflectance = match reflectance {
                 Some(t) => Some(texture(t, images)?),
                 None => None,

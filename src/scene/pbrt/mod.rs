@@ -14,6 +14,8 @@ pub mod parser;
 pub mod ply;
 pub mod shapes;
 pub mod spectra;
+pub mod named_spectra;
+pub mod cie_data;
 pub mod textures;
 pub mod tokenizer;
 

@@ -312,6 +312,44 @@ impl ParamSet {
         }
     }
 
+    /// Replace every `"spectrum"` string that is not one of pbrt-v4's named spectra by the
+    /// (λ, value) pairs of the `.spd` file it names, relative to `dir` (pbrt's format: pairs of
+    /// numbers, `#` comments). A missing file is an error listing the named spectra; a bad file
+    /// an error at its own line.
+    pub fn resolve_spectrum_files(&mut self, dir: &std::path::Path) -> anyhow::Result<()> {
+        for p in &mut self.params {
+            if p.ty != ParamType::Spectrum {
+                continue;
+            }
+            let Values::Strs(names) = &p.values else {
+                continue;
+            };
+            let Some(name) = names.first().cloned() else {
+                continue;
+            };
+            if super::named_spectra::kind(&name).is_some() {
+                continue;
+            }
+            let path = super::textures::resolve(dir, &name);
+            let text = match std::fs::read_to_string(&path) {
+                Ok(t) => t,
+                Err(e) => {
+                    return Err(err_at(
+                        &p.loc,
+                        format!(
+                            "spectrum '{}': \"{name}\" is neither a named spectrum nor a readable file ({}: {e}); named spectra: {}",
+                            p.name,
+                            path.display(),
+                            super::named_spectra::all_names().join(", ")
+                        ),
+                    ));
+                }
+            };
+            p.values = Values::Nums(read_spd(&path, &text)?);
+        }
+        Ok(())
+    }
+
     /// The parameter called `name`, marking it used.
     pub fn find(&self, name: &str) -> Option<&Param> {
         let p = self.params.iter().rev().find(|p| p.name == name)?;
@@ -571,6 +609,47 @@ impl ParamSet {
             _ => return Ok(None),
         }))
     }
+}
+
+/// Parse a pbrt `.spd` file: whitespace-separated numbers in (λ, value) pairs with
+/// increasing λ; `#` starts a comment. Errors name `path:line`.
+pub fn read_spd(path: &std::path::Path, text: &str) -> anyhow::Result<Vec<f64>> {
+    let mut v = Vec::new();
+    let mut last_line = 1;
+    for (i, line) in text.lines().enumerate() {
+        let body = line.split('#').next().unwrap_or("");
+        for w in body.split_whitespace() {
+            let x: f64 = w.parse().map_err(|_| {
+                anyhow::anyhow!(
+                    "{}:{}: expected a number in the spectrum file, found \"{w}\"",
+                    path.display(),
+                    i + 1
+                )
+            })?;
+            if !x.is_finite() {
+                anyhow::bail!("{}:{}: non-finite value {w}", path.display(), i + 1);
+            }
+            if v.len() % 2 == 0 && v.len() >= 2 && x <= v[v.len() - 2] {
+                anyhow::bail!(
+                    "{}:{}: wavelengths must increase, found {x} after {}",
+                    path.display(),
+                    i + 1,
+                    v[v.len() - 2]
+                );
+            }
+            v.push(x);
+            last_line = i + 1;
+        }
+    }
+    if v.is_empty() || v.len() % 2 != 0 {
+        anyhow::bail!(
+            "{}:{}: expected (wavelength, value) pairs, found {} number(s)",
+            path.display(),
+            last_line,
+            v.len()
+        );
+    }
+    Ok(v)
 }
 
 #[cfg(test)]

@@ -218,7 +218,10 @@ impl Parser {
     }
 
     fn params(&mut self) -> anyhow::Result<ParamSet> {
-        ParamSet::parse(&mut self.top().tok)
+        let dir = self.dir();
+        let mut ps = ParamSet::parse(&mut self.top().tok)?;
+        ps.resolve_spectrum_files(&dir)?;
+        Ok(ps)
     }
 
     fn report_unused(&mut self, ps: &ParamSet, what: &str) {
