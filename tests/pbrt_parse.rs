@@ -7,10 +7,10 @@ use penumbra::scene::Filter;
 use penumbra::scene::TriangleMesh;
 use penumbra::scene::pbrt::lights::LightDesc;
 use penumbra::scene::pbrt::materials::{MaterialDesc, MetalSpectrum};
+use penumbra::scene::pbrt::named_spectra;
 use penumbra::scene::pbrt::shapes::ShapeGeom;
 use penumbra::scene::pbrt::textures::TextureDesc;
 use penumbra::scene::pbrt::{PbrtScene, parse_pbrt, parse_pbrt_str};
-use penumbra::scene::pbrt::named_spectra;
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 
@@ -538,7 +538,10 @@ Shape "sphere""#,
     let l1 = s.shapes[1].emission.unwrap().l;
     assert!((penumbra::luminance(l1) - 1.0).abs() < 1e-3);
     let d65 = s.shapes[2].emission.unwrap().l;
-    assert!((d65 - Rgb::ONE).abs().max_element() < 3e-3, "D65 is the sRGB white: {d65}");
+    assert!(
+        (d65 - Rgb::ONE).abs().max_element() < 3e-3,
+        "D65 is the sRGB white: {d65}"
+    );
 }
 
 #[test]

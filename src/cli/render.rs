@@ -152,7 +152,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     anyhow::ensure!(args.exposure.is_finite(), "--exposure must be finite");
     let loaded = load(&args.scene, &load_options(&args))?;
     for w in &loaded.warnings {
-        eprintln!("warning: {w}");
+        // pbrt warnings already read `file:line: warning: …`: one prefix, not two.
+        if w.contains("warning:") {
+            eprintln!("{w}");
+        } else {
+            eprintln!("warning: {w}");
+        }
     }
     let scene = loaded.scene;
     let res = args.res.unwrap_or(scene.film.resolution);

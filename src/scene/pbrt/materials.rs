@@ -1,8 +1,8 @@
 //! pbrt materials → an internal [`MaterialDesc`], converted to [`Material`] by [`to_material`].
 //! The description keeps what the file said; the conversion says what penumbra approximates.
 
-use super::params::{ParamSet, SpecVal};
 use super::named_spectra;
+use super::params::{ParamSet, SpecVal};
 use super::spectra::{
     SpectrumUse, conductor_rgb, named_glass_ior, sampled_at, spectrum_to_rgb, to_rgb,
 };

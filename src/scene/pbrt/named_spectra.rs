@@ -127,7 +127,12 @@ mod tests {
         // pbrt-v4's list: 7 glasses, 12 metal tables, 15 standard illuminants + ACES D60,
         // 17 cameras × 3 channels.
         assert_eq!(names.len(), 7 + 12 + 16 + 17 * 3, "{names:?}");
-        for n in ["metal-Au-eta", "metal-TiO2-k", "stdillum-F12", "illum-acesD60"] {
+        for n in [
+            "metal-Au-eta",
+            "metal-TiO2-k",
+            "stdillum-F12",
+            "illum-acesD60",
+        ] {
             assert!(spectrum(n).is_some_and(|t| t.len() > 20), "{n}");
         }
         assert_eq!(glass_ior("glass-BK7"), Some(1.5185));

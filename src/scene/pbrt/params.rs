@@ -102,6 +102,21 @@ pub struct Param {
     used: Cell<bool>,
 }
 
+impl Param {
+    /// The value of a numeric parameter whose values are all equal (a grey `rgb`, a single
+    /// `float`), else `None`.
+    pub fn constant(&self) -> Option<f64> {
+        match (&self.ty, &self.values) {
+            (ParamType::Float | ParamType::Integer | ParamType::Rgb, Values::Nums(v))
+                if !v.is_empty() && v.iter().all(|x| *x == v[0]) =>
+            {
+                Some(v[0])
+            }
+            _ => None,
+        }
+    }
+}
+
 /// A spectrum-valued parameter before conversion to RGB (see `spectra`).
 #[derive(Clone, Debug, PartialEq)]
 pub enum SpecVal {
@@ -233,7 +248,7 @@ impl ParamSet {
                 _ => want_count(&p, 1, 0, true)?,
             },
             ParamType::Blackbody => {
-                // pbrt-v3 files give [T scale]; the scale is ignored as pbrt-v4 does.
+                // pbrt-v3 files give [T scale]; lights fold the scale in (`upgrade`).
                 if let Values::Nums(v) = &p.values {
                     if v.len() != 1 && v.len() != 2 {
                         want_count(&p, 1, 0, true)?;
@@ -348,6 +363,35 @@ impl ParamSet {
             p.values = Values::Nums(read_spd(&path, &text)?);
         }
         Ok(())
+    }
+
+    /// Rename every parameter called `from` (pbrt-v4's `--upgrade` renames).
+    pub fn rename(&mut self, from: &str, to: &str) {
+        for p in &mut self.params {
+            if p.name == from {
+                p.name = to.to_string();
+            }
+        }
+    }
+
+    /// Remove the parameters called `name`, returning the last one.
+    pub fn remove(&mut self, name: &str) -> Option<Param> {
+        let i = self.params.iter().rposition(|p| p.name == name)?;
+        let p = self.params.remove(i);
+        self.params.retain(|q| q.name != name);
+        Some(p)
+    }
+
+    /// Add a parameter (replacing any of the same name).
+    pub fn push(&mut self, ty: ParamType, name: &str, values: Values, loc: Loc) {
+        self.params.retain(|q| q.name != name);
+        self.params.push(Param {
+            ty,
+            name: name.to_string(),
+            values,
+            loc,
+            used: Cell::new(false),
+        });
     }
 
     /// The parameter called `name`, marking it used.

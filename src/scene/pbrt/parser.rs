@@ -5,8 +5,9 @@ use super::lights::{AreaLightDesc, parse_area_light, parse_light};
 use super::materials::{MaterialCtx, MaterialDesc, parse_material};
 use super::params::ParamSet;
 use super::shapes::{ShapeCtx, make_shape};
-use super::textures::TextureTable;
+use super::textures::{TextureTable, Warn};
 use super::tokenizer::{Loc, Tok, Token, Tokenizer, err_at};
+use super::upgrade;
 use super::{PbrtScene, ShapeCall};
 use crate::camera::Camera;
 use crate::geometry::Transform;
@@ -215,6 +216,16 @@ impl Parser {
             }
         }
         Ok(v)
+    }
+
+    /// Run a pbrt-v3 rewrite (`upgrade`) and report its warnings.
+    fn upgrade<R>(&mut self, f: impl FnOnce(&mut Warn) -> R) -> R {
+        let mut pending = Vec::new();
+        let r = f(&mut |k: &str, l: &Loc, m: String| pending.push((k.to_string(), l.clone(), m)));
+        for (k, l, m) in pending {
+            self.warn(&k, &l, m);
+        }
+        r
     }
 
     fn params(&mut self) -> anyhow::Result<ParamSet> {
@@ -544,7 +555,8 @@ impl Parser {
             "Film" => {
                 self.require_world(name, &loc, false)?;
                 let (ty, _) = self.expect_string("a film type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                let ty = self.upgrade(|w| upgrade::film(&ty, &mut ps, &loc, w));
                 if ty != "rgb" {
                     self.warn(
                         "film-type",
@@ -608,7 +620,8 @@ impl Parser {
             "PixelFilter" => {
                 self.require_world(name, &loc, false)?;
                 let (ty, _) = self.expect_string("a filter type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                upgrade::filter(&ty, &mut ps);
                 let default_r = match ty.as_str() {
                     "box" => 0.5,
                     "triangle" => 2.0,
@@ -780,7 +793,8 @@ impl Parser {
             "LightSource" => {
                 self.require_world(name, &loc, true)?;
                 let (ty, _) = self.expect_string("a light type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                let ty = self.upgrade(|w| upgrade::light(&ty, &mut ps, &loc, w));
                 let dir = self.dir();
                 let mut pending = Vec::new();
                 let l = parse_light(
@@ -803,7 +817,8 @@ impl Parser {
             "AreaLightSource" => {
                 self.require_world(name, &loc, true)?;
                 let (ty, _) = self.expect_string("an area light type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                let ty = self.upgrade(|w| upgrade::area_light(&ty, &mut ps, &loc, w));
                 let mut pending = Vec::new();
                 let a = parse_area_light(&ty, &ps, &loc, &mut |k: &str, l: &Loc, m: String| {
                     pending.push((k.to_string(), l.clone(), m))
@@ -817,7 +832,8 @@ impl Parser {
             "Material" => {
                 self.require_world(name, &loc, true)?;
                 let (ty, _) = self.expect_string("a material type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                let ty = self.upgrade(|w| upgrade::material(&ty, &mut ps, &loc, w));
                 let d = self.parse_material_desc(&ty, &ps, &loc)?;
                 self.report_unused(&ps, &format!("Material \"{ty}\""));
                 self.descs.push(d);
@@ -827,13 +843,14 @@ impl Parser {
             "MakeNamedMaterial" => {
                 self.require_world(name, &loc, true)?;
                 let (n, _) = self.expect_string("a material name")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
                 let ty = ps.string("type")?.ok_or_else(|| {
                     err_at(
                         &loc,
                         format!("MakeNamedMaterial \"{n}\": expected \"string type\", found none"),
                     )
                 })?;
+                let ty = self.upgrade(|w| upgrade::material(&ty, &mut ps, &loc, w));
                 let d = self.parse_material_desc(&ty, &ps, &loc)?;
                 self.report_unused(&ps, &format!("Material \"{ty}\""));
                 if self.named_materials.contains_key(&n) {
@@ -860,7 +877,8 @@ impl Parser {
                 let (n, _) = self.expect_string("a texture name")?;
                 let (ty, _) = self.expect_string("a texture type (\"spectrum\" or \"float\")")?;
                 let (class, _) = self.expect_string("a texture class")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                upgrade::texture(&class, &mut ps);
                 let dir = self.dir();
                 let mut pending = Vec::new();
                 self.textures.define(
@@ -880,7 +898,8 @@ impl Parser {
             "Shape" => {
                 self.require_world(name, &loc, true)?;
                 let (ty, _) = self.expect_string("a shape type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                upgrade::shape(&ty, &mut ps);
                 self.shape(&ty, &ps, &loc)?;
                 self.report_unused(&ps, &format!("Shape \"{ty}\""));
             }

@@ -144,7 +144,9 @@ pub fn sampled_at(pairs: &[(f32, f32)], l: f64) -> f64 {
             if l < first || l > last {
                 return 0.0;
             }
-            let i = pairs.partition_point(|p| (p.0 as f64) <= l).clamp(1, pairs.len() - 1);
+            let i = pairs
+                .partition_point(|p| (p.0 as f64) <= l)
+                .clamp(1, pairs.len() - 1);
             let ((l0, v0), (l1, v1)) = (pairs[i - 1], pairs[i]);
             let t = (l - l0 as f64) / (l1 - l0) as f64;
             v0 as f64 + t * (v1 - v0) as f64
@@ -184,7 +186,11 @@ pub fn conductor_rgb(eta: &[(f32, f32)], k: &[(f32, f32)]) -> (Rgb, Rgb) {
             num += resp(l) * sampled_at(eta, l);
             den += resp(l);
         }
-        let n = if den > 0.0 { (num / den).max(1e-3) } else { 1.0 };
+        let n = if den > 0.0 {
+            (num / den).max(1e-3)
+        } else {
+            1.0
+        };
         let r = (target[c] as f64).clamp(0.0, 0.9999);
         let k2 = (r * (n + 1.0).powi(2) - (n - 1.0).powi(2)) / (1.0 - r);
         if k2 >= 0.0 {
@@ -203,9 +209,7 @@ pub fn conductor_rgb(eta: &[(f32, f32)], k: &[(f32, f32)]) -> (Rgb, Rgb) {
 /// Spectral Fresnel reflectance of a conductor at incidence cosine `cos`, converted to RGB like
 /// a reflectance (the reference [`conductor_rgb`] is checked against).
 pub fn conductor_reflectance_rgb(eta: &[(f32, f32)], k: &[(f32, f32)], cos: f32) -> Rgb {
-    spectrum_to_rgb(|l| {
-        fr_complex(cos, sampled_at(eta, l) as f32, sampled_at(k, l) as f32) as f64
-    })
+    spectrum_to_rgb(|l| fr_complex(cos, sampled_at(eta, l) as f32, sampled_at(k, l) as f32) as f64)
 }
 
 /// Convert a spectrum parameter to RGB for `usage`. Metal names return `None` (the conductor
@@ -271,7 +275,11 @@ mod tests {
         .unwrap();
         assert!((d - Rgb::ONE).abs().max_element() < 3e-3, "{d}");
         // Illuminant A (2856 K) is orange and the same colour as a 2856 K blackbody.
-        let a = to_rgb(&SpecVal::Named("stdillum-A".into()), SpectrumUse::Illuminant).unwrap();
+        let a = to_rgb(
+            &SpecVal::Named("stdillum-A".into()),
+            SpectrumUse::Illuminant,
+        )
+        .unwrap();
         let bb = blackbody_rgb(2856.0);
         assert!((a - bb).abs().max_element() < 0.01, "{a} vs {bb}");
         assert!(a.x > 1.2 && a.z < 0.5, "{a}");
@@ -347,7 +355,10 @@ mod tests {
             assert!(worst < 0.03, "{m}: worst {worst}");
             if m == "Au" || m == "Cu" {
                 // Measured: Au 0.025, Cu 0.0097 head-on for the separate η/k conversion.
-                assert!(naive_head_on > 0.009, "{m}: naive head-on error {naive_head_on}");
+                assert!(
+                    naive_head_on > 0.009,
+                    "{m}: naive head-on error {naive_head_on}"
+                );
             }
         }
         // Gold is gold: red > green > blue at normal incidence.
