@@ -190,6 +190,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         None => render(&scene, res, &opts)?,
     };
+    let mut img = img;
+    scene.film.sensor.apply(&mut img);
     penumbra::image::io::write_image(&img, &out, args.exposure)
         .with_context(|| format!("writing {}", out.display()))?;
     println!(

@@ -8,6 +8,7 @@
 //! (`file:line: warning: …`) and the load continues.
 
 pub mod cie_data;
+pub mod film;
 pub mod lights;
 pub mod materials;
 pub mod named_spectra;

@@ -54,6 +54,12 @@ pub struct Parser {
     world_seen: Option<Loc>,
     warned: HashSet<String>,
     camera: Option<(Transform, f32, Option<[f32; 4]>)>,
+    /// Film sensor parameters and where the Film directive is.
+    sensor: (super::film::SensorParams, Option<Loc>),
+    /// `exposuretime` given on the Film (else the camera's shutter interval).
+    film_exposure: Option<f32>,
+    /// The camera's `shutterclose − shutteropen`.
+    camera_exposure: f32,
     out: PbrtScene,
 }
 
@@ -65,6 +71,7 @@ fn film_default() -> FilmSpec {
         },
         filename: None,
         spp: None,
+        sensor: Default::default(),
     }
 }
 
@@ -101,6 +108,9 @@ impl Parser {
             world_seen: None,
             warned: HashSet::new(),
             camera: None,
+            sensor: (Default::default(), None),
+            film_exposure: None,
+            camera_exposure: 1.0,
             out: PbrtScene {
                 camera: Camera {
                     camera_to_world: Transform::IDENTITY,
@@ -307,6 +317,11 @@ impl Parser {
                 &loc,
                 format!("{kind} without matching End at end of file"),
             );
+        }
+        if let (mut params, Some(loc)) = self.sensor.clone() {
+            params.exposure_time = self.film_exposure.unwrap_or(self.camera_exposure);
+            let r = self.upgrade(|w| super::film::sensor_response(&params, &loc, w))?;
+            self.out.film.sensor = r;
         }
         self.out.images = std::mem::take(&mut self.textures.images);
         if let Some((cam, fov, sw)) = self.camera.take() {
@@ -544,6 +559,11 @@ impl Parser {
                         "Camera 'lensradius' ignored (pinhole camera)".into(),
                     );
                 }
+                let (open, close) = (
+                    ps.float("shutteropen", 0.0)?,
+                    ps.float("shutterclose", 1.0)?,
+                );
+                self.camera_exposure = close - open;
                 let _ = ps.find("focaldistance");
                 let _ = ps.find("frameaspectratio");
                 self.report_unused(&ps, "Camera");
@@ -580,15 +600,17 @@ impl Parser {
                         self.warn(p, &loc, format!("Film '{p}' ignored"));
                     }
                 }
-                for p in [
-                    "iso",
-                    "exposuretime",
-                    "whitebalance",
-                    "sensor",
-                    "savefp16",
-                    "diagonal",
-                    "maxcomponentvalue",
-                ] {
+                self.sensor = (
+                    super::film::SensorParams {
+                        iso: ps.float("iso", 100.0)?,
+                        white_balance: ps.float("whitebalance", 0.0)?,
+                        sensor: ps.string("sensor")?.unwrap_or_else(|| "cie1931".into()),
+                        exposure_time: 1.0,
+                    },
+                    Some(loc.clone()),
+                );
+                self.film_exposure = ps.opt_float("exposuretime")?;
+                for p in ["savefp16", "diagonal", "maxcomponentvalue"] {
                     let _ = ps.find(p);
                 }
                 self.report_unused(&ps, "Film");
