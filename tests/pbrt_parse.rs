@@ -413,7 +413,8 @@ Material "interface"
             reflectance: TextureDesc::Constant(Rgb::new(0.2, 0.3, 0.4)),
             roughness: Vec2::splat(0.05),
             eta: 1.4,
-            remap: true
+            remap: true,
+            layer: penumbra::bsdf::LayerParams::default(),
         }
     );
     assert_eq!(
