@@ -154,6 +154,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
+    for n in &loaded.notes {
+        eprintln!("note: {n}");
+    }
     let scene = loaded.scene;
     let res = args.res.unwrap_or(scene.film.resolution);
     let opts = RenderOptions {
