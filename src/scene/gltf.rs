@@ -217,6 +217,21 @@ impl Walk<'_> {
                 ));
             }
             let color = Rgb::from_array(light.color());
+            let (i, at) = (
+                light.intensity(),
+                format!("{file}: KHR_lights_punctual lights[{}]", light.index()),
+            );
+            if !(i.is_finite() && i >= 0.0) {
+                self.warnings.push(format!(
+                    "{at}: intensity {i} is not a finite non-negative number; the light is black"
+                ));
+            }
+            if !(color.is_finite() && color.min_element() >= 0.0) {
+                self.warnings.push(format!(
+                    "{at}: color [{} {} {}] is not finite and non-negative; negative or non-finite components taken as 0",
+                    color.x, color.y, color.z
+                ));
+            }
             self.b.add_light(punctual_light(
                 light.kind(),
                 color,
@@ -226,7 +241,7 @@ impl Walk<'_> {
         }
         if let Some(mesh) = node.mesh() {
             self.add_mesh(&mesh, world)
-                .with_context(|| format!("{file}: node {} mesh {}", node.index(), mesh.index()))?;
+                .with_context(|| format!("{file}: nodes[{}]", node.index()))?;
         }
         for child in node.children() {
             self.visit(&child, world, depth + 1)?;
@@ -249,14 +264,18 @@ impl Walk<'_> {
                 ));
                 continue;
             }
-            let pos_acc = prim
-                .get(&::gltf::Semantic::Positions)
-                .ok_or_else(|| anyhow!("primitives[{}]: no POSITION attribute", prim.index()))?;
+            let pos_acc = prim.get(&::gltf::Semantic::Positions).ok_or_else(|| {
+                anyhow!(
+                    "{mesh_name} primitives[{}]: no POSITION attribute",
+                    prim.index()
+                )
+            })?;
             check_accessor(&pos_acc, Role::Position)
-                .map_err(|e| anyhow!("primitives[{}]: POSITION {e}", prim.index()))?;
+                .map_err(|e| anyhow!("{mesh_name} primitives[{}]: POSITION {e}", prim.index()))?;
             if let Some(ix) = prim.indices() {
-                check_accessor(&ix, Role::Indices)
-                    .map_err(|e| anyhow!("primitives[{}]: indices {e}", prim.index()))?;
+                check_accessor(&ix, Role::Indices).map_err(|e| {
+                    anyhow!("{mesh_name} primitives[{}]: indices {e}", prim.index())
+                })?;
             }
             // Attributes a renderer can do without are dropped with a warning when misdeclared.
             let normals_ok = match prim.get(&::gltf::Semantic::Normals) {
@@ -283,7 +302,7 @@ impl Walk<'_> {
                 .read_positions()
                 .ok_or_else(|| {
                     anyhow!(
-                        "primitives[{}]: POSITION accessor {} lies outside its buffer",
+                        "{mesh_name} primitives[{}]: POSITION accessor {} lies outside its buffer",
                         prim.index(),
                         pos_acc.index()
                     )
@@ -294,7 +313,7 @@ impl Walk<'_> {
             let indices: Vec<u32> = match reader.read_indices() {
                 Some(ix) => ix.into_u32().collect(),
                 None if prim.indices().is_some() => bail!(
-                    "primitives[{}]: the indices accessor lies outside its buffer",
+                    "{mesh_name} primitives[{}]: the indices accessor lies outside its buffer",
                     prim.index()
                 ),
                 None => (0..nv as u32).collect(),
@@ -366,7 +385,7 @@ impl Walk<'_> {
             let repair = self
                 .b
                 .add_mesh_repaired(mesh, mat, emission)
-                .with_context(|| format!("primitives[{}]", prim.index()))?;
+                .with_context(|| format!("{mesh_name} primitives[{}]", prim.index()))?;
             if !repair.is_clean() {
                 self.warnings.push(format!("{at}: {}", repair.describe()));
             }
@@ -383,7 +402,12 @@ pub fn punctual_light(kind: Kind, color: Rgb, intensity: f32, world: Mat4) -> Li
     } else {
         0.0
     };
-    let radiometric = color.max(Rgb::ZERO) * intensity / LUMENS_PER_WATT;
+    let color = Rgb::from_array(
+        color
+            .to_array()
+            .map(|c| if c.is_finite() { c.max(0.0) } else { 0.0 }),
+    );
+    let radiometric = color * intensity / LUMENS_PER_WATT;
     let p = world.transform_point3(Vec3::ZERO);
     let dir = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
     match kind {
@@ -470,13 +494,44 @@ fn gltf_material(
         }
         None => Texture::Constant(factor),
     };
-    let strength = m
-        .emissive_strength()
-        .filter(|s| s.is_finite())
-        .unwrap_or(1.0);
-    let le = Rgb::from_array(m.emissive_factor()) * strength;
-    let emission = (le.is_finite() && le.max_element() > 0.0).then(|| AreaEmission {
-        l: le.max(Rgb::ZERO),
+    let at = match m.index() {
+        Some(i) => format!("{file}: materials[{i}] '{name}'"),
+        None => format!("{file}: default material"),
+    };
+    let strength = match m.emissive_strength() {
+        Some(s) if !(s.is_finite() && s >= 0.0) => {
+            warnings.push(format!(
+                "{at}: KHR_materials_emissive_strength {s} is not a finite non-negative number; 1 used"
+            ));
+            1.0
+        }
+        Some(s) => s,
+        None => 1.0,
+    };
+    let factor_e = Rgb::from_array(m.emissive_factor());
+    let le = factor_e * strength;
+    let le = if !factor_e.is_finite() {
+        warnings.push(format!(
+            "{at}: emissiveFactor [{} {} {}] is not finite (beyond f32); the material does not emit",
+            factor_e.x, factor_e.y, factor_e.z
+        ));
+        Rgb::ZERO
+    } else if !le.is_finite() {
+        warnings.push(format!(
+            "{at}: emissiveFactor × emissive strength {strength} overflows f32; the material does not emit"
+        ));
+        Rgb::ZERO
+    } else {
+        if le.min_element() < 0.0 {
+            warnings.push(format!(
+                "{at}: emissiveFactor [{} {} {}] has a negative component, taken as 0",
+                factor_e.x, factor_e.y, factor_e.z
+            ));
+        }
+        le.max(Rgb::ZERO)
+    };
+    let emission = (le.max_element() > 0.0).then(|| AreaEmission {
+        l: le,
         two_sided: m.double_sided(),
     });
     let finite01 = |x: f32, d: f32| if x.is_finite() { x.clamp(0.0, 1.0) } else { d };

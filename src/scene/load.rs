@@ -6,6 +6,7 @@
 use super::Scene;
 use super::builtin::{self, BuiltinOptions};
 use super::view::{ViewOptions, apply_view_flags};
+use crate::lights::LightSource;
 use anyhow::{Context, bail};
 use std::path::Path;
 
@@ -142,12 +143,17 @@ fn takes(knobs: &[&str]) -> String {
     }
 }
 
-/// A scene without lights renders black: say so (pbrt-v4 warns too), with `hint` if the
-/// loader knows why.
+/// A scene without lights, or whose lights all have zero power, renders black: say so
+/// (pbrt-v4 warns too), with `hint` if the loader knows why.
 pub fn warn_if_unlit(scene: &Scene, file: &str, hint: &str, warnings: &mut Vec<String>) {
-    if scene.lights.is_empty() {
+    let n = scene.lights.len();
+    if n == 0 {
         warnings.push(format!(
             "{file}: the scene has no lights, so the image will be black{hint}"
+        ));
+    } else if scene.lights.iter().all(|l| !(l.power() > 0.0)) {
+        warnings.push(format!(
+            "{file}: none of its {n} lights emits (all have zero power), so the image will be black{hint}"
         ));
     }
 }

@@ -16,7 +16,7 @@
 
 use crate::camera::Camera;
 use crate::geometry::interaction::NO_LIGHT;
-use crate::geometry::{Ray, RayQuery, Transform};
+use crate::geometry::{PrimKind, Primitive, Ray, RayQuery, Transform};
 use crate::lights::{Emitter, LightSampleContext, LightSource, SamplingMode};
 use crate::scene::{FilmSpec, Filter, Scene};
 use anyhow::ensure;
@@ -219,7 +219,7 @@ pub fn lit_rays(scene: &Scene, cam: &Camera) -> usize {
 /// The automatic camera of `scene`: the axis view that sees the most lit surface (ties, and
 /// a scene where nothing is lit, keep +z), with its probe count.
 pub fn best_axis_frame(scene: &Scene, fov_deg: f32) -> anyhow::Result<(Camera, Vec3, usize)> {
-    let (lo, hi) = scene.geometry.bounds();
+    let (lo, hi) = vertex_bounds(scene);
     check_box(lo, hi)?;
     let mut best: Option<(Camera, Vec3, usize)> = None;
     for side in SIDES {
@@ -266,11 +266,33 @@ pub fn camera_flags(cam: &Camera, target: Vec3) -> String {
     )
 }
 
+/// The box of the scene's triangle vertices (exact, unlike the BVH's padded bounds, so
+/// framing does not move when the BVH changes); the BVH's box if there are quadrics.
+fn vertex_bounds(scene: &Scene) -> (Vec3, Vec3) {
+    let g = &scene.geometry;
+    let mut b = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for i in 0..g.len() as u32 {
+        match g.primitive(i) {
+            Some(Primitive {
+                kind: PrimKind::Triangle { .. },
+                p,
+                ..
+            }) => {
+                for v in p {
+                    b = (b.0.min(*v), b.1.max(*v));
+                }
+            }
+            _ => return g.bounds(),
+        }
+    }
+    b
+}
+
 /// Place the camera of a scene whose file has none: the flags where given, the rest from the
 /// automatic framing. Returns the note that tells the user which camera was used.
 pub fn place_auto_camera(scene: &mut Scene, view: &ViewOptions) -> anyhow::Result<String> {
     let fov = view.fov.unwrap_or(DEFAULT_FOV_DEG);
-    let (lo, hi) = scene.geometry.bounds();
+    let (lo, hi) = vertex_bounds(scene);
     check_box(lo, hi)?;
     let centre = 0.5 * (lo + hi);
     let (eye, up, why) = match view.look_from {
