@@ -126,7 +126,7 @@ fn huge_obj_polygon_loads_fast() {
         let a = std::f64::consts::TAU * k as f64 / n as f64;
         obj.push_str(&format!("v {:.7} {:.7} 0\n", a.cos(), a.sin()));
     }
-    obj.push_str("f");
+    obj.push('f');
     for k in 1..=n {
         obj.push_str(&format!(" {k}"));
     }

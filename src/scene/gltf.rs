@@ -41,7 +41,7 @@ pub fn load_gltf(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     // The gltf crate and our accessor reads run on untrusted data: a panic becomes an error,
     // and its text stays out of the user's terminal.
     guard::catch(|| load_inner(path, opts))
-        .map_err(|()| anyhow!("{file}: the glTF reader crashed on this file"))?
+        .map_err(|_| anyhow!("{file}: the glTF reader crashed on this file"))?
 }
 
 fn load_inner(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {

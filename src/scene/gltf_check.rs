@@ -14,13 +14,13 @@ use anyhow::{anyhow, bail};
 /// Parse and validate a `.gltf`/`.glb` document (buffers not yet resolved).
 pub fn parse_document(bytes: &[u8], file: &str) -> anyhow::Result<::gltf::Gltf> {
     let raw = guard::catch(|| ::gltf::Gltf::from_slice_without_validation(bytes))
-        .map_err(|()| anyhow!("{file}: the glTF parser crashed on this file"))?
+        .map_err(|_| anyhow!("{file}: the glTF parser crashed on this file"))?
         .map_err(|e| anyhow!("{file}: invalid glTF: {e}"))?;
     let ::gltf::Gltf { document, blob } = raw;
     let json = document.into_json();
     check_references(&json).map_err(|e| anyhow!("{file}: invalid glTF: {e}"))?;
     let document = guard::catch(|| ::gltf::Document::from_json(json))
-        .map_err(|()| anyhow!("{file}: the glTF validator crashed on this file"))?
+        .map_err(|_| anyhow!("{file}: the glTF validator crashed on this file"))?
         .map_err(|e| match e {
             ::gltf::Error::Validation(errors) => {
                 let list: Vec<String> = errors

@@ -13,8 +13,12 @@ thread_local! {
 
 static WRAP_HOOK: Once = Once::new();
 
-/// Run `f`; `Err(())` if it panicked, with nothing printed for the panic.
-pub fn catch<T>(f: impl FnOnce() -> T) -> Result<T, ()> {
+/// A panic caught by [`catch`] (its message is deliberately dropped).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crashed;
+
+/// Run `f`; `Err(Crashed)` if it panicked, with nothing printed for the panic.
+pub fn catch<T>(f: impl FnOnce() -> T) -> Result<T, Crashed> {
     WRAP_HOOK.call_once(|| {
         let previous = std::panic::take_hook();
         std::panic::set_hook(Box::new(move |info| {
@@ -26,5 +30,5 @@ pub fn catch<T>(f: impl FnOnce() -> T) -> Result<T, ()> {
     let was = QUIET.with(|q| q.replace(true));
     let r = catch_unwind(AssertUnwindSafe(f));
     QUIET.with(|q| q.set(was));
-    r.map_err(|_| ())
+    r.map_err(|_| Crashed)
 }

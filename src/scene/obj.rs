@@ -36,8 +36,11 @@ const TOBJ: tobj::LoadOptions = tobj::LoadOptions {
     ignore_lines: true,
 };
 
+/// An MTL library `tobj` asked for: its path, its text if it could be read, its error.
+type Library = (PathBuf, Option<MtlText>, Option<tobj::LoadError>);
+
 /// What `tobj` made of a text: its result, or a crash.
-type Parsed = Result<tobj::LoadResult, ()>;
+type Parsed = Result<tobj::LoadResult, guard::Crashed>;
 
 fn parse(bytes: &[u8], load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult) -> Parsed {
     guard::catch(|| tobj::load_obj_buf(&mut Cursor::new(bytes), &TOBJ, load_mtl))
@@ -46,7 +49,7 @@ fn parse(bytes: &[u8], load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult) -> Parse
 /// The same failure: the same `tobj` error, or a crash again.
 fn same_failure(a: &Parsed, b: &Parsed) -> bool {
     match (a, b) {
-        (Err(()), Err(())) => true,
+        (Err(_), Err(_)) => true,
         (Ok(Err(x)), Ok(Err(y))) => x == y,
         _ => false,
     }
@@ -67,7 +70,7 @@ fn located_error(
     .unwrap_or(ranges.len().max(1));
     let text = obj_text::excerpt(bytes, ranges, line);
     let what = match full {
-        Err(()) => "the OBJ parser crashed on this line".to_string(),
+        Err(_) => "the OBJ parser crashed on this line".to_string(),
         Ok(Err(e)) => {
             let count = |key| obj_text::count_before(bytes, ranges, line, key);
             match e {
@@ -104,8 +107,7 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
 
     // MTL libraries in the order `tobj` asks for them, with the text it was given.
-    let libraries: RefCell<Vec<(PathBuf, Option<MtlText>, Option<tobj::LoadError>)>> =
-        RefCell::new(Vec::new());
+    let libraries: RefCell<Vec<Library>> = RefCell::new(Vec::new());
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
         let p = dir.join(name);
         let Ok(raw) = std::fs::read(&p) else {

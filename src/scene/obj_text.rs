@@ -106,11 +106,7 @@ pub fn mesh_first_lines(
             Some("f") | Some("l") => {
                 first.get_or_insert(k + 1);
             }
-            Some("o") | Some("g") => {
-                if first.is_some() {
-                    out.push(first.take());
-                }
-            }
+            Some("o") | Some("g") if first.is_some() => out.push(first.take()),
             Some("usemtl") => {
                 let name = line.split_once(' ').map_or("", |(_, n)| n).trim();
                 if !name.is_empty() {

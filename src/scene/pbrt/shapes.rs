@@ -341,7 +341,7 @@ pub fn make_shape(
                     "ply-polygons",
                     loc,
                     format!(
-                        "{} PLY polygons with more than 4 vertices fan-triangulated",
+                        "{} PLY polygons with more than 4 vertices triangulated (pbrt-v4 reads triangles and quads only)",
                         ply.big_polygons
                     ),
                 );
