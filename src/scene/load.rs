@@ -64,6 +64,7 @@ fn load_any(spec: &str, opts: &LoadOptions) -> anyhow::Result<Loaded> {
             .with_context(|| format!("building built-in scene '{spec}'"))?;
         let notes = apply_view_flags(&mut scene, &opts.view)
             .with_context(|| format!("{spec}: camera flags"))?
+            .map(|n| format!("{spec}: {n}"))
             .into_iter()
             .collect();
         return Ok(Loaded {
@@ -90,8 +91,14 @@ fn load_any(spec: &str, opts: &LoadOptions) -> anyhow::Result<Loaded> {
             let (mut scene, mut warnings) = super::pbrt::load_pbrt(path)?;
             let notes = apply_view_flags(&mut scene, &opts.view)
                 .with_context(|| format!("{spec}: camera flags"))?
+                .map(|n| format!("{spec}: {n}"))
                 .into_iter()
                 .collect();
+            if scene.geometry.is_empty() {
+                warnings.push(format!(
+                    "{spec}: the scene has no geometry (none given, or every mesh was dropped)"
+                ));
+            }
             warn_if_unlit(&scene, spec, "", &mut warnings);
             Loaded {
                 scene,
