@@ -160,3 +160,22 @@ fn huge_obj_polygon_loads_fast() {
     );
     assert!(secs < 10.0, "loading took {secs:.2} s");
 }
+
+#[test]
+fn large_concave_polygon_is_tiled_exactly() {
+    // A 20,000-vertex star (every other vertex pulled in): no balanced split tiles it, so ear
+    // clipping does, with Delaunay flips against slivers.
+    let n = 20_000;
+    let star: Vec<Vec2> = (0..n)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            let r = if k % 2 == 0 { 1.0 } else { 0.9 };
+            Vec2::new((r * a.cos()) as f32, (r * a.sin()) as f32)
+        })
+        .collect();
+    let t = Instant::now();
+    check(&star, Split::Ears);
+    let secs = t.elapsed().as_secs_f64();
+    eprintln!("20,000-vertex star: triangulated in {secs:.2} s");
+    assert!(secs < 5.0, "triangulation took {secs:.2} s");
+}

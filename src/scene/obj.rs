@@ -103,7 +103,9 @@ fn located_error(
 pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).with_context(|| format!("{file}: cannot read"))?;
-    let ranges = obj_text::lines(&bytes);
+    // Line offsets only when a message needs a line (16 bytes a line is a lot for big files).
+    let ranges_cell = std::cell::OnceCell::new();
+    let ranges = || ranges_cell.get_or_init(|| obj_text::lines(&bytes));
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
 
     // MTL libraries in the order `tobj` asks for them, with the text it was given.
@@ -127,24 +129,29 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     let parsed = parse(&bytes, load_mtl);
     let (models, materials) = match parsed {
         Ok(Ok(r)) => r,
-        ref failed => return Err(located_error(&file, &bytes, &ranges, failed)),
+        ref failed => return Err(located_error(&file, &bytes, ranges(), failed)),
     };
     let libraries = libraries.into_inner();
     let mut warnings = Vec::new();
-    let mtllib_lines: Vec<usize> = (1..=ranges.len())
-        .filter(|&n| {
-            let (a, b) = ranges[n - 1];
-            std::str::from_utf8(&bytes[a..b])
-                .ok()
-                .and_then(|l| l.split_whitespace().next())
-                == Some("mtllib")
-        })
-        .collect();
+    let mtllib_lines = || -> Vec<usize> {
+        let ranges = ranges();
+        (1..=ranges.len())
+            .filter(|&n| {
+                let (a, b) = ranges[n - 1];
+                std::str::from_utf8(&bytes[a..b])
+                    .ok()
+                    .and_then(|l| l.split_whitespace().next())
+                    == Some("mtllib")
+            })
+            .collect()
+    };
     let mut key_lines: HashMap<(String, String), String> = HashMap::new();
     for (k, (p, text, err)) in libraries.iter().enumerate() {
-        let at = mtllib_lines
-            .get(k)
-            .map_or(file.clone(), |n| format!("{file}:{n}"));
+        let at = || {
+            mtllib_lines()
+                .get(k)
+                .map_or(file.clone(), |n| format!("{file}:{n}"))
+        };
         if let Some(t) = text {
             warnings.extend(t.warnings.iter().cloned());
             for ((m, key), n) in &t.lines {
@@ -156,7 +163,8 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
         match (text, err) {
             (_, None) => {}
             (None, Some(_)) => warnings.push(format!(
-                "{at}: material library {} not found; its materials are grey diffuse",
+                "{}: material library {} not found; its materials are grey diffuse",
+                at(),
                 p.display()
             )),
             (Some(t), Some(e)) => {
@@ -196,7 +204,7 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     let mut first_lines: Option<Vec<Option<usize>>> = None;
     let mut at_mesh = |i: usize| -> String {
         let lines = first_lines.get_or_insert_with(|| {
-            let l = obj_text::mesh_first_lines(&bytes, &ranges, &names);
+            let l = obj_text::mesh_first_lines(&bytes, ranges(), &names);
             if l.len() == models.len() {
                 l
             } else {
@@ -269,7 +277,7 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     match any_face {
         None => bail!(
             "{file}:{}: no faces ('f' lines with three or more vertices) in the file",
-            ranges.len().max(1)
+            ranges().len().max(1)
         ),
         Some(i) if b.primitive_count() == 0 => bail!(
             "{}: no triangle is left: every one has zero area or a non-finite vertex",

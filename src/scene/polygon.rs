@@ -60,11 +60,14 @@ pub fn triangulate(poly: &[u32], positions: &[Vec3], out: &mut Vec<u32>) -> Spli
     }
     out.truncate(start);
     let mut tris: Vec<u32> = Vec::with_capacity(3 * (n - 2));
-    earcut::Earcut::new().earcut(flat.iter().map(|v| [v.x, v.y]), &[] as &[u32], &mut tris);
+    let xy: Vec<[f64; 2]> = flat.iter().map(|v| [v.x, v.y]).collect();
+    earcut::Earcut::new().earcut_slice(&xy, &[] as &[u32], &mut tris);
     if tris.len() != 3 * (n - 2) {
         fan(poly, out);
         return Split::Fan;
     }
+    // Ear clipping leaves slivers; Delaunay edge flips (boundary kept) fatten them.
+    earcut::refine(&mut tris, &xy);
     for t in tris.chunks_exact(3) {
         let (a, b, c) = (t[0] as usize, t[1] as usize, t[2] as usize);
         // Keep the polygon's winding whatever orientation earcut emits.
