@@ -1,7 +1,6 @@
 //! One entry point for "a scene name or a scene file": built-ins first, then files by extension.
 //! Here too what every format shares: the camera flags applied to a scene's own camera, a
-//! warning for a scene without lights, one warning for flags a scene does not take, and
-//! warnings worded the same way (`location: text`, the caller adding one `warning:`).
+//! warning for a scene without lights, and one warning for flags a scene does not take.
 
 use super::Scene;
 use super::builtin::{self, BuiltinOptions};
@@ -26,7 +25,8 @@ pub struct Loaded {
     /// The scene.
     pub scene: Scene,
     /// Warnings (unsupported features, approximations, repairs), each `location: text` with
-    /// file and line where known and no `warning:` prefix of its own.
+    /// file and line where known, or the pbrt parser's `file:line: warning: text`; the CLI
+    /// prints each with exactly one `warning:`.
     pub warnings: Vec<String>,
     /// Information that is no warning: the camera used when the flags or automatic framing
     /// placed it, as flags to paste.
@@ -35,12 +35,6 @@ pub struct Loaded {
 
 /// Load `spec`: a built-in scene name or a path to a scene file.
 pub fn load(spec: &str, opts: &LoadOptions) -> anyhow::Result<Loaded> {
-    let mut loaded = load_any(spec, opts)?;
-    loaded.warnings = loaded.warnings.iter().map(|w| bare_warning(w)).collect();
-    Ok(loaded)
-}
-
-fn load_any(spec: &str, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     if let Some(b) = builtin::find(spec) {
         let mut warnings = Vec::new();
         let given = [
@@ -162,15 +156,5 @@ pub fn warn_if_unlit(scene: &Scene, file: &str, hint: &str, warnings: &mut Vec<S
         warnings.push(format!(
             "{file}: none of its {n} lights emits (all have zero power), so the image will be black{hint}"
         ));
-    }
-}
-
-/// `w` without any `warning:` marker: `warning: x` → `x`, `file:line: warning: x` →
-/// `file:line: x`.
-fn bare_warning(w: &str) -> String {
-    let w = w.strip_prefix("warning: ").unwrap_or(w);
-    match w.split_once(": warning: ") {
-        Some((at, rest)) => format!("{at}: {rest}"),
-        None => w.to_string(),
     }
 }
