@@ -110,8 +110,8 @@ fn estimate(scene: &Scene, strategy: Strategy, selector: &str, ray: &Ray, m: u32
     (mean, (var / n).sqrt())
 }
 
-/// Every strategy (and MIS with the light BVH, whose importance must not cull lights behind a
-/// transmitting receiver) within 5σ of `exact`.
+/// Every strategy (and light sampling and MIS with the light BVH, whose importance must not
+/// cull lights behind a transmitting receiver) within 5σ of `exact`.
 fn check_all(what: &str, scene: &Scene, ray: &Ray, exact: f64) {
     let mut runs: Vec<(String, (f64, f64))> = Strategy::ALL
         .into_iter()
@@ -120,10 +120,9 @@ fn check_all(what: &str, scene: &Scene, ray: &Ray, exact: f64) {
             (s.to_string(), estimate(scene, s, "uniform", ray, m))
         })
         .collect();
-    runs.push((
-        "mis+bvh".into(),
-        estimate(scene, Strategy::Mis, "bvh", ray, 1),
-    ));
+    for s in [Strategy::LightSolidAngle, Strategy::Mis] {
+        runs.push((format!("{s}+bvh"), estimate(scene, s, "bvh", ray, 1)));
+    }
     let mut ok = true;
     for (name, (mean, se)) in &runs {
         let tol = 5.0 * se + 1e-3 * exact;
@@ -134,7 +133,10 @@ fn check_all(what: &str, scene: &Scene, ray: &Ray, exact: f64) {
         );
         ok &= pass;
     }
-    assert!(ok, "{what}: some strategy is off by more than 5σ (see above)");
+    assert!(
+        ok,
+        "{what}: some strategy is off by more than 5σ (see above)"
+    );
 }
 
 /// ∫ f(wo, wi) |cos θi| dωi over the cone of directions from `p` to the sphere (`c`, `r`),
@@ -194,12 +196,21 @@ fn ray_to(target: Vec3, from: Vec3) -> Ray {
 
 #[test]
 fn rough_glass_plane_transmits_a_light_behind_it_seen_from_outside() {
+    // Two lights, so the light BVH has to choose between lights behind the receiver.
     let (c, r, le, alpha) = (Vec3::new(0.3, 0.2, -2.0), 0.6f32, 5.0f32, 0.3f32);
-    let s = glass_plane(alpha, |b| sphere_light(b, c, r, le));
+    let (c2, r2, le2) = (Vec3::new(-1.0, 2.0, -1.5), 0.4f32, 3.0f32);
+    let s = glass_plane(alpha, |b| {
+        sphere_light(b, c, r, le);
+        sphere_light(b, c2, r2, le2);
+    });
     // 30° from the normal, from above (outside the glass).
     let ray = ray_to(Vec3::ZERO, Vec3::new(0.0, -1.5, 2.598));
-    let exact = le as f64 * cone_integral(alpha, Vec3::ZERO, ray.d, Vec3::Z, c, r, 768);
-    assert!(exact > 0.1, "the test needs a visible transmitted lobe: {exact}");
+    let exact = le as f64 * cone_integral(alpha, Vec3::ZERO, ray.d, Vec3::Z, c, r, 768)
+        + le2 as f64 * cone_integral(alpha, Vec3::ZERO, ray.d, Vec3::Z, c2, r2, 768);
+    assert!(
+        exact > 0.1,
+        "the test needs a visible transmitted lobe: {exact}"
+    );
     check_all("glass plane outside α=0.3", &s, &ray, exact);
 }
 
@@ -211,7 +222,10 @@ fn rough_glass_plane_transmits_a_light_behind_it_seen_from_inside() {
     // refracts out at 31°, near the light.
     let ray = ray_to(Vec3::ZERO, Vec3::new(0.0, 0.684, -1.879));
     let exact = le as f64 * cone_integral(alpha, Vec3::ZERO, ray.d, Vec3::Z, c, r, 768);
-    assert!(exact > 0.1, "the test needs a visible transmitted lobe: {exact}");
+    assert!(
+        exact > 0.1,
+        "the test needs a visible transmitted lobe: {exact}"
+    );
     check_all("glass plane inside α=0.2", &s, &ray, exact);
 }
 
