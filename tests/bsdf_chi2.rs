@@ -13,7 +13,7 @@ use penumbra::sampling::Frame;
 use penumbra::sampling::chi2::{Chi2Config, Chi2Result, chi2_directions, chi2_points};
 
 /// Number of chi-square tests in this file (for the Šidák correction); keep in sync.
-const NUM_TESTS: usize = 50;
+const NUM_TESTS: usize = 54;
 
 fn cfg() -> Chi2Config {
     Chi2Config {
@@ -302,6 +302,31 @@ fn chi2_rough_dielectric_sharp_transmission_zoomed() {
         let axis = refract_z(wo, eta).expect("below the critical angle");
         let name = format!("rough glass α=0.05 entering={entering} {deg}° transmission");
         zoomed(&name, &b, wo, axis, 0.4);
+    }
+}
+
+// ---------------------------------------------------------------- diffuse transmission
+
+#[test]
+fn chi2_diffuse_transmission() {
+    use penumbra::bsdf::DiffuseTransmission;
+    // The density does not depend on wo (beyond its side), so one angle per case suffices.
+    let dt = |r: f32, t: f32, s: LobeSampling| {
+        let mut b = DiffuseTransmission::new(Rgb::new(r, r * 0.5, r), Rgb::new(t, t, t * 0.2));
+        b.sampling = s;
+        Bsdf::DiffuseTransmission(b)
+    };
+    for (r, t, s, deg) in [
+        (0.3, 0.6, LobeSampling::Importance, 30.0),
+        (0.0, 0.5, LobeSampling::Importance, 45.0),
+        (0.5, 0.0, LobeSampling::Importance, 45.0),
+        (0.7, 0.2, LobeSampling::Uniform, 60.0),
+    ] {
+        sphere(
+            &format!("diffuse transmission R={r} T={t} {s:?} {deg}°"),
+            &dt(r, t, s),
+            wo_at(deg),
+        );
     }
 }
 

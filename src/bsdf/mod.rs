@@ -15,6 +15,7 @@
 pub mod coated;
 pub mod conductor;
 pub mod dielectric;
+pub mod diffuse_transmission;
 pub mod fresnel;
 pub mod ggx;
 pub mod lambert;
@@ -24,6 +25,7 @@ pub mod phong;
 pub use coated::CoatedDiffuse;
 pub use conductor::{Conductor, named_metal};
 pub use dielectric::Dielectric;
+pub use diffuse_transmission::DiffuseTransmission;
 pub use ggx::{TrowbridgeReitz, roughness_to_alpha};
 pub use lambert::Lambert;
 pub use mirror::Mirror;
@@ -194,6 +196,8 @@ pub enum Bsdf {
     CoatedDiffuse(CoatedDiffuse),
     /// Ideal mirror.
     Mirror(Mirror),
+    /// Lambertian reflection and transmission (thin sheets).
+    DiffuseTransmission(DiffuseTransmission),
 }
 
 macro_rules! dispatch {
@@ -205,6 +209,7 @@ macro_rules! dispatch {
             Bsdf::Dielectric($b) => $e,
             Bsdf::CoatedDiffuse($b) => $e,
             Bsdf::Mirror($b) => $e,
+            Bsdf::DiffuseTransmission($b) => $e,
         }
     };
 }
@@ -225,6 +230,7 @@ impl Bsdf {
             Bsdf::Phong(b) => b.sampling = s,
             Bsdf::Conductor(b) => b.sampling = s,
             Bsdf::CoatedDiffuse(b) => b.sampling = s,
+            Bsdf::DiffuseTransmission(b) => b.sampling = s,
             Bsdf::Dielectric(_) | Bsdf::Mirror(_) => {}
         }
     }

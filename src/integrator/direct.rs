@@ -713,7 +713,8 @@ pub(super) fn bsdf_ray_through(
     // sampling, but a transmitting BSDF's obey it too (a refraction that leaves on the
     // viewer's side of the geometry leaks light); a reflecting BSDF's delta samples (mirrors)
     // keep their old exemption, so opaque images stay as they were.
-    if !gathers_from(transmits, wi.dot(n), bs.wi.z) && !(bs.delta && !transmits) {
+    let exempt = bs.delta && !transmits;
+    if !(exempt || gathers_from(transmits, wi.dot(n), bs.wi.z)) {
         return None;
     }
     let weight = bs.f * (bs.wi.z.abs() / bs.pdf);

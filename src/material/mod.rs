@@ -8,7 +8,9 @@ pub use texture::Texture;
 use crate::Rgb;
 use crate::bsdf::fresnel::k_from_reflectance;
 use crate::bsdf::ggx::is_smooth;
-use crate::bsdf::{Bsdf, CoatedDiffuse, Conductor, Dielectric, Lambert, Mirror, Phong};
+use crate::bsdf::{
+    Bsdf, CoatedDiffuse, Conductor, Dielectric, DiffuseTransmission, Lambert, Mirror, Phong,
+};
 use crate::geometry::SurfaceHit;
 use glam::Vec2;
 
@@ -58,6 +60,16 @@ pub enum Material {
     },
     /// Perfect mirror (reflectance 1).
     Mirror,
+    /// Lambertian reflection on the viewer's side and Lambertian transmission to the other
+    /// (pbrt-v4 `diffusetransmission`): both scaled by `scale`, then clamped to [0, 1].
+    DiffuseTransmission {
+        /// Reflectance.
+        reflectance: Texture,
+        /// Transmittance.
+        transmittance: Texture,
+        /// Factor on both.
+        scale: f32,
+    },
 }
 
 /// The Lambertian BSDF of a `diffuse` material (reflectance clamped to [0, 1]); inlined into the
@@ -120,6 +132,14 @@ impl Material {
                 entering: front,
             }),
             Material::Mirror => Bsdf::Mirror(Mirror { r: Rgb::ONE }),
+            Material::DiffuseTransmission {
+                reflectance,
+                transmittance,
+                scale,
+            } => Bsdf::DiffuseTransmission(DiffuseTransmission::new(
+                reflectance.eval(hit.uv) * *scale,
+                transmittance.eval(hit.uv) * *scale,
+            )),
         }
     }
 
@@ -130,9 +150,10 @@ impl Material {
             Material::Conductor { alpha, .. } | Material::Dielectric { alpha, .. } => {
                 is_smooth(*alpha)
             }
-            Material::Diffuse { .. } | Material::Phong { .. } | Material::CoatedDiffuse { .. } => {
-                false
-            }
+            Material::Diffuse { .. }
+            | Material::Phong { .. }
+            | Material::CoatedDiffuse { .. }
+            | Material::DiffuseTransmission { .. } => false,
         }
     }
 }
