@@ -75,13 +75,15 @@ fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
             .unwrap();
         a.swap(c, p);
         b.swap(c, p);
-        for r in c + 1..n {
-            let m = a[r][c] / a[c][c];
+        let (top, rest) = a.split_at_mut(c + 1);
+        let pivot = &top[c];
+        for (i, row) in rest.iter_mut().enumerate() {
+            let m = row[c] / pivot[c];
             if m != 0.0 {
-                for k in c..n {
-                    a[r][k] -= m * a[c][k];
+                for (x, p) in row[c..].iter_mut().zip(&pivot[c..]) {
+                    *x -= m * p;
                 }
-                b[r] -= m * b[c];
+                b[c + 1 + i] -= m * b[c];
             }
         }
     }
