@@ -649,18 +649,18 @@ pub(super) fn light_estimate(
     hit: &SurfaceHit,
     mis: Option<MisHeuristic>,
 ) -> Option<(Ray, Rgb)> {
-    let cos_geometric = ls.wi.dot(ctx.n);
-    // The first test rejects what no reflecting BSDF gathers before the frame change; the
-    // second is the whole rule (for a reflecting BSDF, already decided by the first).
+    // The hemisphere rule; a reflecting BSDF's needs no shading cosine, so it is decided
+    // before the frame change, as the lane kernels have always done it.
+    let transmits = bsdf.transmits();
     if !(ls.pdf > 0.0)
         || pmf <= 0.0
         || ls.li == Rgb::ZERO
-        || (cos_geometric <= 0.0 && !bsdf.transmits())
+        || (!transmits && !gathers_from(false, ls.wi.dot(ctx.n), 0.0))
     {
         return None;
     }
     let wi_local = frame.to_local(ls.wi);
-    if !gathers_from(bsdf.transmits(), cos_geometric, wi_local.z) {
+    if transmits && !gathers_from(true, ls.wi.dot(ctx.n), wi_local.z) {
         return None;
     }
     // Under MIS the BSDF pdf is needed too: one dispatch evaluates both (for the few
