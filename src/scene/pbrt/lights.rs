@@ -206,10 +206,10 @@ pub fn parse_light(
                         ));
                     }
                     let path = resolve(dir, &file);
-                    if !path.is_file() {
+                    if let Some(why) = crate::image::io::not_a_file(&path) {
                         return Err(err_at(
                             params.loc_of("filename").as_ref().unwrap_or(loc),
-                            format!("infinite light: file not found: {}", path.display()),
+                            format!("infinite light: {why}: {}", path.display()),
                         ));
                     }
                     let floc = params.loc_of("filename").unwrap_or(loc.clone());

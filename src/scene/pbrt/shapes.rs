@@ -363,10 +363,10 @@ pub fn make_shape(
             for ignored in ["edgelength", "displacement"] {
                 let _ = params.find(ignored);
             }
-            if !path.is_file() {
+            if let Some(why) = crate::image::io::not_a_file(&path) {
                 return Err(err_at(
                     params.loc_of("filename").as_ref().unwrap_or(loc),
-                    format!("plymesh: file not found: {}", path.display()),
+                    format!("plymesh: {why}: {}", path.display()),
                 ));
             }
             let ply = read_ply(&path).map_err(|e| err_at(loc, format!("plymesh: {e}")))?;
