@@ -267,6 +267,7 @@ fn film() -> FilmSpec {
         },
         filename: None,
         spp: None,
+        sensor: Default::default(),
     }
 }
 

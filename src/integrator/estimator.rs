@@ -19,10 +19,11 @@
 //! selector stays unbiased). Delta lobes and delta lights cannot be produced by the other
 //! technique: their weight is 1.
 //!
-//! Both techniques estimate the same integrand restricted to directions above the geometric
-//! surface on the viewer's side (reflection only), so their MIS combination stays unbiased even
-//! where shading normals disagree with the geometry; only delta transmission (smooth glass)
-//! leaves below it.
+//! Both techniques estimate the same integrand restricted by one hemisphere rule,
+//! [`gathers_from`]: above the geometric surface on the viewer's side for reflecting BSDFs;
+//! both sides for transmitting ones (rough glass, diffuse transmission), except directions on
+//! which the geometric and shading normals disagree. So their MIS combination stays unbiased
+//! even where shading normals disagree with the geometry.
 //!
 //! The stages (`stages.rs`) call these functions for one lane at a time; the vector kernels
 //! (`lanes.rs`) call the very same functions in loops over 16 lanes, so every lane's bits are
@@ -30,7 +31,7 @@
 
 use super::MisHeuristic;
 use crate::Rgb;
-use crate::bsdf::{BsdfSample, Bxdf};
+use crate::bsdf::{BsdfSample, Bxdf, gathers_from};
 use crate::geometry::{Ray, SurfaceHit};
 use crate::light_selection::{LightSelector, ShadingPoint};
 use crate::lights::{Emitter, Light, LightLiSample, LightSampleContext, SamplingMode};
@@ -61,10 +62,20 @@ pub(super) fn light_estimate(
     hit: &SurfaceHit,
     mis: Option<MisHeuristic>,
 ) -> Option<(Ray, Rgb)> {
-    if !(ls.pdf > 0.0) || pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(ctx.n) <= 0.0 {
+    // The hemisphere rule; a reflecting BSDF's needs no shading cosine, so it is decided
+    // before the frame change, as the lane kernels have always done it.
+    let transmits = bsdf.transmits();
+    if !(ls.pdf > 0.0)
+        || pmf <= 0.0
+        || ls.li == Rgb::ZERO
+        || (!transmits && !gathers_from(false, ls.wi.dot(ctx.n), 0.0))
+    {
         return None;
     }
     let wi_local = frame.to_local(ls.wi);
+    if transmits && !gathers_from(true, ls.wi.dot(ctx.n), wi_local.z) {
+        return None;
+    }
     // Under MIS the BSDF pdf is needed too: one dispatch evaluates both (for the few
     // occluded samples it is wasted, cheaper than a second call for all the others).
     let weigh = if ls.delta { None } else { mis };
@@ -112,12 +123,24 @@ impl BsdfRay {
     };
 }
 
-/// BSDF sample `bs` (local frame `frame`) at `hit`, whose geometric normal facing the viewer
-/// is `n`, as a ray with its weight f·cos / pdf; `None` when the estimate is zero without
-/// tracing it.
+/// BSDF sample `bs` of a reflecting BSDF (local frame `frame`) at `hit`, whose geometric
+/// normal facing the viewer is `n`, as a ray with its weight f·cos / pdf; `None` when the
+/// estimate is zero without tracing it. Shared by the per-lane path and the lane kernels.
 #[inline(always)]
 pub(super) fn bsdf_ray_of(
     bs: &BsdfSample,
+    frame: &Frame,
+    n: Vec3,
+    hit: &SurfaceHit,
+) -> Option<BsdfRay> {
+    bsdf_ray_through(bs, false, frame, n, hit)
+}
+
+/// [`bsdf_ray_of`] for a BSDF that transmits (`transmits`) or not.
+#[inline(always)]
+pub(super) fn bsdf_ray_through(
+    bs: &BsdfSample,
+    transmits: bool,
     frame: &Frame,
     n: Vec3,
     hit: &SurfaceHit,
@@ -126,9 +149,12 @@ pub(super) fn bsdf_ray_of(
         return None;
     }
     let wi = frame.to_world(bs.wi).normalize();
-    // Only specular transmission (smooth glass) may leave below the geometric surface;
-    // every other sample there is rejected exactly as light sampling rejects it.
-    if wi.dot(n) <= 0.0 && !bs.delta {
+    // The rule light sampling applies (`light_estimate`). Delta samples cannot meet light
+    // sampling, but a transmitting BSDF's obey it too (a refraction that leaves on the
+    // viewer's side of the geometry leaks light); a reflecting BSDF's delta samples (mirrors)
+    // keep their exemption, so opaque images stay as they were.
+    let exempt = bs.delta && !transmits;
+    if !(exempt || gathers_from(transmits, wi.dot(n), bs.wi.z)) {
         return None;
     }
     let weight = bs.f * (bs.wi.z.abs() / bs.pdf);

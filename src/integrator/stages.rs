@@ -20,7 +20,7 @@
 
 use super::dims::{VertexDims, rounds_at, sample_index};
 use super::estimator::{
-    BsdfRay, Techniques, bsdf_ray_of, emission_weight, emitter_hit_value, escaped_radiance,
+    BsdfRay, Techniques, bsdf_ray_through, emission_weight, emitter_hit_value, escaped_radiance,
     light_estimate, nee_pdf,
 };
 use super::lanes::{DiffuseBsdfLanes, TriangleLightLanes};
@@ -160,11 +160,18 @@ struct Shading<'h> {
 
 impl Shading<'_> {
     /// The selector's view of this shading point, built only for selectors that read it.
+    /// A transmitting BSDF gathers from both sides, so the selector gets no normal (zero):
+    /// with one, importance-based selectors would give lights behind the surface (the bulb's
+    /// filament) probability 0.
     #[inline]
     fn shading_point(&self) -> ShadingPoint {
         ShadingPoint {
             p: self.ctx.p,
-            n: self.ctx.n,
+            n: if self.bsdf.transmits() {
+                Vec3::ZERO
+            } else {
+                self.ctx.n
+            },
             wo: self.wo,
         }
     }
@@ -562,11 +569,11 @@ impl<'a> Integrator<'a> {
     fn bsdf_ray(&self, sh: &Shading, lobe: f32, u: Vec2) -> Option<BsdfRay> {
         // Lambert inline: `Bsdf::sample` carries every BSDF and stays out of line, so the
         // common diffuse hit paid a call and a `BsdfSample` returned through memory.
-        let bs = match sh.bsdf {
-            Bsdf::Lambert(b) => b.sample(sh.wo_local, lobe, u),
-            other => other.sample(sh.wo_local, lobe, u),
-        }?;
-        bsdf_ray_of(&bs, &sh.frame, sh.ctx.n, sh.hit)
+        let (bs, transmits) = match sh.bsdf {
+            Bsdf::Lambert(b) => (b.sample(sh.wo_local, lobe, u), false),
+            other => (other.sample(sh.wo_local, lobe, u), other.transmits()),
+        };
+        bsdf_ray_through(&bs?, transmits, &sh.frame, sh.ctx.n, sh.hit)
     }
 
     /// What BSDF ray `b` from `sh` gathers given the nearest emitter `hit` along it (`None`:
