@@ -30,6 +30,7 @@ SCENES=(
   "many-rooms --rooms 3|uniform bvh adaptive wald"
   "many-mesh|uniform power bvh exhaustive"
   "$MIXED|uniform power bvh"
+  "tests/data/bulb/bulb.pbrt|uniform bvh"
 )
 STRATEGIES=(
   "bsdf"
