@@ -7,6 +7,9 @@
 # Usage: scripts/ident.sh OLD_BIN NEW_BIN [OUT_DIR]
 #   QUICK=1  fewer combinations (one selector per scene, patterns stratified + sobol, M = 1 | 2
 #            only on cornell) for a check while developing.
+#   OLD_ARGS / NEW_ARGS  extra options for one binary only, e.g. NEW_ARGS="--integrator direct"
+#            when the new binary knows an option the old one does not (the default Cornell box
+#            asks for path tracing since --integrator exists; every render here is direct).
 # Exit status 0 when every pair is identical. Needs ../shared/ for the cornell scenes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -56,10 +59,11 @@ run() { # name, args...
   total=$((total + 1))
   local b
   for b in old new; do
-    local bin=$OLD
-    [ $b = new ] && bin=$NEW
+    local bin=$OLD extra=${OLD_ARGS:-}
+    [ $b = new ] && bin=$NEW && extra=${NEW_ARGS:-}
     rm -f "$OUT/$b/$name.pfm"
-    if ! "$bin" render "$@" --quiet -o "$OUT/$b/$name.pfm" >"$OUT/$b/$name.log" 2>&1; then
+    # shellcheck disable=SC2086
+    if ! "$bin" render "$@" $extra --quiet -o "$OUT/$b/$name.pfm" >"$OUT/$b/$name.log" 2>&1; then
       differ=$((differ + 1))
       echo "FAILED ($b) $name: render $*"
       sed 's/^/    /' "$OUT/$b/$name.log"

@@ -71,6 +71,8 @@ fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> 
         shadow_rays: m,
         bsdf_sampling: penumbra::bsdf::LobeSampling::Importance,
         mis_light: penumbra::lights::SamplingMode::SolidAngle,
+        max_depth: 1,
+        roulette: false,
     };
     // A ray that reaches the origin from the side, clear of lights above it.
     let o = Vec3::new(0.0, -3.0, 1.0);

@@ -2,9 +2,8 @@
 //! radiance is derived in tests/furnace_support (an angular integral equation solved on a
 //! grid); here the solver is checked against the closed form of two diffuse-transmission
 //! sheets and for convergence on rough glass, the furnace scene's interfaces are checked to
-//! face the right way, and the path-tracer comparison itself waits behind `#[ignore]` until
-//! `penumbra render --integrator path` exists (run it with `cargo test --release --test
-//! furnace_slab -- --ignored`).
+//! face the right way, and the path tracer (`penumbra render --integrator path`, the file's
+//! maxdepth 1000) is compared with the derived answer.
 
 mod furnace_support;
 
@@ -103,12 +102,10 @@ fn furnace_scene_interfaces_face_outward() {
     }
 }
 
-/// The path tracer against the derived answer. Assumes `penumbra render FILE --integrator
-/// path` (depth from the file's `Integrator "path" "integer maxdepth" [1000]`, unbounded in
-/// effect: at α = 0.3 light leaves the slab within tens of bounces); adapt the flags when the
-/// path tracer lands, then drop the `#[ignore]`.
+/// The path tracer against the derived answer: `penumbra render FILE --integrator path`
+/// (depth from the file's `Integrator "path" "integer maxdepth" [1000]`, unbounded in effect:
+/// at α = 0.3 light leaves the slab within tens of bounces).
 #[test]
-#[ignore = "needs `penumbra render --integrator path` (the path tracer is being built)"]
 fn path_tracer_white_furnace_through_rough_slab() {
     let dir = std::env::temp_dir().join(format!("penumbra-furnace-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

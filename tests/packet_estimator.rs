@@ -30,6 +30,8 @@ fn check(scene: &Scene, strategy: Strategy, selection: &str, spp: u32, m: u32) -
         shadow_rays: m,
         bsdf_sampling: penumbra::bsdf::LobeSampling::Importance,
         mis_light: SamplingMode::Area,
+        max_depth: 1,
+        roulette: false,
     };
     let res = UVec2::new(24, 24);
     let camera = scene.camera.rays(res);

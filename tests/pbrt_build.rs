@@ -43,7 +43,16 @@ fn cornell_builder_has_8_materials_and_2_emissive_triangles() {
 #[test]
 fn cornell_from_file_renders_the_same_pixels_as_builtin() {
     let (from_file, warnings) = load_pbrt(&cornell_path()).unwrap();
-    assert!(warnings.iter().any(|w| w.contains("Integrator")));
+    // `Integrator "path"` is rendered as asked: no warning, and the file's depth.
+    assert!(
+        !warnings.iter().any(|w| w.contains("Integrator")),
+        "{warnings:?}"
+    );
+    let spec = from_file.integrator.clone().expect("the file's Integrator");
+    assert_eq!(
+        (spec.kind, spec.max_depth),
+        (penumbra::integrator::IntegratorKind::Path, 65)
+    );
     let builtin = load("cornell", &LoadOptions::default()).unwrap().scene;
     let opts = RenderOptions {
         spp: 4,

@@ -344,6 +344,15 @@ WorldBegin"#,
         }
     );
     assert_eq!(s.max_depth, Some(3));
+    // volpath renders as path, with one warning.
+    let spec = s.integrator.clone().expect("Integrator read");
+    assert_eq!(spec.kind, penumbra::integrator::IntegratorKind::Path);
+    assert_eq!(spec.max_depth, 3);
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("\"volpath\" rendered by penumbra's path tracer"))
+    );
     assert!(
         s.warnings
             .iter()

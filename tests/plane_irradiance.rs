@@ -621,6 +621,8 @@ fn measure(b: &Built, c: &Case, cfg: &Config, seed: u64) -> Vec<(f64, f64)> {
         shadow_rays: 1,
         bsdf_sampling: LobeSampling::Importance,
         mis_light: cfg.mis_light,
+        max_depth: 1,
+        roulette: false,
     };
     let mut r = Rng::new(&[0x51ed, c.id, seed]);
     let s = c.size;

@@ -94,6 +94,8 @@ fn estimate(scene: &Scene, strategy: Strategy, selector: &str, ray: &Ray, m: u32
         shadow_rays: m,
         bsdf_sampling: penumbra::bsdf::LobeSampling::Importance,
         mis_light: penumbra::lights::SamplingMode::SolidAngle,
+        max_depth: 1,
+        roulette: false,
     };
     let pixels = 2000u32;
     let (mut s, mut s2) = (0.0f64, 0.0f64);

@@ -2,7 +2,7 @@
 
 use anyhow::Context;
 use glam::UVec2;
-use penumbra::integrator::{MisHeuristic, RenderOptions, Strategy, render};
+use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy, render};
 use penumbra::sampling::PatternKind;
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
@@ -28,7 +28,8 @@ pub struct Args {
     /// Eye rays per pixel (N); default: the scene's, else 64.
     #[arg(long)]
     pub spp: Option<u32>,
-    /// Light (or BSDF) samples per eye ray (M).
+    /// Light (or BSDF) samples per eye ray (M) at the first vertex; path tracing's later
+    /// vertices take one light sample and one BSDF sample each.
     #[arg(long, default_value_t = 1)]
     pub shadow_rays: u32,
     /// Resolution WxH; default: the scene's.
@@ -43,7 +44,18 @@ pub struct Args {
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
-    /// Estimator: bsdf, light-area, light-solid-angle or mis.
+    /// Light transport: direct (emission and direct lighting: the path tracer with max depth
+    /// 1) or path (global illumination). Default: the scene file's `Integrator`, else direct.
+    #[arg(long)]
+    pub integrator: Option<IntegratorKind>,
+    /// Path tracing's depth, pbrt-v4's `maxdepth` (N bounces: 1 is direct lighting, 0 emission
+    /// only). Default: the scene file's, else 5.
+    #[arg(long)]
+    pub max_depth: Option<u32>,
+    /// Path tracing without Russian roulette (every path runs to --max-depth).
+    #[arg(long)]
+    pub no_roulette: bool,
+    /// Estimator at every path vertex: bsdf, light-area, light-solid-angle or mis.
     #[arg(long, default_value = "mis")]
     pub strategy: Strategy,
     /// MIS heuristic: power (β = 2) or balance.
@@ -52,9 +64,10 @@ pub struct Args {
     /// Sample pattern: fixed, random, grid, stratified, lhs or sobol.
     #[arg(long, default_value = "stratified")]
     pub pattern: PatternKind,
-    /// Light selection strategy.
-    #[arg(long, default_value = "uniform")]
-    pub light_selection: String,
+    /// Light selection strategy (at every path vertex). Default: the scene file's
+    /// `lightsampler`, else uniform.
+    #[arg(long)]
+    pub light_selection: Option<String>,
     /// Light sampling technique inside `mis`: solid-angle (default) or area.
     #[arg(long, default_value = "solid-angle", value_parser = parse_mode)]
     pub mis_light: penumbra::lights::SamplingMode,
@@ -187,6 +200,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // The loaders build the BVHs (scene and emitters) as their last step and time them.
     let bvh_time = scene.geometry.build_time + scene.emitters.build_time;
     let res = args.res.unwrap_or(scene.film.resolution);
+    let file = scene.integrator.as_ref();
     let opts = RenderOptions {
         spp: args.spp.or(scene.film.spp).unwrap_or(64),
         shadow_rays: args.shadow_rays,
@@ -194,9 +208,20 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         strategy: args.strategy,
         mis: args.mis,
         pattern: args.pattern,
-        light_selection: args.light_selection.clone(),
+        light_selection: args
+            .light_selection
+            .clone()
+            .or_else(|| file.and_then(|i| i.light_selection.clone()))
+            .unwrap_or_else(|| "uniform".into()),
         bsdf_sampling: args.bsdf_sampling,
         mis_light: args.mis_light,
+        // The flags override the file's `Integrator`; without either, direct lighting.
+        integrator: args
+            .integrator
+            .or(file.map(|i| i.kind))
+            .unwrap_or(IntegratorKind::Direct),
+        max_depth: args.max_depth.or(file.map(|i| i.max_depth)).unwrap_or(5),
+        roulette: !args.no_roulette,
         progress: !args.quiet,
     };
     anyhow::ensure!(
@@ -254,7 +279,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         res.y,
         opts.spp,
         opts.shadow_rays,
-        opts.strategy,
+        match opts.integrator {
+            IntegratorKind::Direct => opts.strategy.to_string(),
+            IntegratorKind::Path => format!("{} path depth {}", opts.strategy, opts.max_depth),
+        },
         secs(load_time.saturating_sub(bvh_time)),
         secs(bvh_time),
         secs(render_time),

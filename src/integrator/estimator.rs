@@ -298,6 +298,22 @@ pub(super) fn escaped_radiance(
     sum
 }
 
+/// Russian roulette on a path's throughput `beta` after vertex `depth` (0: the camera ray's
+/// hit) sampled its BSDF, pbrt-v4's rule: from the second vertex on, a path whose largest
+/// throughput component is below 1 survives with probability p equal to it (`u()`, a uniform
+/// draw, is read only then). Returns p for a surviving path, whose throughput is then
+/// divided by p so that the estimate stays unbiased (E = p·β/p + (1 − p)·0 = β), and `None`
+/// for one that ends.
+#[inline]
+pub(super) fn roulette(depth: u32, beta: Rgb, u: impl FnOnce() -> f32) -> Option<f32> {
+    let top = beta.max_element();
+    if depth == 0 || !(top < 1.0) {
+        return Some(1.0);
+    }
+    let q = (1.0 - top).max(0.0);
+    if u() < q { None } else { Some(1.0 - q) }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -322,5 +338,26 @@ mod tests {
             // The light sample of the same direction takes the complement.
             assert!((w + h.weight(0.5, 2.0) - 1.0).abs() < 1e-6, "{h:?}");
         }
+    }
+
+    #[test]
+    fn roulette_keeps_the_expected_throughput() {
+        let never = || -> f32 { panic!("drew a number where no roulette is played") };
+        // The first vertex and throughputs of at least 1 always continue, drawing nothing.
+        assert_eq!(roulette(0, Rgb::splat(0.1), never), Some(1.0));
+        assert_eq!(roulette(3, Rgb::new(0.2, 1.0, 0.1), never), Some(1.0));
+        // Otherwise survival with p = max component: E[survive / p] = 1.
+        let beta = Rgb::new(0.25, 0.5, 0.1);
+        let n = 10_000;
+        let mut expected = 0.0f64;
+        for i in 0..n {
+            let u = (i as f32 + 0.5) / n as f32;
+            if let Some(p) = roulette(2, beta, || u) {
+                assert_eq!(p, 0.5);
+                expected += 1.0 / p as f64;
+            }
+        }
+        assert!((expected / n as f64 - 1.0).abs() < 1e-3, "{expected}");
+        assert_eq!(roulette(1, Rgb::ZERO, || 0.999), None);
     }
 }

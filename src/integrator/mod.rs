@@ -73,6 +73,44 @@ impl FromStr for Strategy {
     }
 }
 
+/// The light transport the image shows (`--integrator`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum IntegratorKind {
+    /// Emission plus one bounce of direct light: the path tracer with max depth 1.
+    Direct,
+    /// Global illumination: the path tracer with [`RenderOptions::max_depth`].
+    Path,
+}
+
+impl IntegratorKind {
+    /// The CLI name.
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Direct => "direct",
+            IntegratorKind::Path => "path",
+        }
+    }
+}
+
+impl fmt::Display for IntegratorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for IntegratorKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim() {
+            "direct" => Ok(Self::Direct),
+            "path" => Ok(Self::Path),
+            _ => Err(format!(
+                "unknown integrator '{s}' (expected direct or path)"
+            )),
+        }
+    }
+}
+
 /// MIS weighting heuristic.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum MisHeuristic {
@@ -128,8 +166,25 @@ pub struct RenderOptions {
     pub mis_light: crate::lights::SamplingMode,
     /// How BSDF lobes are sampled (the lecture's I₂ variants; importance by default).
     pub bsdf_sampling: LobeSampling,
+    /// Direct lighting or path tracing.
+    pub integrator: IntegratorKind,
+    /// Path tracing's pbrt-v4 `maxdepth`: vertices that sample lights and the BSDF (ignored
+    /// by `Direct`, which is 1).
+    pub max_depth: u32,
+    /// Russian roulette on the path throughput (pbrt-v4's rule; unbiased).
+    pub roulette: bool,
     /// Show a progress bar.
     pub progress: bool,
+}
+
+impl RenderOptions {
+    /// The max depth the stages run: 1 for direct lighting.
+    pub fn depth(&self) -> u32 {
+        match self.integrator {
+            IntegratorKind::Direct => 1,
+            IntegratorKind::Path => self.max_depth,
+        }
+    }
 }
 
 impl Default for RenderOptions {
@@ -144,6 +199,9 @@ impl Default for RenderOptions {
             light_selection: "uniform".into(),
             bsdf_sampling: LobeSampling::Importance,
             mis_light: crate::lights::SamplingMode::SolidAngle,
+            integrator: IntegratorKind::Direct,
+            max_depth: 5,
+            roulette: true,
             progress: false,
         }
     }

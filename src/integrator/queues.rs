@@ -136,8 +136,21 @@ pub(super) struct PathLanes {
     pub(super) pixel: [u8; PACKET],
     /// Per lane: eye sample index within the pixel (the pattern's sample index at depth 0).
     pub(super) sample: [u32; PACKET],
-    /// Throughput β: the product of the BSDF weights f·cos / pdf of the bounces so far.
+    /// Throughput β: the product of the BSDF weights f·cos / pdf of the bounces so far
+    /// (divided by the Russian-roulette survival probabilities).
     pub(super) beta: V3,
+    /// Per lane: the factor of the emission the current ray finds (1 for camera rays): the
+    /// share of the previous vertex's BSDF-sampled emission this ray stands for (1/M beside
+    /// the other rounds' gathered rays), times the roulette survival probability that β was
+    /// divided by (that emission belongs to the previous vertex, which counts it whether the
+    /// path survives or not).
+    pub(super) le_scale: Lanes,
+    /// The rays of the paths that continue (written by stage *continue_or_terminate*).
+    pub(super) rays: RayPacket,
+    /// Lanes whose path continues past the current vertex.
+    pub(super) next: u32,
+    /// Per continuing lane: its throughput at the next vertex.
+    beta_next: V3,
     /// Bit k: path k's current ray left the camera or a delta lobe (its emission weight is 1).
     prev_delta: u32,
     /// Per lane: the pdf of the BSDF sample that made the current ray.
@@ -155,6 +168,10 @@ impl PathLanes {
             pixel: [0; PACKET],
             sample: [0; PACKET],
             beta: V3::splat(Vec3::ONE),
+            le_scale: [1.0; PACKET],
+            rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
+            next: 0,
+            beta_next: V3::splat(Vec3::ONE),
             prev_delta: u32::MAX,
             prev_pdf: [0.0; PACKET],
             prev_at: [ShadingPoint {
@@ -174,7 +191,41 @@ impl PathLanes {
         self.pixel = cam.pixel;
         self.sample = cam.eye;
         self.beta = V3::splat(Vec3::ONE);
+        self.le_scale = [1.0; PACKET];
+        self.next = 0;
         self.prev_delta = u32::MAX;
+    }
+
+    /// Path k continues along BSDF ray `b` (sampled at `at`, as light selection saw it) with
+    /// throughput `beta` at the next vertex and emission scale `le_scale` there (the current
+    /// vertex's emission has been counted: its fields can be overwritten).
+    #[inline]
+    pub(super) fn set_next(
+        &mut self,
+        k: usize,
+        b: &BsdfRay,
+        beta: crate::Rgb,
+        le_scale: f32,
+        at: ShadingPoint,
+    ) {
+        self.next |= 1 << k;
+        self.beta_next.set(k, beta);
+        self.le_scale[k] = le_scale;
+        self.prev_delta = (self.prev_delta & !(1 << k)) | ((b.delta as u32) << k);
+        self.prev_pdf[k] = b.pdf;
+        self.prev_at[k] = at;
+    }
+
+    /// Move to the next vertex: the continuing paths stay active with their new throughput,
+    /// the others end.
+    #[inline]
+    pub(super) fn advance(&mut self) {
+        self.active = self.next;
+        self.next = 0;
+        if self.active != 0 {
+            self.beta = self.beta_next;
+            self.depth += 1;
+        }
     }
 
     /// Whether path k's current ray left the camera or a delta lobe.

@@ -68,6 +68,8 @@ pub fn render(
         shadow_rays: opts.shadow_rays.max(1),
         bsdf_sampling: opts.bsdf_sampling,
         mis_light: opts.mis_light,
+        max_depth: opts.depth(),
+        roulette: opts.roulette,
     };
     let camera = scene.camera.rays(res);
     let isa = Isa::detect();

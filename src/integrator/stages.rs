@@ -6,22 +6,25 @@
 //!
 //! ```text
 //!  camera rays ─▶ draw ─▶ intersect ─▶ shade ─┬─▶ round j = 0 .. M: draw ─▶ sample_lights
-//!  (render.rs)           closest hits  Le·w·β, │     ─▶ sample_bsdfs ─▶ gather_emitters
-//!                                      BSDFs   │     ─▶ trace_shadows ─▶ accumulate
-//!                                              └─▶ finish: L += β·Σ/M, continue or terminate
+//!  (render.rs)      ▲    closest hits  Le·w·β, │     ─▶ sample_bsdfs ─▶ (j = 0) continue_or_terminate
+//!                   │                  BSDFs   │     ─▶ gather_emitters ─▶ trace_shadows ─▶ accumulate
+//!                   │                          └─▶ finish: L += β·Σ/M; the continuing paths advance
+//!                   └──── continuing BSDF rays (while depth < max depth) ◀──┘
 //! ```
 //!
-//! Direct lighting is the path with one vertex: its BSDF rays are the last of the path, so
+//! Direct lighting is the path with max depth 1: its BSDF rays are the last of the path, so
 //! `gather_emitters` finds what they reach with a query of the emitters alone (most BSDF rays
 //! reach no light: no closest-hit query of the whole scene for them) and tests the visibility
-//! of the emitters found; `finish` terminates every path. Every value is a pure function of
+//! of the emitters found; `finish` terminates every path. Path tracing loops: round 0's BSDF
+//! ray of a vertex before the last continues its path (Russian roulette permitting), and the
+//! emission it finds is counted by `shade` at the next vertex. Every value is a pure function of
 //! the path's pixel, sample index and pattern dimension, and each lane's value is what the
 //! one-lane packet ([`Integrator::li`]) computes, so neither packets nor threads change a bit.
 
 use super::dims::{VertexDims, rounds_at, sample_index};
 use super::estimator::{
     BsdfRay, Techniques, bsdf_ray_through, emission_weight, emitter_hit_value, escaped_radiance,
-    light_estimate, nee_pdf,
+    light_estimate, nee_pdf, roulette,
 };
 use super::lanes::{DiffuseBsdfLanes, TriangleLightLanes};
 use super::queues::{BsdfRays, CameraPacket, Draws, LaneShading, PathLanes, Receivers, ShadowRays};
@@ -57,6 +60,11 @@ pub struct Integrator<'a> {
     pub bsdf_sampling: LobeSampling,
     /// Light sampling technique of `mis`.
     pub mis_light: SamplingMode,
+    /// pbrt-v4's `maxdepth`: the most vertices of a path that sample lights and the BSDF
+    /// (1: direct lighting; 0: emission seen by camera rays only).
+    pub max_depth: u32,
+    /// Russian roulette on the path throughput from the second vertex on (pbrt-v4's rule).
+    pub roulette: bool,
 }
 
 /// The work queues of one render thread (made once per tile, not per packet: every lane a
@@ -223,27 +231,55 @@ impl<'a> Integrator<'a> {
     ) -> u64 {
         let t = self.techniques();
         q.paths.start(cam);
-        let m = rounds_at(q.paths.depth, self.shadow_rays.max(1));
         *out = [Rgb::ZERO; PACKET];
         // The first round's draws are pure arithmetic that does not depend on the hits:
         // issued before the camera rays' traversal, they overlap with its memory-bound work.
-        self.draw(pxs, q, t, 0, q.paths.active);
+        self.draw(pxs, q, t, 0, q.paths.active, self.continues(0));
         let mut rays = self.intersect(&cam.rays, q);
         self.shade(&cam.rays, q, t, out);
-        // The vertex's M rounds of light and BSDF samples (N eye rays × M shadow rays).
-        q.sums = [Rgb::ZERO; PACKET];
-        for j in 0..m {
-            if j > 0 {
-                self.draw(pxs, q, t, j, q.shaded);
+        // One vertex per pass: the path's ray has been traced and shaded (its emission added).
+        while q.paths.depth < self.max_depth {
+            let depth = q.paths.depth;
+            let m = rounds_at(depth, self.shadow_rays.max(1));
+            // Whether this vertex's BSDF ray (round 0's) may continue the path.
+            let go_on = self.continues(depth);
+            // The vertex's M rounds of light and BSDF samples (N eye rays × M shadow rays at
+            // the first vertex, one round later).
+            q.sums = [Rgb::ZERO; PACKET];
+            for j in 0..m {
+                if j > 0 {
+                    self.draw(pxs, q, t, j, q.shaded, false);
+                }
+                rays += self.sample_lights(q, t);
+                rays += self.sample_bsdfs(pxs, q, t, j, go_on && j == 0);
+                if go_on && j == 0 {
+                    self.continue_or_terminate(pxs, q, t, m);
+                }
+                // Continuing rays find their emission at the next vertex (stage *shade*).
+                let on = if go_on && j == 0 { q.paths.next } else { 0 };
+                self.gather_emitters(q, t, on);
+                self.trace_shadows(q);
+                self.accumulate(q, t);
             }
-            rays += self.sample_lights(q, t);
-            rays += self.sample_bsdfs(pxs, q, t, j);
-            self.gather_emitters(q, t);
-            self.trace_shadows(q);
-            self.accumulate(q, t);
+            self.finish(q, m, out);
+            if q.paths.active == 0 {
+                break;
+            }
+            // The next vertex: the continuing BSDF rays are the paths' rays.
+            self.draw(pxs, q, t, 0, q.paths.active, self.continues(q.paths.depth));
+            let next = q.paths.rays;
+            self.intersect(&next, q);
+            self.shade(&next, q, t, out);
         }
-        self.finish(q, m, out);
         rays
+    }
+
+    /// Whether the BSDF ray of vertex `depth` may continue its path (a later vertex samples
+    /// lights and the BSDF): pbrt-v4's `depth + 1 < maxdepth`. Otherwise that ray is the
+    /// path's last and only gathers the emission it reaches.
+    #[inline(always)]
+    fn continues(&self, depth: u32) -> bool {
+        depth + 1 < self.max_depth
     }
 
     /// Stage *draw*: round `j`'s light and BSDF draws of the lanes `on` (only the dimensions
@@ -253,11 +289,21 @@ impl<'a> Integrator<'a> {
     /// is drawn later, only for receivers whose BSDF has lobes to choose (values are pure
     /// functions of pixel, dimension and index, so skipping it changes nothing).
     // Forced inline: out of line, the draws came back through memory after a call.
+    /// `go_on`: the round's BSDF ray may continue the path (so it is drawn whatever the
+    /// techniques).
     #[inline(always)]
-    fn draw(&self, pxs: &[PixelSamples], q: &mut Queues, t: Techniques, j: u32, on: u32) {
+    fn draw(
+        &self,
+        pxs: &[PixelSamples],
+        q: &mut Queues,
+        t: Techniques,
+        j: u32,
+        on: u32,
+        go_on: bool,
+    ) {
         let (n, m, depth) = (self.eye_rays.max(1), self.shadow_rays.max(1), q.paths.depth);
         let dims = VertexDims::at(depth);
-        let (light, bsdf) = (t.light(), t.bsdf());
+        let (light, bsdf) = (t.light(), t.bsdf() || go_on);
         for k in bits(on) {
             let px = &pxs[q.paths.pixel[k] as usize];
             let (index, count) = sample_index(depth, q.paths.sample[k], j, n, m);
@@ -282,7 +328,12 @@ impl<'a> Integrator<'a> {
         self.scene
             .geometry
             .intersect_packet_cols(rays, active, &mut q.hits, &mut q.rx.cols);
-        u64::from(active.count_ones())
+        // Later vertices' rays were counted when their BSDF samples made them.
+        if q.paths.depth == 0 {
+            u64::from(active.count_ones())
+        } else {
+            0
+        }
     }
 
     /// Stage *shade*: every hit's shading geometry (all lanes at once), then per lane the
@@ -307,7 +358,7 @@ impl<'a> Integrator<'a> {
                     le
                 }
             };
-            out[k] += q.paths.beta.get(k) * le;
+            out[k] += q.paths.beta.get(k) * (le * q.paths.le_scale[k]);
         }
         q.shaded = shaded;
     }
@@ -368,10 +419,18 @@ impl<'a> Integrator<'a> {
     /// receivers in the kernel, the others one lane at a time; the rays and their weights go
     /// to the `bsdf_rays` queue. Returns the rays made (one logical ray per sample, whatever
     /// comes of it: an emitter query, maybe a visibility test).
+    /// `go_on`: the rays may continue their paths (they are sampled whatever the techniques).
     #[inline(always)]
-    fn sample_bsdfs(&self, pxs: &[PixelSamples], q: &mut Queues, t: Techniques, j: u32) -> u64 {
+    fn sample_bsdfs(
+        &self,
+        pxs: &[PixelSamples],
+        q: &mut Queues,
+        t: Techniques,
+        j: u32,
+        go_on: bool,
+    ) -> u64 {
         q.bsdf_rays.clear();
-        if !t.bsdf() {
+        if !(t.bsdf() || go_on) {
             return 0;
         }
         q.bsdf_lanes.active = q.shaded & q.rx.diffuse;
@@ -405,17 +464,19 @@ impl<'a> Integrator<'a> {
     /// gives, with the ray whose blocking voids it, to the `gathered` queue. The first hit of
     /// the ray is an emitter exactly when that emitter is visible, so this is the closest-hit
     /// estimator without a closest-hit query for the many rays that miss every light.
+    /// Lanes of `continuing` are skipped: their rays go on to the next vertex.
     #[inline(always)]
-    fn gather_emitters(&self, q: &mut Queues, t: Techniques) {
+    fn gather_emitters(&self, q: &mut Queues, t: Techniques, continuing: u32) {
         let scene = self.scene;
         q.gathered.active = 0;
-        if q.bsdf_rays.active == 0 {
+        let ending = q.bsdf_rays.active & !continuing;
+        if ending == 0 || !t.bsdf() {
             return;
         }
         scene
             .emitters
-            .intersect_packet(&q.bsdf_rays.rays, q.bsdf_rays.active, &mut q.emitter_hits);
-        for k in bits(q.bsdf_rays.active) {
+            .intersect_packet(&q.bsdf_rays.rays, ending, &mut q.emitter_hits);
+        for k in bits(ending) {
             let hit = q.emitter_hits[k].as_ref();
             // Most BSDF rays reach no light: nothing to gather, no view to build.
             if hit.is_none() && scene.infinite_lights.is_empty() {
@@ -449,14 +510,49 @@ impl<'a> Integrator<'a> {
         }
     }
 
+    /// Stage *continue_or_terminate* (after round 0's BSDF samples of a vertex whose ray may
+    /// go on): each lane with a BSDF ray continues with throughput β·f·cos/pdf unless Russian
+    /// roulette ([`roulette`]) ends it; the ray, the new β, the emission scale and what the
+    /// MIS weight at the next hit needs go to the path queue ([`PathLanes::set_next`]). Lanes
+    /// without a ray, or ended, terminate (their ray then only gathers emission).
+    #[inline(always)]
+    fn continue_or_terminate(&self, pxs: &[PixelSamples], q: &mut Queues, t: Techniques, m: u32) {
+        let depth = q.paths.depth;
+        let (n, mm) = (self.eye_rays.max(1), self.shadow_rays.max(1));
+        let dim = VertexDims::at(depth).roulette;
+        // The share of this vertex's BSDF-sampled emission the continuing ray carries: the
+        // other rounds gather theirs (1/M each) when BSDF samples gather at all.
+        let rounds_share = if t.bsdf() { 1.0 / m as f32 } else { 1.0 };
+        q.paths.next = 0;
+        for k in bits(q.bsdf_rays.active) {
+            let Some(sh) = q.view(k) else { continue };
+            let b = q.bsdf_rays.get(k);
+            let beta = q.paths.beta.get(k) * b.weight;
+            let survive = if self.roulette {
+                let px = &pxs[q.paths.pixel[k] as usize];
+                roulette(depth, beta, || {
+                    let (index, count) = sample_index(depth, q.paths.sample[k], 0, n, mm);
+                    px.sample_1d(dim, index, count)
+                })
+            } else {
+                Some(1.0)
+            };
+            let Some(p) = survive else { continue };
+            let at = sh.shading_point();
+            q.paths.set_next(k, &b, beta / p, p * rounds_share, at);
+        }
+        q.paths.rays = q.bsdf_rays.rays;
+    }
+
     /// Stage *finish*: each shaded path adds β times the mean of its `m` rounds to its
-    /// radiance. Then continue or terminate: direct lighting's paths end here.
+    /// radiance; then the continuing paths move to their next vertex and the others end
+    /// (direct lighting's all end here).
     #[inline(always)]
     fn finish(&self, q: &mut Queues, m: u32, out: &mut [Rgb; PACKET]) {
         for k in bits(q.shaded) {
             out[k] += q.paths.beta.get(k) * (q.sums[k] / m as f32);
         }
-        q.paths.active = 0;
+        q.paths.advance();
     }
 
     /// The emitted radiance path `k`'s ray finds at `hit` (its shading geometry in `rx`),

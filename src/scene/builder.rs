@@ -325,6 +325,7 @@ impl SceneBuilder {
             infinite_lights,
             camera,
             film,
+            integrator: None,
         })
     }
 }

@@ -96,4 +96,18 @@ pub struct Scene {
     pub camera: Camera,
     /// Film settings.
     pub film: FilmSpec,
+    /// What the scene file asks of the integrator (pbrt-v4's `Integrator`), if it says.
+    pub integrator: Option<IntegratorSpec>,
+}
+
+/// A scene file's `Integrator` directive as penumbra renders it: the CLI's `--integrator`,
+/// `--max-depth` and `--light-selection` override it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct IntegratorSpec {
+    /// Direct lighting or path tracing (`path`, and the integrators penumbra renders as path).
+    pub kind: crate::integrator::IntegratorKind,
+    /// `maxdepth` (pbrt-v4's default 5).
+    pub max_depth: u32,
+    /// `lightsampler` mapped to a selector name, when the file gives one.
+    pub light_selection: Option<String>,
 }

@@ -93,7 +93,14 @@ pub fn add_cornell_box(
 pub fn cornell(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
     let mut b = SceneBuilder::new();
     add_cornell_box(&mut b, true)?;
-    b.build(cornell_camera(), cornell_film())
+    let mut scene = b.build(cornell_camera(), cornell_film())?;
+    // The file's `Integrator "path" "integer maxdepth" [ 65 ]`.
+    scene.integrator = Some(crate::scene::IntegratorSpec {
+        kind: crate::integrator::IntegratorKind::Path,
+        max_depth: 65,
+        light_selection: None,
+    });
+    Ok(scene)
 }
 
 /// The Cornell box with glossy spheres instead of blocks: modified Phong (front row, exponents

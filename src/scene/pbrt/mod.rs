@@ -52,8 +52,10 @@ pub struct PbrtScene {
     pub camera: Camera,
     /// Film settings (default 1280×720, box filter).
     pub film: FilmSpec,
-    /// `Integrator "maxdepth"` if given (penumbra renders direct lighting).
+    /// `Integrator "maxdepth"` if given.
     pub max_depth: Option<u32>,
+    /// The `Integrator` directive as penumbra renders it, if the file has one.
+    pub integrator: Option<crate::scene::IntegratorSpec>,
     /// Materials in builder order (only those used by a shape).
     pub materials: Vec<MaterialDesc>,
     /// Shapes in file order.
@@ -160,6 +162,10 @@ pub fn parse_pbrt_to_builder(
 
 /// Load a pbrt-v4 scene: the entry point the CLI calls.
 pub fn load_pbrt(path: &Path) -> anyhow::Result<(Scene, Vec<String>)> {
-    let (b, camera, film, warnings) = parse_pbrt_to_builder(path)?;
-    Ok((b.build(camera, film)?, warnings))
+    let parsed = parse_pbrt(path)?;
+    let integrator = parsed.integrator.clone();
+    let (b, camera, film, warnings) = parsed.into_builder()?;
+    let mut scene = b.build(camera, film)?;
+    scene.integrator = integrator;
+    Ok((scene, warnings))
 }

@@ -119,6 +119,7 @@ impl Parser {
                 },
                 film: film_default(),
                 max_depth: None,
+                integrator: None,
                 materials: Vec::new(),
                 shapes: Vec::new(),
                 lights: Vec::new(),
@@ -676,11 +677,31 @@ impl Parser {
                 let (ty, _) = self.expect_string("an integrator type")?;
                 let ps = self.params()?;
                 let d = ps.int("maxdepth", 5)?;
-                self.out.max_depth = Some(d.clamp(0, u32::MAX as i64) as u32);
+                let max_depth = d.clamp(0, u32::MAX as i64) as u32;
+                self.out.max_depth = Some(max_depth);
+                // pbrt-v4's light samplers are penumbra's selectors of the same names.
+                let light_selection = match ps.string("lightsampler")?.as_deref() {
+                    Some(s @ ("uniform" | "power" | "bvh")) => Some(s.to_string()),
+                    Some(other) => {
+                        self.warn("lightsampler", &loc, format!("lightsampler \"{other}\" unknown: light selection by the --light-selection default"));
+                        None
+                    }
+                    None => None,
+                };
+                if ps.bool("regularize", false)? {
+                    self.warn("regularize", &loc, "\"regularize\" not implemented: near-specular BSDFs are rendered as they are".into());
+                }
                 for p in ps.params.iter() {
                     let _ = ps.find(&p.name);
                 }
-                self.warn("Integrator", &loc, format!("Integrator \"{ty}\" read; penumbra renders direct lighting (maxdepth {d} remembered)"));
+                if ty != "path" {
+                    self.warn("Integrator", &loc, format!("Integrator \"{ty}\" rendered by penumbra's path tracer (maxdepth {max_depth})"));
+                }
+                self.out.integrator = Some(crate::scene::IntegratorSpec {
+                    kind: crate::integrator::IntegratorKind::Path,
+                    max_depth,
+                    light_selection,
+                });
             }
             "Accelerator" => {
                 self.require_world(name, &loc, false)?;
