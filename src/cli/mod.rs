@@ -26,6 +26,8 @@ pub enum Command {
     Lab(lab::Args),
     /// Plot and chi-square-test a sampling routine; dump samples, evaluate its pdf.
     Warp(warp::Args),
+    /// Combine the sample-range parts of a render (`render --spp-range`) into the whole image.
+    Merge(merge::Args),
 }
 
 pub mod bench;
@@ -33,6 +35,7 @@ pub mod compare;
 pub mod interrupt;
 pub mod lab;
 pub mod memory;
+pub mod merge;
 pub mod messages;
 pub mod render;
 pub mod warp;
@@ -55,6 +58,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Some(Command::Bench(a)) => bench::run(a),
         Some(Command::Warp(a)) => warp::run_cmd(a),
+        Some(Command::Merge(a)) => merge::run(a),
         None => match Cli::try_parse_from(["penumbra", "render"])?.command {
             Some(Command::Render(a)) => render::run(a),
             _ => unreachable!("`render` parses to the render command"),

@@ -15,6 +15,7 @@ use super::interrupt::Interrupt;
 use super::memory::{self, Need};
 use super::messages;
 use penumbra::image::io::{check_output_path, remove_stale_temps, write_image_with};
+use penumbra::image::parts::{Part, PartInfo, render_key, write_part};
 
 /// Arguments of `penumbra render`.
 #[derive(clap::Args, Debug, Clone)]
@@ -89,6 +90,10 @@ pub struct Args {
     /// for automatic framing).
     #[arg(long)]
     pub fov: Option<f32>,
+    /// Render only sample indices A..B (of the --spp of every pixel) into an EXR part that
+    /// records them; `penumbra merge` combines the parts.
+    #[arg(long, value_name = "A..B", value_parser = parse_range)]
+    pub spp_range: Option<std::ops::Range<u32>>,
 }
 
 /// Parse `X,Y,Z` (finite numbers).
@@ -167,6 +172,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(out) = &args.output {
         prepare_output(out)?;
     }
+    if args.spp_range.is_some() && !is_exr(args.output.as_deref()) {
+        anyhow::bail!("--spp-range writes a part that records its samples: give -o PART.exr");
+    }
     let threads = args.threads.unwrap_or_else(rayon::current_num_threads);
     if let Some(res) = args.res {
         memory::check(&Need::new(res, threads, 0), memory::available().as_ref())?;
@@ -198,7 +206,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bsdf_sampling: args.bsdf_sampling,
         mis_light: args.mis_light,
         progress: !args.quiet,
+        sample_range: args.spp_range.clone(),
+        ..RenderOptions::default()
     };
+    opts.samples()
+        .map_err(|e| anyhow::anyhow!("--spp-range: {e}"))?;
     anyhow::ensure!(
         opts.spp >= 1,
         "the scene's pixel samples must be at least 1"
@@ -238,8 +250,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     scene.film.sensor.apply(&mut img);
 
     let write_start = Instant::now();
-    interrupt.writing(test_write_pause(), |ctl| {
-        write_image_with(&img, &out, args.exposure, ctl)
+    interrupt.writing(test_write_pause(), |ctl| match &args.spp_range {
+        Some(samples) => {
+            let part = Part {
+                image: img,
+                info: PartInfo {
+                    samples: samples.clone(),
+                    spp: opts.spp,
+                    render: render_key(&args.scene, &load_options(&args), res, &opts),
+                },
+            };
+            write_part(&part, &out, ctl)
+        }
+        None => write_image_with(&img, &out, args.exposure, ctl),
     })?;
     let write_time = write_start.elapsed();
 
@@ -247,8 +270,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(|peak| format!("  peak memory {}", memory::human(peak)))
         .unwrap_or_default();
     let secs = |d: Duration| d.as_secs_f64();
+    let samples = match &args.spp_range {
+        Some(r) => format!(" (samples {}..{})", r.start, r.end),
+        None => String::new(),
+    };
     let line = format!(
-        "{}x{}  {} spp x {} shadow rays  {}  load {:.3} s  bvh {:.3} s  render {:.3} s  \
+        "{}x{}  {} spp{samples} x {} shadow rays  {}  load {:.3} s  bvh {:.3} s  render {:.3} s  \
          write {:.3} s  total {:.3} s  {:.2} M rays  {:.1} Mrays/s{memory}  -> {}",
         res.x,
         res.y,
@@ -266,6 +293,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     );
     writeln!(std::io::stdout(), "{line}").context("writing to standard output")?;
     Ok(())
+}
+
+/// Parse `A..B` for `--spp-range`.
+fn parse_range(s: &str) -> Result<std::ops::Range<u32>, String> {
+    penumbra::image::parts::parse_range(s)
+}
+
+/// Whether `out` is given and names an EXR file.
+fn is_exr(out: Option<&Path>) -> bool {
+    out.and_then(|o| o.extension())
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
 /// Check that `out` can be written and remove the temp files killed runs left beside it.
