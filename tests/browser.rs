@@ -96,6 +96,47 @@ impl Driver {
     }
 }
 
+/// Start chromedriver and a headless Chromium session with a `size` ("W,H") window.
+fn open_driver(driver: &str, chromium: &str, size: &str) -> Driver {
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let child = Command::new(&driver)
+        .arg(format!("--port={port}"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut d = Driver {
+        addr: format!("127.0.0.1:{port}"),
+        child,
+        session: None,
+    };
+    let t = Instant::now();
+    while std::net::TcpStream::connect(&d.addr).is_err() {
+        assert!(
+            t.elapsed() < Duration::from_secs(15),
+            "chromedriver did not start"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let caps = json!({ "capabilities": { "alwaysMatch": {
+        "browserName": "chrome",
+        "goog:chromeOptions": { "binary": chromium, "args": [
+            "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+            format!("--window-size={size}"), "--force-device-scale-factor=1",
+            "--force-color-profile=srgb", "--hide-scrollbars"
+        ] }
+    } } });
+    let r = http(&d.addr, "POST", "/session", &caps.to_string());
+    let v = r.json();
+    assert_eq!(r.status, 200, "new session: {v}");
+    d.session = Some(v["value"]["sessionId"].as_str().unwrap().to_string());
+    d
+}
+
 fn b64decode(s: &str) -> Vec<u8> {
     let val = |c: u8| -> u32 {
         match c {
@@ -139,42 +180,7 @@ fn the_page_shows_the_render_converging_and_switches_strategy() {
     let spp_s = spp.to_string();
     let viewer = start_viewer(&dir, &["cornell", "--res", "96x72", "--spp", &spp_s]);
 
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    let child = Command::new(&driver)
-        .arg(format!("--port={port}"))
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut d = Driver {
-        addr: format!("127.0.0.1:{port}"),
-        child,
-        session: None,
-    };
-    let t = Instant::now();
-    while std::net::TcpStream::connect(&d.addr).is_err() {
-        assert!(
-            t.elapsed() < Duration::from_secs(15),
-            "chromedriver did not start"
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let caps = json!({ "capabilities": { "alwaysMatch": {
-        "browserName": "chrome",
-        "goog:chromeOptions": { "binary": chromium, "args": [
-            "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-            "--window-size=1000,640", "--force-device-scale-factor=1",
-            "--force-color-profile=srgb", "--hide-scrollbars"
-        ] }
-    } } });
-    let r = http(&d.addr, "POST", "/session", &caps.to_string());
-    let v = r.json();
-    assert_eq!(r.status, 200, "new session: {v}");
-    d.session = Some(v["value"]["sessionId"].as_str().unwrap().to_string());
+    let d = open_driver(&driver, &chromium, "1000,640");
     d.cmd(
         "POST",
         "/url",
@@ -268,4 +274,69 @@ fn the_page_shows_the_render_converging_and_switches_strategy() {
         "browser test: counts {seen:?}, screenshot matches (worst {worst}, mean {mean:.3}), {:.1} s",
         start.elapsed().as_secs_f64()
     );
+}
+
+/// Not a check: the README's screenshot (`PENUMBRA_VIEWER_SCREENSHOT=docs/viewer.png cargo
+/// test --release --test browser -- --ignored readme`): `many-open` with 64 lights, A = BVH
+/// light selection, B = uniform, split view, and a clicked floor pixel's BVH pmf drawn over it.
+#[test]
+#[ignore]
+fn readme_screenshot() {
+    let (Some(chromium), Some(driver)) = (
+        which(&["chromium", "chromium-browser"]),
+        which(&["chromedriver"]),
+    ) else {
+        panic!("chromium and chromedriver are needed for the screenshot");
+    };
+    let out = std::env::var_os("PENUMBRA_VIEWER_SCREENSHOT").expect("PENUMBRA_VIEWER_SCREENSHOT");
+    let dir = scratch("readme");
+    let viewer = start_viewer(
+        &dir,
+        &[
+            "many-open",
+            "--light-count",
+            "64",
+            "--res",
+            "480x360",
+            "--spp",
+            "32",
+            "--light-selection",
+            "bvh",
+            "--exposure",
+            "1",
+        ],
+    );
+    let d = open_driver(&driver, &chromium, "820,720");
+    d.cmd("POST", "/window/rect", json!({ "width": 820, "height": 720 }));
+    d.cmd(
+        "POST",
+        "/url",
+        json!({ "url": format!("http://{}/", viewer.addr) }),
+    );
+    d.wait(
+        "the page",
+        Duration::from_secs(20),
+        "return document.getElementById('light_selection-b') != null",
+    );
+    d.click("#light_selection-b option[value='uniform']");
+    d.click("#apply-b");
+    d.wait(
+        "both channels done",
+        Duration::from_secs(120),
+        "const a = document.getElementById('img-a'), b = document.getElementById('img-b'); \
+         return a.dataset.samples === '32' && b.dataset.samples === '32'",
+    );
+    d.js(
+        "const r = document.getElementById('stage').getBoundingClientRect(); \
+          click({clientX: r.left + 130, clientY: r.top + 290}); \
+          document.getElementById('side').scrollTop = 0; return true",
+    );
+    d.wait(
+        "the probe",
+        Duration::from_secs(10),
+        "return document.getElementById('probe').textContent.includes('pmf')",
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    let shot = d.cmd("GET", "/screenshot", json!({}));
+    std::fs::write(out, b64decode(shot.as_str().unwrap())).unwrap();
 }
