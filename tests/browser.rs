@@ -103,7 +103,7 @@ fn open_driver(driver: &str, chromium: &str, size: &str) -> Driver {
         .local_addr()
         .unwrap()
         .port();
-    let child = Command::new(&driver)
+    let child = Command::new(driver)
         .arg(format!("--port={port}"))
         .stdout(Stdio::null())
         .stderr(Stdio::null())
@@ -307,7 +307,11 @@ fn readme_screenshot() {
         ],
     );
     let d = open_driver(&driver, &chromium, "820,720");
-    d.cmd("POST", "/window/rect", json!({ "width": 820, "height": 720 }));
+    d.cmd(
+        "POST",
+        "/window/rect",
+        json!({ "width": 820, "height": 720 }),
+    );
     d.cmd(
         "POST",
         "/url",
