@@ -74,16 +74,33 @@ impl Driver {
         )
     }
 
-    fn click(&self, css: &str) {
+    /// The WebDriver id of the element `css` selects.
+    fn element(&self, css: &str) -> String {
         let e = self.cmd(
             "POST",
             "/element",
             json!({ "using": "css selector", "value": css }),
         );
-        let id = e[ELEMENT]
+        e[ELEMENT]
             .as_str()
-            .unwrap_or_else(|| panic!("no element {css}: {e}"));
+            .unwrap_or_else(|| panic!("no element {css}: {e}"))
+            .to_string()
+    }
+
+    fn click(&self, css: &str) {
+        let id = self.element(css);
         self.cmd("POST", &format!("/element/{id}/click"), json!({}));
+    }
+
+    /// Clear the input `css` and type `text` into it.
+    fn type_into(&self, css: &str, text: &str) {
+        let id = self.element(css);
+        self.cmd("POST", &format!("/element/{id}/clear"), json!({}));
+        self.cmd(
+            "POST",
+            &format!("/element/{id}/value"),
+            json!({ "text": text }),
+        );
     }
 
     /// Poll the script until it returns true.
@@ -175,10 +192,10 @@ fn the_page_shows_the_render_converging_and_switches_strategy() {
     };
     let start = Instant::now();
     let dir = scratch("browser");
-    // Small enough that every pass is quick, large enough to see several passes.
-    let spp = 1024;
-    let spp_s = spp.to_string();
-    let viewer = start_viewer(&dir, &["cornell", "--res", "96x72", "--spp", &spp_s]);
+    // Small enough that every pass is quick; A's first render never ends on its own (the page
+    // may load late on a busy machine), the switched one stops at `spp`.
+    let spp = 256;
+    let viewer = start_viewer(&dir, &["cornell", "--res", "96x72", "--spp", "1000000"]);
 
     let d = open_driver(&driver, &chromium, "1000,640");
     d.cmd(
@@ -210,6 +227,7 @@ fn the_page_shows_the_render_converging_and_switches_strategy() {
 
     // Switch the strategy with the page's controls.
     d.click("#strategy-a option[value='light-area']");
+    d.type_into("#spp-a", &spp.to_string());
     d.click("#apply-a");
     d.wait(
         "the finished light-area image",
@@ -302,8 +320,6 @@ fn readme_screenshot() {
             "32",
             "--light-selection",
             "bvh",
-            "--exposure",
-            "1",
         ],
     );
     let d = open_driver(&driver, &chromium, "820,720");

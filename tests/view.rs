@@ -49,6 +49,7 @@ fn endpoints_answer_and_bad_requests_are_400_with_a_reason() {
     assert!(a["eta"].as_f64().unwrap() > 0.0);
     assert!(a["rel_mse"].is_null(), "no reference given");
     assert_eq!(s2["channels"]["b"]["enabled"], false);
+    assert_eq!(s2["exposure"], 0.0);
     assert!(s2["choices"]["light_selection"].as_array().unwrap().len() >= 7);
 
     for view in ["srgb", "false"] {

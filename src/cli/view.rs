@@ -189,6 +189,8 @@ struct Shared {
     res: UVec2,
     seed: u64,
     budget: Option<Duration>,
+    /// `--exposure`: where the page's exposure slider starts.
+    exposure: f32,
     reference: Option<Image>,
     pool: Option<rayon::ThreadPool>,
     channels: Mutex<[Channel; 2]>,
@@ -208,6 +210,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "view writes no file: -o, --spp-range, --resume and --progressive are render options"
     );
     anyhow::ensure!(r.shadow_rays >= 1, "--shadow-rays must be at least 1");
+    anyhow::ensure!(
+        r.exposure.is_finite() && r.exposure.abs() <= 8.0,
+        "--exposure must be within ±8 stops in the viewer"
+    );
     anyhow::ensure!(r.spp != Some(0), "--spp must be at least 1");
     anyhow::ensure!(r.threads != Some(0), "--threads must be at least 1");
     penumbra::light_selection::SELECTORS
@@ -279,6 +285,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         res,
         seed: r.seed,
         budget: r.time.map(Duration::from_secs_f64),
+        exposure: r.exposure,
         reference,
         pool,
         channels: Mutex::new([channel(true), channel(false)]),
@@ -553,6 +560,7 @@ fn state(shared: &Shared) -> serde_json::Value {
         "height": shared.res.y,
         "reference": shared.reference.is_some(),
         "budget": shared.budget.map(|b| b.as_secs_f64()),
+        "exposure": shared.exposure,
         "lights": shared.scene.lights.len(),
         "channels": { "a": ch(&chans[0]), "b": ch(&chans[1]) },
         "choices": {
