@@ -21,7 +21,7 @@ pub use interaction::{ShadingGeometry, SurfaceHit};
 pub use packet::{HitColumns, PACKET, PacketRayForm, RayPacket};
 pub use primitive::{MeshShading, PrimKind, Primitive};
 pub use quadric::{Quadric, QuadricKind};
-pub use ray::{Ray, random_query_rays};
+pub use ray::{Ray, bounce_query_rays, random_query_rays};
 pub use transform::Transform;
 
 /// Closest-hit and any-hit ray queries: what integrators and lights need from geometry.
