@@ -6,7 +6,8 @@
 //! the scene box, uniform directions) and `bounce` (`bounce_query_rays`: a cosine bounce from
 //! each camera-ray hit, a path tracer's second segment) — with penumbra's closest-hit prim id
 //! of every ray; then times, single-threaded, the one-ray closest-hit and any-hit queries and
-//! the 16-ray packet ones (16 consecutive rays per packet), REPS times each, and prints one
+//! the 16-ray packet ones (16 consecutive rays per packet), REPS times each (this thread's CPU
+//! time, so that other processes on a loaded machine count less), and prints one
 //! line per query: `penumbra SCENE SET QUERY MRAYS HITS`. Files are little-endian: `.tris` is
 //! u32 n then n × 9 f32; `.rays` u32 n then n × 7 f32 (o, d, t_max); `.hits` n × (u32 prim id,
 //! f32 t; u32::MAX and +∞ for a miss).
@@ -45,11 +46,22 @@ fn packets(rays: &[Ray]) -> Vec<([Ray; PACKET], u32)> {
         .collect()
 }
 
-/// Seconds of `f` and its result.
+/// Nanoseconds this thread has run on a CPU (`/proc/thread-self/schedstat`), if readable.
+fn cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
+/// Seconds of `f` and its result: CPU time of this thread where Linux reports it (on a loaded
+/// machine, time spent descheduled is not the ray core's), else wall time.
 fn time<T>(f: impl FnOnce() -> T) -> (f64, T) {
-    let t = Instant::now();
+    let (c, t) = (cpu_ns(), Instant::now());
     let r = black_box(f());
-    (t.elapsed().as_secs_f64(), r)
+    let wall = t.elapsed().as_secs_f64();
+    match (c, cpu_ns()) {
+        (Some(a), Some(b)) => ((b - a) as f64 * 1e-9, r),
+        _ => (wall, r),
+    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -88,7 +100,10 @@ fn run_set(g: &Geometry, scene: &str, set: &str, rays: &[Ray], reps: usize) {
         secs[3].push(s);
         hits[3] = h;
     }
-    for (k, q) in ["closest1", "any1", "closest16", "any16"].iter().enumerate() {
+    for (k, q) in ["closest1", "any1", "closest16", "any16"]
+        .iter()
+        .enumerate()
+    {
         let m = rays.len() as f64 / median(secs[k].clone()) / 1e6;
         println!("penumbra {scene} {set} {q} {m:.3} {}", hits[k]);
     }
@@ -132,8 +147,13 @@ fn main() -> anyhow::Result<()> {
         rb.extend_from_slice(&(rays.len() as u32).to_le_bytes());
         let mut hb = Vec::with_capacity(rays.len() * 8);
         for r in rays.iter() {
-            push_f32s(&mut rb, &[r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.t_max]);
-            let (id, t) = g.intersect(r).map_or((u32::MAX, f32::INFINITY), |h| (h.prim, h.t));
+            push_f32s(
+                &mut rb,
+                &[r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.t_max],
+            );
+            let (id, t) = g
+                .intersect(r)
+                .map_or((u32::MAX, f32::INFINITY), |h| (h.prim, h.t));
             hb.extend_from_slice(&id.to_le_bytes());
             hb.extend_from_slice(&t.to_le_bytes());
         }
