@@ -1,5 +1,6 @@
 //! penumbra's side of the ray-core comparison with Embree (`scripts/embree-compare.sh` runs both):
-//! `cargo run --release --example embree_compare -- SCENE DIR [RAYS] [REPS]`.
+//! `cargo run --release --example embree_compare -- SCENE DIR [RAYS] [REPS] [TRIANGLES]`
+//! (TRIANGLES: `dense`'s `--triangles`).
 //!
 //! Writes the scene's triangles (in penumbra's primitive order, so Embree's primID is our prim
 //! id) and two incoherent ray sets to DIR — `random` (`random_query_rays`: origins uniform in
@@ -113,13 +114,20 @@ fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     anyhow::ensure!(
         args.len() >= 3,
-        "usage: embree_compare SCENE DIR [RAYS] [REPS]"
+        "usage: embree_compare SCENE DIR [RAYS] [REPS] [TRIANGLES]"
     );
     let (name, dir) = (&args[1], Path::new(&args[2]));
     let n: u32 = args.get(3).map_or(Ok(1_000_000), |s| s.parse())?;
     let reps: usize = args.get(4).map_or(Ok(3), |s| s.parse())?;
     std::fs::create_dir_all(dir)?;
-    let scene = load(name, &LoadOptions::default())?.scene;
+    let opts = LoadOptions {
+        builtin: penumbra::scene::builtin::BuiltinOptions {
+            triangles: args.get(5).map(|s| s.parse()).transpose()?,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let scene = load(name, &opts)?.scene;
     let g = &scene.geometry;
     let mut tris = Vec::new();
     tris.extend_from_slice(&(g.len() as u32).to_le_bytes());
