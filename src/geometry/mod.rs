@@ -2,6 +2,7 @@
 //! collapse, obvhs CWBVH).
 
 mod accel;
+pub mod alpha;
 mod bvh;
 mod float;
 pub mod interaction;
@@ -17,6 +18,7 @@ pub mod triangle;
 mod wide;
 
 pub use accel::{Backend, Geometry};
+pub use alpha::{Alpha, AlphaTexture};
 pub use interaction::{ShadingGeometry, SurfaceHit};
 pub use packet::{HitColumns, PACKET, PacketRayForm, RayPacket};
 pub use primitive::{MeshShading, PrimKind, Primitive};

@@ -2,6 +2,7 @@
 //! or references to quadrics), the per-mesh data their hit records interpolate
 //! ([`MeshShading`]), and the per-primitive quantities the BVH build needs (bounds, normals).
 
+use super::alpha::Alpha;
 use super::quadric::Quadric;
 use glam::{Vec2, Vec3};
 
@@ -14,6 +15,8 @@ pub struct MeshShading {
     pub uvs: Option<Vec<Vec2>>,
     /// Flip the geometric normal (only when there are no vertex normals).
     pub flip: bool,
+    /// Alpha cut-out: hits where it does not keep them are ignored by every query.
+    pub alpha: Option<Alpha>,
 }
 
 /// What a primitive is.

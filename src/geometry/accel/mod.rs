@@ -56,6 +56,8 @@ pub struct Geometry {
     pub build_time: Duration,
     /// Vector instruction set of the packet queries, detected once here rather than per query.
     pub(super) isa: Isa,
+    /// Some mesh has an alpha cut-out (its triangles are tested through [`Self::other_t`]).
+    has_alpha: bool,
 }
 
 impl Geometry {
@@ -85,6 +87,21 @@ impl Geometry {
             bounds.0 = bounds.0.min(*lo);
             bounds.1 = bounds.1.max(*hi);
         }
+        // Triangles of cut-out meshes are tested by `other_t` (with their alpha test), not by
+        // the wide BVH's packet triangle tests.
+        let mut called_back: Vec<bool> = prims
+            .iter()
+            .map(|p| match p.kind {
+                PrimKind::Triangle { mesh, .. } => {
+                    meshes.get(mesh as usize).is_some_and(|m| m.alpha.is_some())
+                }
+                PrimKind::Quadric(_) => false,
+            })
+            .collect();
+        let has_alpha = called_back.contains(&true);
+        if !has_alpha {
+            called_back.clear();
+        }
         let (order, accel): (Vec<u32>, Accel) = if prims.is_empty() {
             (Vec::new(), Accel::None)
         } else {
@@ -93,12 +110,12 @@ impl Geometry {
                     // PLOC + reinsertion gives the better tree; the binned-SAH one is
                     // depth-limited, so it is the fallback for degenerate inputs.
                     let mut tree = Tree2::ploc(&boxes);
-                    let wide = match WideBvh::build(&tree, &prims) {
+                    let wide = match WideBvh::build(&tree, &prims, &called_back) {
                         Some(w) => w,
                         None => {
                             tree = Tree2::from_bvh(Bvh::build(&boxes));
                             // Never empty: the binned-SAH tree is at most 64 levels deep.
-                            WideBvh::build(&tree, &prims).unwrap_or_default()
+                            WideBvh::build(&tree, &prims, &called_back).unwrap_or_default()
                         }
                     };
                     (tree.order, Accel::Wide(wide))
@@ -139,6 +156,7 @@ impl Geometry {
             bounds,
             build_time: start.elapsed(),
             isa: Isa::detect(),
+            has_alpha,
         }
     }
 
@@ -196,31 +214,86 @@ impl Geometry {
     fn prim_hit(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> (f32, Bary) {
         let p = &self.prims[id];
         match p.kind {
+            PrimKind::Triangle { .. } if self.has_alpha => self
+                .alpha_triangle(id, o, d, t_max)
+                .unwrap_or((f32::INFINITY, NO_BARY)),
             PrimKind::Triangle { .. } => match shear.intersect(p.p[0], p.p[1], p.p[2], t_max) {
                 Some((t, b0, b1, b2)) => (t, [b0, b1, b2]),
                 None => (f32::INFINITY, NO_BARY),
             },
-            PrimKind::Quadric(_) => (self.quadric_t(id, o, d, t_max), NO_BARY),
+            PrimKind::Quadric(_) => (self.other_t(id, o, d, t_max), NO_BARY),
         }
     }
 
-    /// Hit distance of non-triangle primitive `id` below `t_max`, or +∞.
+    /// Hit distance below `t_max` (else +∞) of primitive `id` that the wide BVH does not test
+    /// itself: a quadric, or a triangle of a cut-out mesh (alpha-tested).
     #[inline(always)]
-    fn quadric_t(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+    fn other_t(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
         match self.prims[id].kind {
             PrimKind::Quadric(q) => self.quadrics[q as usize]
                 .intersect_t(o, d, t_max)
                 .unwrap_or(f32::INFINITY),
-            PrimKind::Triangle { .. } => f32::INFINITY,
+            PrimKind::Triangle { .. } => self
+                .alpha_triangle(id, o, d, t_max)
+                .map_or(f32::INFINITY, |(t, _)| t),
         }
     }
 
-    /// [`Self::quadric_t`] kept out of line for the wide traversal: inlined, the compiler
+    /// Triangle `id`'s hit below `t_max` (t, barycentrics) if its mesh's alpha mask keeps it
+    /// (any hit of a triangle without one).
+    #[inline(never)]
+    fn alpha_triangle(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, Bary)> {
+        let p = &self.prims[id];
+        let PrimKind::Triangle { mesh, v } = p.kind else {
+            return None;
+        };
+        let (t, b0, b1, b2) = RayShear::new(o, d).intersect(p.p[0], p.p[1], p.p[2], t_max)?;
+        let b = [b0, b1, b2];
+        let m = &self.meshes[mesh as usize];
+        match &m.alpha {
+            None => Some((t, b)),
+            Some(a) => {
+                let key = ((mesh as u64) << 32 | v[0] as u64) ^ ((v[1] as u64) << 21 | (v[2] as u64) << 42);
+                a.keeps(mesh_uv(m, v, b), o, d, key).then_some((t, b))
+            }
+        }
+    }
+
+    /// Barycentrics of the accepted hit at `t` of primitive `id`, whose traversal reported
+    /// placeholders when it is a cut-out triangle (tested through [`Self::other_t`]): the same
+    /// triangle test again, hence the same values.
+    #[inline(always)]
+    fn final_bary(&self, id: usize, ray: &Ray, b: Bary) -> Bary {
+        if !self.has_alpha {
+            return b;
+        }
+        let p = &self.prims[id];
+        match p.kind {
+            PrimKind::Triangle { mesh, .. } if self.meshes[mesh as usize].alpha.is_some() => {
+                RayShear::new(ray.o, ray.d)
+                    .intersect(p.p[0], p.p[1], p.p[2], f32::INFINITY)
+                    .map_or(b, |(_, b0, b1, b2)| [b0, b1, b2])
+            }
+            _ => b,
+        }
+    }
+
+    /// True if a hit on primitive `id` needs [`Self::final_bary`] (packet queries redo those).
+    #[inline(always)]
+    pub(super) fn is_cut_out(&self, id: usize) -> bool {
+        self.has_alpha
+            && match self.prims[id].kind {
+                PrimKind::Triangle { mesh, .. } => self.meshes[mesh as usize].alpha.is_some(),
+                PrimKind::Quadric(_) => false,
+            }
+    }
+
+    /// [`Self::other_t`] kept out of line for the wide traversal: inlined, the compiler
     /// hoists its per-ray setup (splats of the ray) out of the traversal loop, which every ray
     /// pays for although triangle-only scenes never run it.
     #[inline(never)]
-    pub(super) fn quadric_t_outlined(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
-        self.quadric_t(id, o, d, t_max)
+    pub(super) fn other_t_outlined(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        self.other_t(id, o, d, t_max)
     }
 
     /// Hit distance of primitive `id` below `t_max`, or +∞ (any-hit queries).
@@ -264,13 +337,7 @@ impl Geometry {
                         ng
                     }
                 };
-                let uv = match &m.uvs {
-                    Some(uv) => {
-                        uv[v[0] as usize] * b0 + uv[v[1] as usize] * b1 + uv[v[2] as usize] * b2
-                    }
-                    // pbrt-v4's default parameterisation (0,0), (1,0), (1,1).
-                    None => Vec2::new(b1 + b2, b2),
-                };
+                let uv = mesh_uv(m, v, [b0, b1, b2]);
                 let err = barycentric_error([b0, b1, b2], verts);
                 SurfaceHit {
                     t,
@@ -313,6 +380,17 @@ fn unit_or_zero(v: Vec3) -> Vec3 {
         v * rcp
     } else {
         Vec3::ZERO
+    }
+}
+
+/// Texture coordinates of mesh `m`'s triangle `v` at barycentrics `b`.
+#[inline(always)]
+fn mesh_uv(m: &MeshShading, v: [u32; 3], b: Bary) -> Vec2 {
+    let [b0, b1, b2] = b;
+    match &m.uvs {
+        Some(uv) => uv[v[0] as usize] * b0 + uv[v[1] as usize] * b1 + uv[v[2] as usize] * b2,
+        // pbrt-v4's default parameterisation (0,0), (1,0), (1,1).
+        None => Vec2::new(b1 + b2, b2),
     }
 }
 
@@ -366,7 +444,7 @@ impl Geometry {
         match &self.accel {
             Accel::None => false,
             Accel::Wide(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.quadric_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
+                self.other_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
             }),
             Accel::Own(bvh) => {
                 let shear = shear();
@@ -390,11 +468,11 @@ impl Geometry {
         let (id, t, b) = match &self.accel {
             // The wide BVH tests triangles itself; only quadrics come back here.
             Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                self.quadric_t_outlined(id, ray.o, ray.d, t_max)
+                self.other_t_outlined(id, ray.o, ray.d, t_max)
             })?,
             _ => self.closest_by_callback(ray)?,
         };
-        Some(self.surface_hit(id, ray, t, b))
+        Some(self.surface_hit(id, ray, t, self.final_bary(id, ray, b)))
     }
 }
 
@@ -414,7 +492,7 @@ impl RayQuery for Geometry {
         // four into a jump table that every shadow ray pays for).
         if let Accel::Wide(bvh) = &self.accel {
             return bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
+                self.other_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
             });
         }
         self.occluded_other(ray)

@@ -106,9 +106,17 @@ impl Geometry {
         }
         let mut hits = PacketHits::new();
         bvh.closest_packet(isa, rays, active, &mut hits, |id, ray, t_max| {
-            self.quadric_t_outlined(id, ray.o, ray.d, t_max)
+            self.other_t_outlined(id, ray.o, ray.d, t_max)
         });
-        let ties = hits.ties;
+        let mut ties = hits.ties;
+        if self.has_alpha {
+            // Cut-out hits carry placeholder barycentrics: the one-ray query forms those.
+            for i in bits(hits.found & !ties) {
+                if self.is_cut_out(hits.hit(i).0) {
+                    ties |= 1 << i;
+                }
+            }
+        }
         self.hit_records(isa, rays, &hits, hits.found & !ties, out, cols);
         for i in bits(ties) {
             out[i] = self.intersect(&rays.ray(i));
@@ -141,7 +149,7 @@ impl Geometry {
             return bits(active).fold(0, |m, i| m | (self.occluded(&rays.ray(i)) as u32) << i);
         };
         bvh.any_packet(isa, rays, active, SPARSE, |id, ray| {
-            self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
+            self.other_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
         })
     }
 }

@@ -21,13 +21,16 @@ impl Node4 {
 impl WideBvh {
     /// Collapse `tree` over `prims` (input order; `tree.order` maps leaf order to it). Returns
     /// `None` if the tree is deeper than [`MAX_TREE_DEPTH`] (the traversal stack's bound).
-    pub fn build(tree: &Tree2, prims: &[Primitive]) -> Option<Self> {
+    /// Triangles i with `called_back[i]` (input order; an empty slice: none) go to the
+    /// packets' `other` lanes like quadrics, so the traversal asks the caller about them
+    /// (alpha cut-outs).
+    pub fn build(tree: &Tree2, prims: &[Primitive], called_back: &[bool]) -> Option<Self> {
         let mut w = Self::default();
         if !tree.nodes.is_empty() {
             if tree.depth() > MAX_TREE_DEPTH {
                 return None;
             }
-            w.collapse(tree, prims, 0);
+            w.collapse(tree, prims, called_back, 0);
         }
         // One node whose lanes 1..3 are unused (inverted boxes, which every ray misses) and
         // whose lane 0 is therefore a leaf.
@@ -59,7 +62,7 @@ impl WideBvh {
     /// repeatedly replaced by its two children (largest surface area first, as in the SAH) until
     /// there are four. Subtrees of at most [`LEAF_PRIMS`] primitives become one leaf: a packet
     /// tests four triangles for little more than the price of one.
-    fn collapse(&mut self, tree: &Tree2, prims: &[Primitive], n2: usize) {
+    fn collapse(&mut self, tree: &Tree2, prims: &[Primitive], called_back: &[bool], n2: usize) {
         let nodes = &tree.nodes;
         let is_leaf = |k: usize| nodes[k].range.len() <= LEAF_PRIMS || nodes[k].children.is_none();
         let mut kids: Vec<usize> = match nodes[n2].children {
@@ -83,10 +86,10 @@ impl WideBvh {
         self.nodes.push(Node4::EMPTY);
         for (lane, &k) in kids.iter().enumerate() {
             let child = if is_leaf(k) {
-                LEAF | self.leaf(tree, prims, nodes[k].range.clone())
+                LEAF | self.leaf(tree, prims, called_back, nodes[k].range.clone())
             } else {
                 let child = self.nodes.len() as u32;
-                self.collapse(tree, prims, k);
+                self.collapse(tree, prims, called_back, k);
                 child
             };
             let node = &mut self.nodes[idx];
@@ -99,14 +102,24 @@ impl WideBvh {
     }
 
     /// Pack the leaf-order primitives `range` into consecutive packets; returns the first.
-    fn leaf(&mut self, tree: &Tree2, prims: &[Primitive], range: Range<usize>) -> u32 {
+    fn leaf(
+        &mut self,
+        tree: &Tree2,
+        prims: &[Primitive],
+        called_back: &[bool],
+        range: Range<usize>,
+    ) -> u32 {
         let first = self.packets.len();
         let ids: Vec<usize> = range.collect();
         for chunk in ids.chunks(4) {
             let mut pk = TriPacket::EMPTY;
             for (lane, &id) in chunk.iter().enumerate() {
-                let p = &prims[tree.order[id] as usize];
+                let input = tree.order[id] as usize;
+                let p = &prims[input];
                 match p.kind {
+                    PrimKind::Triangle { .. } if called_back.get(input) == Some(&true) => {
+                        pk.set_other(lane, id as u32)
+                    }
                     PrimKind::Triangle { .. } => pk.set_triangle(lane, id as u32, p.p),
                     PrimKind::Quadric(_) => pk.set_other(lane, id as u32),
                 }
@@ -160,7 +173,7 @@ mod tests {
                     light: u32::MAX,
                 })
                 .collect();
-            let Some(fast) = WideBvh::build(&Tree2::ploc(&boxes(&prims)), &prims) else {
+            let Some(fast) = WideBvh::build(&Tree2::ploc(&boxes(&prims)), &prims, &[]) else {
                 panic!("{n} triangles gave a too deep tree");
             };
             assert!(fast.single_leaf.is_some(), "{n} triangles are not one leaf");
@@ -217,7 +230,7 @@ mod tests {
                     assert_eq!(n.range, tree.nodes[a].range.start..tree.nodes[b].range.end);
                 }
             }
-            let Some(w) = WideBvh::build(&tree, &prims) else {
+            let Some(w) = WideBvh::build(&tree, &prims, &[]) else {
                 panic!("500 triangles gave a tree deeper than {MAX_TREE_DEPTH}");
             };
             let mut hits = 0;
