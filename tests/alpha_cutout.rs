@@ -8,8 +8,7 @@
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::interaction::NO_LIGHT;
 use penumbra::geometry::{
-    Alpha, AlphaTexture, Backend, Geometry, MeshShading, PACKET, PrimKind, Primitive, Ray,
-    RayQuery,
+    Alpha, AlphaTexture, Backend, Geometry, MeshShading, PACKET, PrimKind, Primitive, Ray, RayQuery,
 };
 use penumbra::integrator::{RenderOptions, render};
 use penumbra::sampling::{PatternKind, make_pattern};
@@ -275,7 +274,9 @@ fn pbrt_cut_out_roof_passes_one_minus_coverage_of_the_sun() {
     let (under, err) = render_mean(Some(c));
     let ratio = under / open;
     let sigma = (err * err + (ratio * open_err).powi(2)).sqrt() / open;
-    eprintln!("roof of coverage {c}: ground {under:.5} ± {err:.5} vs open {open:.5}: ratio {ratio:.4} ± {sigma:.4}");
+    eprintln!(
+        "roof of coverage {c}: ground {under:.5} ± {err:.5} vs open {open:.5}: ratio {ratio:.4} ± {sigma:.4}"
+    );
     assert!(sigma > 0.0 && sigma < 0.02, "σ {sigma}");
     assert!(
         (ratio - (1.0 - c as f64)).abs() <= 5.0 * sigma,
@@ -286,4 +287,57 @@ fn pbrt_cut_out_roof_passes_one_minus_coverage_of_the_sun() {
     // An opaque roof (alpha 1 is no cut-out) blocks the sun entirely.
     let (shut, _) = render_mean(Some(1.0));
     assert!(shut < 1e-6 * open, "opaque roof lets {shut} through");
+}
+
+/// A leaf over the quad's uv square: inside |v − ½| < ½·sin(πu) (area 2/π), outside nothing.
+/// Inside it the coverage is 1 (`soft: false`) or u (`soft: true`, total ∫ u·sin(πu) du = 1/π),
+/// so the blocked fraction of rays spread uniformly over the quad is 2/π or 1/π.
+#[derive(Debug)]
+struct Leaf {
+    soft: bool,
+}
+
+impl AlphaTexture for Leaf {
+    fn alpha(&self, uv: Vec2) -> f32 {
+        let inside = (uv.y - 0.5).abs() < 0.5 * (std::f32::consts::PI * uv.x).sin();
+        match (inside, self.soft) {
+            (false, _) => 0.0,
+            (true, false) => 1.0,
+            (true, true) => uv.x,
+        }
+    }
+}
+
+/// `n` parallel tilted rays whose hit points on the plane z = 0 are uniform over the quad
+/// [-1, 1]² (so over its uv square).
+fn covering_rays(n: u32) -> Vec<Ray> {
+    let pat = make_pattern(PatternKind::Random, 23);
+    let d = Vec3::new(-0.04, 0.07, 1.0).normalize();
+    (0..n)
+        .map(|i| {
+            let u = pat.sample_2d(UVec2::new(i, 0), 0, 0, 1);
+            let hit = Vec3::new(2.0 * u.x - 1.0, 2.0 * u.y - 1.0, 0.0);
+            Ray::new(hit - d / d.z, d)
+        })
+        .collect()
+}
+
+#[test]
+fn leaf_texture_blocks_its_analytic_coverage() {
+    let rays = covering_rays(40_000);
+    let pi = std::f64::consts::PI;
+    for (soft, blocked) in [(false, 2.0 / pi), (true, 1.0 / pi)] {
+        let a = answers(
+            &[0.0],
+            &[Some(Alpha::Texture(Arc::new(Leaf { soft })))],
+            &rays,
+        );
+        let passed = a.iter().filter(|h| h.is_none()).count();
+        check_fraction(
+            &format!("leaf (soft: {soft})"),
+            passed,
+            rays.len(),
+            1.0 - blocked,
+        );
+    }
 }

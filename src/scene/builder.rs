@@ -4,8 +4,7 @@ use super::mesh_repair::{MeshRepair, repair_mesh};
 use super::{AreaEmission, FilmSpec, Scene, TriangleMesh};
 use crate::camera::Camera;
 use crate::geometry::{
-    Alpha,
-    Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Transform,
+    Alpha, Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Transform,
     interaction::NO_LIGHT,
 };
 use crate::lights::{DiskLight, Light, QuadLight, SphereLight, TriangleLight};

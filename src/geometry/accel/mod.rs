@@ -253,7 +253,8 @@ impl Geometry {
         match &m.alpha {
             None => Some((t, b)),
             Some(a) => {
-                let key = ((mesh as u64) << 32 | v[0] as u64) ^ ((v[1] as u64) << 21 | (v[2] as u64) << 42);
+                let key = ((mesh as u64) << 32 | v[0] as u64)
+                    ^ ((v[1] as u64) << 21 | (v[2] as u64) << 42);
                 a.keeps(mesh_uv(m, v, b), o, d, key).then_some((t, b))
             }
         }
