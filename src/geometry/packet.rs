@@ -103,6 +103,7 @@ pub(crate) trait ColumnSink {
     /// Lanes `group` (of the vectors `p`, `ng`, `ns`, `p_error`) are hits.
     fn set_group<S: Simd>(
         &mut self,
+        s: S,
         group: u32,
         p: &[S::F; 3],
         ng: &[S::F; 3],
@@ -115,7 +116,15 @@ pub(crate) trait ColumnSink {
 
 impl ColumnSink for () {
     #[inline(always)]
-    fn set_group<S: Simd>(&mut self, _: u32, _: &[S::F; 3], _: &[S::F; 3], _: &[S::F; 3], _: S::F) {
+    fn set_group<S: Simd>(
+        &mut self,
+        _: S,
+        _: u32,
+        _: &[S::F; 3],
+        _: &[S::F; 3],
+        _: &[S::F; 3],
+        _: S::F,
+    ) {
     }
     #[inline(always)]
     fn set_lane(&mut self, _: usize, _: &SurfaceHit) {}
@@ -125,6 +134,7 @@ impl ColumnSink for HitColumns {
     #[inline(always)]
     fn set_group<S: Simd>(
         &mut self,
+        s: S,
         group: u32,
         p: &[S::F; 3],
         ng: &[S::F; 3],
@@ -132,14 +142,14 @@ impl ColumnSink for HitColumns {
         p_error: S::F,
     ) {
         // A blend with the old lanes: the other lanes may hold other hits already.
-        let m = S::mask(group);
+        let m = s.mask(group);
         for a in 0..3 {
-            S::store(S::select(m, p[a], S::load(&self.p[a])), &mut self.p[a]);
-            S::store(S::select(m, ng[a], S::load(&self.ng[a])), &mut self.ng[a]);
-            S::store(S::select(m, ns[a], S::load(&self.ns[a])), &mut self.ns[a]);
+            S::store(S::select(m, p[a], s.load(&self.p[a])), &mut self.p[a]);
+            S::store(S::select(m, ng[a], s.load(&self.ng[a])), &mut self.ng[a]);
+            S::store(S::select(m, ns[a], s.load(&self.ns[a])), &mut self.ns[a]);
         }
         S::store(
-            S::select(m, p_error, S::load(&self.p_error)),
+            S::select(m, p_error, s.load(&self.p_error)),
             &mut self.p_error,
         );
     }
@@ -183,15 +193,15 @@ mod sealed {
     /// The two forms of a packet's rays the kernels read: `[Ray; PACKET]` and [`RayPacket`].
     pub trait PacketRays {
         /// `[o.x, o.y, o.z, d.x, d.y, d.z, t_max]` as lanes (see [`Simd::rays`]).
-        fn lanes<S: Simd>(&self) -> [S::F; 7];
+        fn lanes<S: Simd>(&self, s: S) -> [S::F; 7];
         /// Ray `i` (for the scalar steps).
         fn ray(&self, i: usize) -> Ray;
     }
 
     impl PacketRays for [Ray; PACKET] {
         #[inline(always)]
-        fn lanes<S: Simd>(&self) -> [S::F; 7] {
-            S::rays(self)
+        fn lanes<S: Simd>(&self, s: S) -> [S::F; 7] {
+            s.rays(self)
         }
         #[inline(always)]
         fn ray(&self, i: usize) -> Ray {
@@ -201,16 +211,16 @@ mod sealed {
 
     impl PacketRays for RayPacket {
         #[inline(always)]
-        fn lanes<S: Simd>(&self) -> [S::F; 7] {
+        fn lanes<S: Simd>(&self, s: S) -> [S::F; 7] {
             let (o, d) = (&self.o, &self.d);
             [
-                S::load(&o[0]),
-                S::load(&o[1]),
-                S::load(&o[2]),
-                S::load(&d[0]),
-                S::load(&d[1]),
-                S::load(&d[2]),
-                S::load(&self.t_max),
+                s.load(&o[0]),
+                s.load(&o[1]),
+                s.load(&o[2]),
+                s.load(&d[0]),
+                s.load(&d[1]),
+                s.load(&d[2]),
+                s.load(&self.t_max),
             ]
         }
         #[inline(always)]

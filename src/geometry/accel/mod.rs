@@ -12,7 +12,7 @@ use super::tree2::Tree2;
 use super::triangle::{RayShear, barycentric_error};
 use super::wide::{Bary, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
-use crate::isa::Isa;
+use crate::isa::{Cpu, Isa};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
@@ -55,7 +55,7 @@ pub struct Geometry {
     /// Wall time of the BVH build.
     pub build_time: Duration,
     /// Vector instruction set of the packet queries, detected once here rather than per query.
-    pub(super) isa: Isa,
+    cpu: Cpu,
     /// Some mesh has an alpha cut-out (its triangles are tested through [`Self::other_t`]).
     has_alpha: bool,
 }
@@ -64,7 +64,7 @@ impl Geometry {
     /// The vector instruction set detected when this geometry was built (what its packet
     /// queries, and the integrator's lane kernels, run on).
     pub fn isa(&self) -> Isa {
-        self.isa
+        self.cpu.isa()
     }
 
     /// Build the default BVH over `prims` (reordered internally so the BVH's leaf order is the
@@ -155,7 +155,7 @@ impl Geometry {
             accel,
             bounds,
             build_time: start.elapsed(),
-            isa: Isa::detect(),
+            cpu: Cpu::detect(),
             has_alpha,
         }
     }

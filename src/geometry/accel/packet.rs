@@ -8,15 +8,13 @@ use crate::geometry::packet::{
     ColumnSink, HitColumns, PACKET, PACKET_MASK, PacketRayForm, PacketRays, bits,
 };
 use crate::geometry::primitive::{PrimKind, Primitive};
-#[cfg(target_arch = "x86_64")]
-use crate::geometry::simd16::{Avx2, Avx512};
-use crate::geometry::simd16::{Portable, Simd};
+use crate::geometry::simd16::{OnSimd, Simd, SimdKernel};
 use crate::geometry::triangle::POINT_ERROR_GAMMA;
 use crate::geometry::wide::PacketHits;
 use crate::geometry::{RayQuery, SurfaceHit};
 #[cfg(doc)]
 use crate::geometry::{packet::RayPacket, wide::WideBvh};
-use crate::isa::Isa;
+use crate::isa::{Cpu, Isa};
 
 impl Geometry {
     /// Closest hit of each active ray (bit i of `active` ⇒ ray i is traced); out[i] = None for
@@ -28,7 +26,7 @@ impl Geometry {
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.intersect_packet_with(self.isa, rays, active, out, &mut ());
+        self.intersect_packet_with(self.cpu, rays, active, out, &mut ());
     }
 
     /// [`Self::intersect_packet`] on a chosen vector backend (for tests and benchmarks; one
@@ -40,7 +38,7 @@ impl Geometry {
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
     ) {
-        self.intersect_packet_with(isa.supported(), rays, active, out, &mut ());
+        self.intersect_packet_with(isa.cpu(), rays, active, out, &mut ());
     }
 
     /// [`Self::intersect_packet`] that also writes the hits' points, normals and error bounds
@@ -53,7 +51,7 @@ impl Geometry {
         out: &mut [Option<SurfaceHit>; PACKET],
         cols: &mut HitColumns,
     ) {
-        self.intersect_packet_with(self.isa, rays, active, out, cols);
+        self.intersect_packet_with(self.cpu, rays, active, out, cols);
     }
 
     /// [`Self::intersect_packet_cols`] on a chosen vector backend (see
@@ -66,14 +64,13 @@ impl Geometry {
         out: &mut [Option<SurfaceHit>; PACKET],
         cols: &mut HitColumns,
     ) {
-        self.intersect_packet_with(isa.supported(), rays, active, out, cols);
+        self.intersect_packet_with(isa.cpu(), rays, active, out, cols);
     }
 
-    /// [`Self::intersect_packet`] on `isa`, a set this CPU runs, with the hits' columns to
-    /// `cols`.
+    /// [`Self::intersect_packet`] on `cpu`, with the hits' columns to `cols`.
     fn intersect_packet_with<R: PacketRays + ?Sized, C: ColumnSink>(
         &self,
-        isa: Isa,
+        cpu: Cpu,
         rays: &R,
         active: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
@@ -96,7 +93,7 @@ impl Geometry {
             // Most scenes' emitter-only geometry, which most rays miss: its box test on the
             // vectors (`RayQuery::intersect`'s pre-test, lane by lane), then the scalar query
             // for the rays that enter the box.
-            for i in bits(bvh.root_box_packet(isa, rays, active)) {
+            for i in bits(bvh.root_box_packet(cpu, rays, active)) {
                 if let Some(h) = self.intersect_full(&rays.ray(i)) {
                     cols.set_lane(i, &h);
                     out[i] = Some(h);
@@ -105,7 +102,7 @@ impl Geometry {
             return;
         }
         let mut hits = PacketHits::new();
-        bvh.closest_packet(isa, rays, active, &mut hits, |id, ray, t_max| {
+        bvh.closest_packet(cpu, rays, active, &mut hits, |id, ray, t_max| {
             self.other_t_outlined(id, ray.o, ray.d, t_max)
         });
         let mut ties = hits.ties;
@@ -117,7 +114,7 @@ impl Geometry {
                 }
             }
         }
-        self.hit_records(isa, rays, &hits, hits.found & !ties, out, cols);
+        self.hit_records(cpu, rays, &hits, hits.found & !ties, out, cols);
         for i in bits(ties) {
             out[i] = self.intersect(&rays.ray(i));
             if let Some(h) = &out[i] {
@@ -133,22 +130,22 @@ impl Geometry {
     /// rays enter is finished by the scalar query of each (incoherent shadow rays, e.g. on
     /// `dense`, would otherwise make the packet visit the union of the rays' subtrees).
     pub fn occluded_packet<R: PacketRayForm>(&self, rays: &R, active: u32) -> u32 {
-        self.occluded_packet_with(self.isa, rays, active)
+        self.occluded_packet_with(self.cpu, rays, active)
     }
 
     /// [`Self::occluded_packet`] on a chosen vector backend (for tests and benchmarks; one
     /// this CPU does not run falls back to the widest it does).
     pub fn occluded_packet_on<R: PacketRayForm>(&self, isa: Isa, rays: &R, active: u32) -> u32 {
-        self.occluded_packet_with(isa.supported(), rays, active)
+        self.occluded_packet_with(isa.cpu(), rays, active)
     }
 
-    /// [`Self::occluded_packet`] on `isa`, a set this CPU runs.
-    fn occluded_packet_with<R: PacketRays + ?Sized>(&self, isa: Isa, rays: &R, active: u32) -> u32 {
+    /// [`Self::occluded_packet`] on `cpu`.
+    fn occluded_packet_with<R: PacketRays + ?Sized>(&self, cpu: Cpu, rays: &R, active: u32) -> u32 {
         let active = active & PACKET_MASK;
         let Some(bvh) = self.wide() else {
             return bits(active).fold(0, |m, i| m | (self.occluded(&rays.ray(i)) as u32) << i);
         };
-        bvh.any_packet(isa, rays, active, SPARSE, |id, ray| {
+        bvh.any_packet(cpu, rays, active, SPARSE, |id, ray| {
             self.other_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
         })
     }
@@ -161,54 +158,42 @@ const SPARSE: u32 = 4;
 
 impl Geometry {
     /// The hit records of the rays `lanes` of a packet query (`hits` finished), into `out`,
-    /// on backend `isa` (one this CPU runs): `out[i] = Some(self.surface_hit(..))` for each,
-    /// bit for bit, and its point, normals and error bound to lane i of `cols`.
+    /// on `cpu`: `out[i] = Some(self.surface_hit(..))` for each, bit for bit, and its point,
+    /// normals and error bound to lane i of `cols`.
     fn hit_records<R: PacketRays + ?Sized, C: ColumnSink>(
         &self,
-        isa: Isa,
+        cpu: Cpu,
         rays: &R,
         hits: &PacketHits,
         lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
         cols: &mut C,
     ) {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
-            Isa::Avx512 => unsafe { self.hit_records_avx512(rays, hits, lanes, out, cols) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as above: the CPU runs AVX2.
-            Isa::Avx2 => unsafe { self.hit_records_avx2(rays, hits, lanes, out, cols) },
-            _ => self.hit_records_impl::<Portable, R, C>(rays, hits, lanes, out, cols),
+        /// [`Geometry::hit_records_impl`]'s arguments.
+        struct Records<'a, R: ?Sized, C> {
+            g: &'a Geometry,
+            rays: &'a R,
+            hits: &'a PacketHits,
+            lanes: u32,
+            out: &'a mut [Option<SurfaceHit>; PACKET],
+            cols: &'a mut C,
         }
-    }
-
-    /// [`Self::hit_records_impl`] on AVX-512.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512dq")]
-    fn hit_records_avx512<R: PacketRays + ?Sized, C: ColumnSink>(
-        &self,
-        rays: &R,
-        hits: &PacketHits,
-        lanes: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-        cols: &mut C,
-    ) {
-        self.hit_records_impl::<Avx512, R, C>(rays, hits, lanes, out, cols)
-    }
-
-    /// [`Self::hit_records_impl`] on AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn hit_records_avx2<R: PacketRays + ?Sized, C: ColumnSink>(
-        &self,
-        rays: &R,
-        hits: &PacketHits,
-        lanes: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-        cols: &mut C,
-    ) {
-        self.hit_records_impl::<Avx2, R, C>(rays, hits, lanes, out, cols)
+        impl<R: PacketRays + ?Sized, C: ColumnSink> SimdKernel for Records<'_, R, C> {
+            type Output = ();
+            #[inline(always)]
+            fn run<S: Simd>(self, s: S) {
+                let k = self;
+                k.g.hit_records_impl(s, k.rays, k.hits, k.lanes, k.out, k.cols)
+            }
+        }
+        cpu.dispatch(OnSimd(Records {
+            g: self,
+            rays,
+            hits,
+            lanes,
+            out,
+            cols,
+        }))
     }
 
     /// Rays that hit the same triangle (most of a coherent packet) get their records on the
@@ -216,23 +201,24 @@ impl Geometry {
     #[inline(always)]
     fn hit_records_impl<S: Simd, R: PacketRays + ?Sized, C: ColumnSink>(
         &self,
+        s: S,
         rays: &R,
         hits: &PacketHits,
         mut lanes: u32,
         out: &mut [Option<SurfaceHit>; PACKET],
         cols: &mut C,
     ) {
-        let ids = S::load(&hits.id);
+        let ids = s.load(&hits.id);
         while lanes != 0 {
             let first = lanes.trailing_zeros() as usize & (PACKET - 1);
-            let group = S::bits(S::eq_bits(ids, S::splat(hits.id[first]))) & lanes;
+            let group = S::bits(S::eq_bits(ids, s.splat(hits.id[first]))) & lanes;
             lanes &= !group;
             let id = hits.id[first].to_bits() as usize;
             // SAFETY: as in `surface_hit`, ids reported by a traversal index `prims`.
             let p = unsafe { self.prims.get_unchecked(id) };
             match p.kind {
                 PrimKind::Triangle { mesh, v } if group & (group - 1) != 0 => {
-                    self.triangle_records::<S, C>(id, p, mesh, v, hits, group, out, cols);
+                    self.triangle_records(s, id, p, mesh, v, hits, group, out, cols);
                 }
                 _ => {
                     for i in bits(group) {
@@ -254,6 +240,7 @@ impl Geometry {
     #[inline(always)]
     fn triangle_records<S: Simd, C: ColumnSink>(
         &self,
+        s: S,
         id: usize,
         p: &Primitive,
         mesh: u32,
@@ -263,25 +250,20 @@ impl Geometry {
         out: &mut [Option<SurfaceHit>; PACKET],
         cols: &mut C,
     ) {
-        let sp = S::splat;
-        let zero = sp(0.0);
-        let b = [
-            S::load(&hits.b[0]),
-            S::load(&hits.b[1]),
-            S::load(&hits.b[2]),
-        ];
+        let zero = s.splat(0.0);
+        let b = [s.load(&hits.b[0]), s.load(&hits.b[1]), s.load(&hits.b[2])];
         let verts = [p.p[0].to_array(), p.p[1].to_array(), p.p[2].to_array()];
         // pos = v0·b0 + v1·b1 + v2·b2 and `barycentric_error`'s sum of |products|.
         let mut pos = [zero; 3];
         let mut err = [zero; 3];
         for a in 0..3 {
             let q = [
-                sp(verts[0][a]) * b[0],
-                sp(verts[1][a]) * b[1],
-                sp(verts[2][a]) * b[2],
+                s.splat(verts[0][a]) * b[0],
+                s.splat(verts[1][a]) * b[1],
+                s.splat(verts[2][a]) * b[2],
             ];
             pos[a] = q[0] + q[1] + q[2];
-            err[a] = (S::abs(q[0]) + S::abs(q[1]) + S::abs(q[2])) * sp(POINT_ERROR_GAMMA);
+            err[a] = (S::abs(q[0]) + S::abs(q[1]) + S::abs(q[2])) * s.splat(POINT_ERROR_GAMMA);
         }
         // SAFETY: `tri_ng` has one entry per primitive, and `id` indexes `prims`.
         let tri_ng = unsafe { *self.tri_ng.get_unchecked(id) }.to_array();
@@ -295,16 +277,21 @@ impl Geometry {
                 ];
                 let mut r = [zero; 3];
                 for a in 0..3 {
-                    r[a] = sp(nv[0][a]) * b[0] + sp(nv[1][a]) * b[1] + sp(nv[2][a]) * b[2];
+                    r[a] = s.splat(nv[0][a]) * b[0]
+                        + s.splat(nv[1][a]) * b[1]
+                        + s.splat(nv[2][a]) * b[2];
                 }
                 // `unit_or_zero`: 0 < 1/|r| < ∞ is its integer test as float compares.
-                let rcp = S::div(sp(1.0), S::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
-                let valid = S::and(S::lt(zero, rcp), S::lt(rcp, sp(f32::INFINITY)));
+                let rcp = S::div(
+                    s.splat(1.0),
+                    S::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]),
+                );
+                let valid = S::and(S::lt(zero, rcp), S::lt(rcp, s.splat(f32::INFINITY)));
                 let mut u = [zero; 3];
                 let mut g = [zero; 3];
                 for a in 0..3 {
                     u[a] = S::select(valid, r[a] * rcp, zero);
-                    g[a] = sp(tri_ng[a]);
+                    g[a] = s.splat(tri_ng[a]);
                 }
                 let is_zero = S::and(
                     S::and(S::eq(u[0], zero), S::eq(u[1], zero)),
@@ -314,7 +301,7 @@ impl Geometry {
                 let flip = S::andnot(S::lt(d, zero), is_zero);
                 let (mut ng, mut ns) = ([zero; 3], [zero; 3]);
                 for a in 0..3 {
-                    ng[a] = S::select(flip, sp(-tri_ng[a]), g[a]);
+                    ng[a] = S::select(flip, s.splat(-tri_ng[a]), g[a]);
                     ns[a] = S::select(is_zero, g[a], u[a]);
                 }
                 (ng, ns)
@@ -325,7 +312,7 @@ impl Geometry {
                 } else {
                     tri_ng
                 };
-                let g = [sp(n[0]), sp(n[1]), sp(n[2])];
+                let g = [s.splat(n[0]), s.splat(n[1]), s.splat(n[2])];
                 (g, g)
             }
         };
@@ -338,17 +325,18 @@ impl Geometry {
                 ];
                 let mut c = [zero; 2];
                 for a in 0..2 {
-                    c[a] = sp(w[0][a]) * b[0] + sp(w[1][a]) * b[1] + sp(w[2][a]) * b[2];
+                    c[a] =
+                        s.splat(w[0][a]) * b[0] + s.splat(w[1][a]) * b[1] + s.splat(w[2][a]) * b[2];
                 }
                 c
             }
             None => [b[1] + b[2], b[2]],
         };
         let p_error = err[0] * S::abs(ng[0]) + err[1] * S::abs(ng[1]) + err[2] * S::abs(ng[2]);
-        cols.set_group::<S>(group, &pos, &ng, &ns, p_error);
+        cols.set_group(s, group, &pos, &ng, &ns, p_error);
         // The fields in `SurfaceHit`'s order, transposed to one row per ray.
         let rows = S::transpose([
-            S::load(&hits.t),
+            s.load(&hits.t),
             pos[0],
             pos[1],
             pos[2],
@@ -361,9 +349,9 @@ impl Geometry {
             uv[0],
             uv[1],
             p_error,
-            sp(f32::from_bits(id as u32)),
-            sp(f32::from_bits(p.material)),
-            sp(f32::from_bits(p.light)),
+            s.splat(f32::from_bits(id as u32)),
+            s.splat(f32::from_bits(p.material)),
+            s.splat(f32::from_bits(p.light)),
         ]);
         for i in 0..PACKET {
             if group >> i & 1 != 0 {

@@ -7,7 +7,7 @@
 //! ray's box verdicts are the one-ray ones, and a leaf's triangles are tested against the rays
 //! that passed its box, each lane doing [`RayShear4`](crate::geometry::tri4::RayShear4)'s f32
 //! operations. The kernels are generic over the 16-lane vector type of `simd16` (AVX-512,
-//! AVX2 or portable lane loops, picked at run time: [`Isa`]).
+//! AVX2 or portable lane loops, picked at run time: [`Cpu::dispatch`]).
 //!
 //! Why the closest hit is the one-ray one: a triangle (or quadric) test accepts a hit exactly
 //! when it is valid and its t is below the current best (the t_max pre-filter never rejects
@@ -21,12 +21,10 @@ use super::{Bary, LEAF, Node4, STACK, WideBvh};
 use crate::geometry::Ray;
 use crate::geometry::bvh::{NEAR_SLACK, ROUNDING_SLACK};
 use crate::geometry::packet::{PACKET, PACKET_MASK, PacketRays, bits};
-#[cfg(target_arch = "x86_64")]
-use crate::geometry::simd16::{Avx2, Avx512};
-use crate::geometry::simd16::{Lanes, Portable, Simd};
+use crate::geometry::simd16::{Lanes, OnSimd, Simd, SimdKernel};
 use crate::geometry::tri4::TriPacket;
 use crate::geometry::triangle::{RayShear, self_hit_bound};
-use crate::isa::Isa;
+use crate::isa::Cpu;
 use std::mem::MaybeUninit;
 
 /// The closest-hit state of a packet's traversal, lanes over rays (in memory, so that the
@@ -80,6 +78,8 @@ impl PacketHits {
 
 /// Per-ray constants of the slab test, lanes over rays.
 struct PacketBox<S: Simd> {
+    /// The backend's token.
+    tk: S,
     o: [S::F; 3],
     inv: [S::F; 3],
     /// Rays that enter the box through the upper plane of that axis.
@@ -91,7 +91,7 @@ struct PacketBox<S: Simd> {
 impl<S: Simd> PacketBox<S> {
     /// From the rays' lanes `l` ([`Simd::rays`]).
     #[inline(always)]
-    fn new(l: &[S::F; 7], active: u32) -> Self {
+    fn new(tk: S, l: &[S::F; 7], active: u32) -> Self {
         // Loops, not closures: a closure left out of line would lack the caller's target
         // features, and so would every intrinsic in it.
         let (mut inv, mut neg) = ([l[3]; 3], [S::lt(l[3], l[3]); 3]);
@@ -99,10 +99,10 @@ impl<S: Simd> PacketBox<S> {
         for a in 0..3 {
             // `safe_inverse` per lane: tiny components become ±1e-30 with their sign bit.
             let d = l[3 + a];
-            let tiny = S::lt(S::abs(d), S::splat(1e-30));
-            let small = S::select(S::sign(d), S::splat(-1e-30), S::splat(1e-30));
-            inv[a] = S::div(S::splat(1.0), S::select(tiny, small, d));
-            neg[a] = S::lt(inv[a], S::splat(0.0));
+            let tiny = S::lt(S::abs(d), tk.splat(1e-30));
+            let small = S::select(S::sign(d), tk.splat(-1e-30), tk.splat(1e-30));
+            inv[a] = S::div(tk.splat(1.0), S::select(tiny, small, d));
+            neg[a] = S::lt(inv[a], tk.splat(0.0));
             negs[a] = S::bits(neg[a]) & active;
         }
         let uniform = (negs.iter().all(|&n| n == 0 || n == active)).then_some([
@@ -111,6 +111,7 @@ impl<S: Simd> PacketBox<S> {
             (negs[2] != 0) as usize,
         ]);
         PacketBox {
+            tk,
             o: [l[0], l[1], l[2]],
             inv,
             neg,
@@ -131,21 +132,22 @@ fn child_hits<S: Simd, const MIXED: bool>(
     t_max: S::F,
     near: &mut Lanes,
 ) -> u32 {
+    let tk = r.tk;
     let plane = |s: usize, a: usize| node.b[s & 1][a].to_array()[c & 3];
-    let mut n = [S::splat(0.0); 3];
-    let mut f = [S::splat(0.0); 3];
+    let mut n = [tk.splat(0.0); 3];
+    let mut f = [tk.splat(0.0); 3];
     for a in 0..3 {
         let (np, fp) = if MIXED {
-            let (lo, hi) = (S::splat(plane(0, a)), S::splat(plane(1, a)));
+            let (lo, hi) = (tk.splat(plane(0, a)), tk.splat(plane(1, a)));
             (S::select(r.neg[a], hi, lo), S::select(r.neg[a], lo, hi))
         } else {
-            (S::splat(plane(side[a], a)), S::splat(plane(side[a] ^ 1, a)))
+            (tk.splat(plane(side[a], a)), tk.splat(plane(side[a] ^ 1, a)))
         };
         n[a] = (np - r.o[a]) * r.inv[a];
         f[a] = (fp - r.o[a]) * r.inv[a];
     }
-    let nr = S::max(S::max(S::max(n[0], n[1]), n[2]), S::splat(0.0)) * S::splat(NEAR_SLACK);
-    let fr = S::min(S::min(f[0], f[1]), f[2]) * S::splat(ROUNDING_SLACK);
+    let nr = S::max(S::max(S::max(n[0], n[1]), n[2]), tk.splat(0.0)) * tk.splat(NEAR_SLACK);
+    let fr = S::min(S::min(f[0], f[1]), f[2]) * tk.splat(ROUNDING_SLACK);
     S::store(nr, near);
     S::bits(S::le(nr, S::min(fr, t_max)))
 }
@@ -158,7 +160,8 @@ fn node_hits<S: Simd>(
     t_max: &Lanes,
     near: &mut [Lanes; 4],
 ) -> [u32; 4] {
-    let t_max = S::load(t_max);
+    let tk = r.tk;
+    let t_max = tk.load(t_max);
     let mut m = [0; 4];
     match r.uniform {
         Some(side) => {
@@ -178,6 +181,8 @@ fn node_hits<S: Simd>(
 /// Per-ray constants of the watertight triangle test, lanes over rays: the constants of
 /// [`RayShear4`](super::tri4::RayShear4) for each ray, with each lane's own shear axes (`shear_axes` of its direction).
 struct PacketShear<S: Simd> {
+    /// The backend's token.
+    tk: S,
     /// The shear axes when all active rays share them (the common case for coherent packets),
     /// else `None`: then each lane picks its vertex coordinates by `pick`.
     k: Option<[usize; 3]>,
@@ -198,7 +203,7 @@ fn pick3<S: Simd>(m: [S::M; 2], a: [S::F; 3]) -> S::F {
 impl<S: Simd> PacketShear<S> {
     /// From the rays' lanes `l` ([`Simd::rays`]).
     #[inline(always)]
-    fn new(l: &[S::F; 7], active: u32) -> Self {
+    fn new(tk: S, l: &[S::F; 7], active: u32) -> Self {
         // `shear_axes` per lane: kz is the dominant axis (ties to the later one), and
         // (kx, ky) = (kz + 1, kz + 2) mod 3, swapped when d[kz] < 0.
         let d = [l[3], l[4], l[5]];
@@ -206,9 +211,9 @@ impl<S: Simd> PacketShear<S> {
         let x_gt_y = S::lt(a[1], a[0]);
         let x_max = S::and(x_gt_y, S::lt(a[2], a[0]));
         let y_max = S::andnot(S::lt(a[2], a[1]), x_gt_y);
-        let z_max = S::andnot(S::mask(PACKET_MASK), S::or(x_max, y_max));
-        let neg = S::lt(pick3::<S>([x_max, y_max], d), S::splat(0.0));
-        let pos = S::andnot(S::mask(PACKET_MASK), neg);
+        let z_max = S::andnot(tk.mask(PACKET_MASK), S::or(x_max, y_max));
+        let neg = S::lt(pick3::<S>([x_max, y_max], d), tk.splat(0.0));
+        let pos = S::andnot(tk.mask(PACKET_MASK), neg);
         let either = |p: S::M, n: S::M| S::or(S::and(pos, p), S::and(neg, n));
         let pick = [
             [either(z_max, y_max), either(x_max, z_max)],
@@ -243,8 +248,9 @@ impl<S: Simd> PacketShear<S> {
             pick3::<S>(pick[1], d),
             pick3::<S>(pick[2], d),
         );
-        let minus = S::splat(-1.0);
+        let minus = tk.splat(-1.0);
         PacketShear {
+            tk,
             k,
             pick,
             o: [
@@ -255,7 +261,7 @@ impl<S: Simd> PacketShear<S> {
             s: [
                 S::div(dx, dz) * minus,
                 S::div(dy, dz) * minus,
-                S::div(S::splat(1.0), dz),
+                S::div(tk.splat(1.0), dz),
             ],
             ad: [S::abs(dx), S::abs(dy)],
         }
@@ -266,6 +272,8 @@ impl<S: Simd> PacketShear<S> {
 /// [`RayShear4`](super::tri4::RayShear4)'s lane test for that ray (same order, hence the same
 /// bits, self-hit rejection included).
 struct TriLanes<S: Simd> {
+    /// The backend's token.
+    tk: S,
     /// Rays accepted by the f32 test with t in (0, t_max).
     hit: u32,
     /// Rays with an exactly-zero edge function: to be redone by the scalar test.
@@ -288,7 +296,8 @@ fn shear<S: Simd>(
     j: usize,
     ps: &PacketShear<S>,
 ) -> (S::F, S::F, S::F) {
-    let v = |a: usize| S::splat(AsRef::<[f32; 4]>::as_ref(&pk.v[j][a])[lane & 3]);
+    let tk = ps.tk;
+    let v = |a: usize| tk.splat(AsRef::<[f32; 4]>::as_ref(&pk.v[j][a])[lane & 3]);
     let c = match ps.k {
         Some(k) => [v(k[0]), v(k[1]), v(k[2])],
         None => {
@@ -314,19 +323,20 @@ fn triangle_lanes<S: Simd>(
     t_max: &Lanes,
     mask: u32,
 ) -> TriLanes<S> {
+    let tk = ps.tk;
     let (ax, ay, az) = shear(pk, lane, 0, ps);
     let (bx, by, bz) = shear(pk, lane, 1, ps);
     let (cx, cy, cz) = shear(pk, lane, 2, ps);
     let e0 = bx * cy - by * cx;
     let e1 = cx * ay - cy * ax;
     let e2 = ax * by - ay * bx;
-    let zero = S::splat(0.0);
+    let zero = tk.splat(0.0);
     let redo = S::or(S::or(S::eq(e0, zero), S::eq(e1, zero)), S::eq(e2, zero));
     let n0 = S::sign(e0);
     let mixed = S::or(S::xor(n0, S::sign(e1)), S::xor(n0, S::sign(e2)));
     let det = e0 + e1 + e2;
     let t_scaled = e0 * az + e1 * bz + e2 * cz;
-    let t_max = S::load(t_max);
+    let t_max = tk.load(t_max);
     let tmd = t_max * det;
     let sgn = S::sign_one(det);
     let (ts, tm) = (t_scaled * sgn, tmd * sgn);
@@ -336,6 +346,7 @@ fn triangle_lanes<S: Simd>(
     if S::bits(cand) & mask == 0 {
         // The common miss: skip the division.
         return TriLanes {
+            tk,
             hit: 0,
             redo,
             t: zero,
@@ -350,11 +361,12 @@ fn triangle_lanes<S: Simd>(
         max_abs3::<S>(ay, by, cy),
         max_abs3::<S>(az, bz, cz),
     );
-    let bound = self_hit_bound(mx, my, mz, ps.ad[0], ps.ad[1], S::splat);
-    let inv = S::div(S::splat(1.0), det);
+    let bound = self_hit_bound(mx, my, mz, ps.ad[0], ps.ad[1], |x| tk.splat(x));
+    let inv = S::div(tk.splat(1.0), det);
     let t = t_scaled * inv;
     let ok = S::and(S::and(S::lt(zero, t), S::lt(t, t_max)), S::lt(bound, ts));
     TriLanes {
+        tk,
         hit: S::bits(S::and(ok, cand)),
         redo,
         t,
@@ -424,22 +436,23 @@ fn consider(st: &mut PacketHits, i: usize, id: usize, t: f32, b: Bary) {
 /// operands, hence the same bits).
 #[inline(always)]
 fn consider_lanes<S: Simd>(st: &mut PacketHits, id: u32, h: &TriLanes<S>, hit: u32) {
-    let best = S::load(&st.t);
-    let ids = S::load(&st.id);
-    let idv = S::splat(f32::from_bits(id));
-    let hm = S::mask(hit);
+    let tk = h.tk;
+    let best = tk.load(&st.t);
+    let ids = tk.load(&st.id);
+    let idv = tk.splat(f32::from_bits(id));
+    let hm = tk.mask(hit);
     let closer = S::and(S::lt(h.t, best), hm);
-    let same = S::and(S::and(S::eq(h.t, best), hm), S::mask(st.found));
+    let same = S::and(S::and(S::eq(h.t, best), hm), tk.mask(st.found));
     let tie = S::andnot(same, S::eq_bits(ids, idv));
     S::store(S::select(closer, h.t, best), &mut st.t);
     // Hits have 0 < t < ∞, where `up` adds one to the bit pattern.
-    let tm = S::select(closer, h.t, S::load(&st.tm));
+    let tm = S::select(closer, h.t, tk.load(&st.tm));
     S::store(S::inc_bits(closer, tm), &mut st.tm);
     S::store(S::select(closer, idv, ids), &mut st.id);
     for k in 0..3 {
-        S::store(S::select(closer, h.e[k], S::load(&st.b[k])), &mut st.b[k]);
+        S::store(S::select(closer, h.e[k], tk.load(&st.b[k])), &mut st.b[k]);
     }
-    S::store(S::select(closer, h.inv, S::load(&st.inv)), &mut st.inv);
+    S::store(S::select(closer, h.inv, tk.load(&st.inv)), &mut st.inv);
     let closer = S::bits(closer);
     st.found |= closer;
     st.ties = (st.ties & !closer) | S::bits(tie);
@@ -456,53 +469,40 @@ struct Pending {
 
 /// Rays `mask` whose entry distance is not beyond their best hit.
 #[inline(always)]
-fn still_open<S: Simd>(near: &Lanes, best: &Lanes, mask: u32) -> u32 {
+fn still_open<S: Simd>(tk: S, near: &Lanes, best: &Lanes, mask: u32) -> u32 {
     // `<=`, not the scalar `<`: a box entered exactly at the best t may hold a tie.
-    S::bits(S::le(S::load(near), S::load(best))) & mask
+    S::bits(S::le(tk.load(near), tk.load(best))) & mask
 }
 
 impl WideBvh {
     /// The rays `active` that enter the box of the root's first child before their t_max, on
-    /// backend `isa` (one this CPU runs); for a single-leaf tree, bit i is `!self.single_leaf_missed(ray i)` (the
-    /// same operations on the same values: `SingleLeaf::hit` is lane 0 of `Node4::hit`).
+    /// `cpu`; for a single-leaf tree, bit i is `!self.single_leaf_missed(ray i)` (the same
+    /// operations on the same values: `SingleLeaf::hit` is lane 0 of `Node4::hit`).
     pub(in crate::geometry) fn root_box_packet<R: PacketRays + ?Sized>(
         &self,
-        isa: Isa,
+        cpu: Cpu,
         rays: &R,
         active: u32,
     ) -> u32 {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
-            Isa::Avx512 => unsafe { self.root_box_avx512(rays, active) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as above: the CPU runs AVX2.
-            Isa::Avx2 => unsafe { self.root_box_avx2(rays, active) },
-            _ => self.root_box_impl::<Portable, R>(rays, active),
+        /// [`WideBvh::root_box_impl`]'s arguments.
+        struct RootBox<'a, R: ?Sized>(&'a WideBvh, &'a R, u32);
+        impl<R: PacketRays + ?Sized> SimdKernel for RootBox<'_, R> {
+            type Output = u32;
+            #[inline(always)]
+            fn run<S: Simd>(self, tk: S) -> u32 {
+                self.0.root_box_impl(tk, self.1, self.2)
+            }
         }
-    }
-
-    /// [`Self::root_box_impl`] on AVX-512.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512dq")]
-    fn root_box_avx512<R: PacketRays + ?Sized>(&self, rays: &R, active: u32) -> u32 {
-        self.root_box_impl::<Avx512, R>(rays, active)
-    }
-
-    /// [`Self::root_box_impl`] on AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn root_box_avx2<R: PacketRays + ?Sized>(&self, rays: &R, active: u32) -> u32 {
-        self.root_box_impl::<Avx2, R>(rays, active)
+        cpu.dispatch(OnSimd(RootBox(self, rays, active)))
     }
 
     #[inline(always)]
-    fn root_box_impl<S: Simd, R: PacketRays + ?Sized>(&self, rays: &R, active: u32) -> u32 {
+    fn root_box_impl<S: Simd, R: PacketRays + ?Sized>(&self, tk: S, rays: &R, active: u32) -> u32 {
         let Some(root) = self.nodes.first() else {
             return 0;
         };
-        let l = rays.lanes::<S>();
-        let r = PacketBox::<S>::new(&l, active);
+        let l = rays.lanes(tk);
+        let r = PacketBox::new(tk, &l, active);
         let mut near = [0.0f32; PACKET];
         let m = match r.uniform {
             Some(side) => child_hits::<S, false>(root, 0, &r, side, l[6], &mut near),
@@ -513,107 +513,60 @@ impl WideBvh {
 }
 
 impl WideBvh {
-    /// Closest hits of the rays `active` on backend `isa` (one this CPU runs) into `out` (a
-    /// fresh [`PacketHits`]): `out.hit(i)` for each ray i in `out.found`; `out.ties` flags
-    /// rays with another primitive hit at exactly their best t (the caller redoes those with
-    /// the scalar query). `other(id, ray, t_max)`
-    /// is the hit distance of a non-triangle primitive if below `t_max`, else +∞.
+    /// Closest hits of the rays `active` on `cpu` into `out` (a fresh [`PacketHits`]):
+    /// `out.hit(i)` for each ray i in `out.found`; `out.ties` flags rays with another
+    /// primitive hit at exactly their best t (the caller redoes those with the scalar query).
+    /// `other(id, ray, t_max)` is the hit distance of a primitive the traversal does not test
+    /// itself (a quadric, a cut-out triangle) if below `t_max`, else +∞.
     pub(in crate::geometry) fn closest_packet<R: PacketRays + ?Sized>(
         &self,
-        isa: Isa,
+        cpu: Cpu,
         rays: &R,
         active: u32,
         out: &mut PacketHits,
         other: impl FnMut(usize, &Ray, f32) -> f32,
     ) {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
-            Isa::Avx512 => unsafe { self.closest_packet_avx512(rays, active, out, other) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as above: the CPU runs AVX2.
-            Isa::Avx2 => unsafe { self.closest_packet_avx2(rays, active, out, other) },
-            _ => self.closest_packet_impl::<Portable, R>(rays, active, out, other),
+        /// [`WideBvh::closest_packet_impl`]'s arguments.
+        struct Closest<'a, R: ?Sized, F>(&'a WideBvh, &'a R, u32, &'a mut PacketHits, F);
+        impl<R: PacketRays + ?Sized, F: FnMut(usize, &Ray, f32) -> f32> SimdKernel for Closest<'_, R, F> {
+            type Output = ();
+            #[inline(always)]
+            fn run<S: Simd>(self, tk: S) {
+                let Closest(bvh, rays, active, out, other) = self;
+                bvh.closest_packet_impl(tk, rays, active, out, other)
+            }
         }
+        cpu.dispatch(OnSimd(Closest(self, rays, active, out, other)))
     }
 
-    /// [`Self::closest_packet_impl`] on AVX-512.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512dq")]
-    fn closest_packet_avx512<R: PacketRays + ?Sized>(
-        &self,
-        rays: &R,
-        active: u32,
-        out: &mut PacketHits,
-        other: impl FnMut(usize, &Ray, f32) -> f32,
-    ) {
-        self.closest_packet_impl::<Avx512, R>(rays, active, out, other)
-    }
-
-    /// [`Self::closest_packet_impl`] on AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn closest_packet_avx2<R: PacketRays + ?Sized>(
-        &self,
-        rays: &R,
-        active: u32,
-        out: &mut PacketHits,
-        other: impl FnMut(usize, &Ray, f32) -> f32,
-    ) {
-        self.closest_packet_impl::<Avx2, R>(rays, active, out, other)
-    }
-
-    /// Mask of the rays `active` that something blocks in (0, t_max), on backend `isa` (one
-    /// this CPU runs);
-    /// `other(id, ray)` tells whether non-triangle primitive `id` blocks `ray`.
+    /// Mask of the rays `active` that something blocks in (0, t_max), on `cpu`;
+    /// `other(id, ray)` tells whether a primitive the traversal does not test itself blocks
+    /// `ray`.
     pub(in crate::geometry) fn any_packet<R: PacketRays + ?Sized>(
         &self,
-        isa: Isa,
+        cpu: Cpu,
         rays: &R,
         active: u32,
         sparse: u32,
         other: impl FnMut(usize, &Ray) -> bool,
     ) -> u32 {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
-            Isa::Avx512 => unsafe { self.any_packet_avx512(rays, active, sparse, other) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as above: the CPU runs AVX2.
-            Isa::Avx2 => unsafe { self.any_packet_avx2(rays, active, sparse, other) },
-            _ => self.any_packet_impl::<Portable, R>(rays, active, sparse, other),
+        /// [`WideBvh::any_packet_impl`]'s arguments.
+        struct Any<'a, R: ?Sized, F>(&'a WideBvh, &'a R, u32, u32, F);
+        impl<R: PacketRays + ?Sized, F: FnMut(usize, &Ray) -> bool> SimdKernel for Any<'_, R, F> {
+            type Output = u32;
+            #[inline(always)]
+            fn run<S: Simd>(self, tk: S) -> u32 {
+                let Any(bvh, rays, active, sparse, other) = self;
+                bvh.any_packet_impl(tk, rays, active, sparse, other)
+            }
         }
-    }
-
-    /// [`Self::any_packet_impl`] on AVX-512.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512dq")]
-    fn any_packet_avx512<R: PacketRays + ?Sized>(
-        &self,
-        rays: &R,
-        active: u32,
-        sparse: u32,
-        other: impl FnMut(usize, &Ray) -> bool,
-    ) -> u32 {
-        self.any_packet_impl::<Avx512, R>(rays, active, sparse, other)
-    }
-
-    /// [`Self::any_packet_impl`] on AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn any_packet_avx2<R: PacketRays + ?Sized>(
-        &self,
-        rays: &R,
-        active: u32,
-        sparse: u32,
-        other: impl FnMut(usize, &Ray) -> bool,
-    ) -> u32 {
-        self.any_packet_impl::<Avx2, R>(rays, active, sparse, other)
+        cpu.dispatch(OnSimd(Any(self, rays, active, sparse, other)))
     }
 
     #[inline(always)]
     fn closest_packet_impl<S: Simd, R: PacketRays + ?Sized>(
         &self,
+        tk: S,
         rays: &R,
         active: u32,
         st: &mut PacketHits,
@@ -622,15 +575,15 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return;
         }
-        let l = rays.lanes::<S>();
-        let r = PacketBox::<S>::new(&l, active);
-        let best = S::select(S::mask(active), l[6], S::splat(f32::NEG_INFINITY));
+        let l = rays.lanes(tk);
+        let r = PacketBox::new(tk, &l, active);
+        let best = S::select(tk.mask(active), l[6], tk.splat(f32::NEG_INFINITY));
         S::store(best, &mut st.t);
         // Bounds of the tests: up(best), so that hits at exactly the best t are seen.
-        let zero = S::splat(0.0);
-        let finite = S::and(S::le(zero, best), S::lt(best, S::splat(f32::INFINITY)));
+        let zero = tk.splat(0.0);
+        let finite = S::and(S::le(zero, best), S::lt(best, tk.splat(f32::INFINITY)));
         S::store(S::inc_bits(finite, best), &mut st.tm);
-        let ps = PacketShear::<S>::new(&l, active);
+        let ps = PacketShear::new(tk, &l, active);
         let mut stack = [const { MaybeUninit::<Pending>::uninit() }; STACK];
         let mut sp = 0usize;
         let (mut cur, mut mask) = (0u32, active);
@@ -720,16 +673,16 @@ impl WideBvh {
             loop {
                 if sp == 0 {
                     // The barycentrics of the best hits (see `PacketHits::b`).
-                    let inv = S::load(&st.inv);
+                    let inv = tk.load(&st.inv);
                     for k in 0..3 {
-                        S::store(S::load(&st.b[k]) * inv, &mut st.b[k]);
+                        S::store(tk.load(&st.b[k]) * inv, &mut st.b[k]);
                     }
                     return;
                 }
                 sp -= 1;
                 // SAFETY: every slot below the stack pointer was written by a push above.
                 let e = unsafe { stack.get_unchecked(sp).assume_init_ref() };
-                let m = still_open::<S>(&e.near, &st.t, e.mask);
+                let m = still_open(tk, &e.near, &st.t, e.mask);
                 if m != 0 {
                     cur = e.child;
                     mask = m;
@@ -742,6 +695,7 @@ impl WideBvh {
     #[inline(always)]
     fn any_packet_impl<S: Simd, R: PacketRays + ?Sized>(
         &self,
+        tk: S,
         rays: &R,
         active: u32,
         sparse: u32,
@@ -750,12 +704,12 @@ impl WideBvh {
         if self.nodes.is_empty() || active == 0 {
             return 0;
         }
-        let l = rays.lanes::<S>();
-        let r = PacketBox::<S>::new(&l, active);
+        let l = rays.lanes(tk);
+        let r = PacketBox::new(tk, &l, active);
         let mut t_max: Lanes = [0.0; PACKET];
-        let inactive = S::splat(f32::NEG_INFINITY);
-        S::store(S::select(S::mask(active), l[6], inactive), &mut t_max);
-        let ps = PacketShear::<S>::new(&l, active);
+        let inactive = tk.splat(f32::NEG_INFINITY);
+        S::store(S::select(tk.mask(active), l[6], inactive), &mut t_max);
+        let ps = PacketShear::new(tk, &l, active);
         let mut blocked = 0u32;
         // Only interior nodes are pushed (leaves are tested on sight), with their ray mask.
         let mut stack = [const { MaybeUninit::<(u32, u32)>::uninit() }; STACK];
