@@ -6,8 +6,13 @@ use glam::Vec2;
 use super::sets::{SetKeys, Strata};
 
 /// The keys of a `fixed` set: none beyond the set key, which nothing reads.
-#[inline]
-pub(super) fn keys(_set: &mut SetKeys) {}
+#[inline(always)]
+pub(super) fn keys(key: u64) -> SetKeys {
+    SetKeys {
+        key,
+        ..Default::default()
+    }
+}
 
 /// The 1D value of every index.
 #[inline(always)]

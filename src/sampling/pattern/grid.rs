@@ -8,9 +8,13 @@ use super::sets::{SetKeys, Strata, in_stratum};
 use crate::sampling::permutation::Permutation;
 
 /// The keys of a `grid` set (from its `key`): the strata → index permutation.
-#[inline]
-pub(super) fn keys(set: &mut SetKeys) {
-    set.perm = Permutation::new(set.key);
+#[inline(always)]
+pub(super) fn keys(key: u64) -> SetKeys {
+    SetKeys {
+        key,
+        perm: Permutation::new(key),
+        ..Default::default()
+    }
 }
 
 /// The 1D sample `index`: the centre of its stratum.

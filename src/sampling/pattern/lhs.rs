@@ -9,11 +9,15 @@ use crate::sampling::hash::{hash_keys, hash_step, uniform_pair};
 use crate::sampling::permutation::Permutation;
 
 /// The keys of an `lhs` set (from its `key`): one permutation per axis and the jitter stream.
-#[inline]
-pub(super) fn keys(set: &mut SetKeys) {
-    set.perm = Permutation::new(set.key);
-    set.perm_y = Permutation::new(hash_keys(&[set.key, TAG_LHS_Y]));
-    set.jitter = hash_step(set.key, TAG_JITTER);
+#[inline(always)]
+pub(super) fn keys(key: u64) -> SetKeys {
+    SetKeys {
+        key,
+        perm: Permutation::new(key),
+        perm_y: Permutation::new(hash_keys(&[key, TAG_LHS_Y])),
+        jitter: hash_step(key, TAG_JITTER),
+        ..Default::default()
+    }
 }
 
 /// The 1D sample `index`: the `stratified` one.

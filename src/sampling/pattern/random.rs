@@ -9,9 +9,13 @@ use super::sets::{SetKeys, Strata};
 use crate::sampling::hash::{hash_step, uniform_pair};
 
 /// The keys of a `random` set (from its `key`): the stream key.
-#[inline]
-pub(super) fn keys(set: &mut SetKeys) {
-    set.jitter = hash_step(set.key, TAG_JITTER);
+#[inline(always)]
+pub(super) fn keys(key: u64) -> SetKeys {
+    SetKeys {
+        key,
+        jitter: hash_step(key, TAG_JITTER),
+        ..Default::default()
+    }
 }
 
 /// The 1D sample `index`.

@@ -10,9 +10,13 @@ use crate::sampling::hash::hash_keys;
 
 /// The keys of a `sobol` set (from its `key`): the seed of its first 2^16 points (the set key
 /// seeds the rest).
-#[inline]
-pub(super) fn keys(set: &mut SetKeys) {
-    set.sobol0 = sobol_seed(set.key, 0);
+#[inline(always)]
+pub(super) fn keys(key: u64) -> SetKeys {
+    SetKeys {
+        key,
+        sobol0: sobol_seed(key, 0),
+        ..Default::default()
+    }
 }
 
 /// The seed of the sequence holding indices `hi · 2^16 ..` of the set `key`.

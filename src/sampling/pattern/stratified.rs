@@ -12,11 +12,16 @@ use crate::sampling::permutation::Permutation;
 
 /// The keys of a `stratified` set (from its `key`): the strata permutation and the jitter
 /// stream (also in the `jitter_fast` form the fast paths hash).
-#[inline]
-pub(super) fn keys(set: &mut SetKeys) {
-    set.perm = Permutation::new(set.key);
-    set.jitter = hash_step(set.key, TAG_JITTER);
-    set.jitter_fast = set.jitter.wrapping_add(HASH_INIT);
+#[inline(always)]
+pub(super) fn keys(key: u64) -> SetKeys {
+    let jitter = hash_step(key, TAG_JITTER);
+    SetKeys {
+        key,
+        perm: Permutation::new(key),
+        jitter,
+        jitter_fast: jitter.wrapping_add(HASH_INIT),
+        ..Default::default()
+    }
 }
 
 /// The 1D sample `index`: its stratum of `count`, jittered.
