@@ -13,7 +13,9 @@ use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::packet::bits;
 use crate::geometry::{PACKET, Ray, RayPacket, SurfaceHit};
-use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
+use crate::light_selection::{
+    LightSelector, SelectedLight, SelectorKind, ShadingPoint, UniformSelector,
+};
 use crate::lights::{Emitter, Light, LightLiSample, LightSampleContext, LightSource, SamplingMode};
 use crate::sampling::{Frame, PixelSamples, SamplePattern};
 use crate::scene::Scene;
@@ -359,11 +361,10 @@ impl<'a> DirectLighting<'a> {
             .take(n)
             .fold(0u32, |s, (k, l)| s | (l.is_some() as u32) << k);
         let mode = self.mode();
-        let uniform = if use_light {
-            self.selector.uniform_count()
-        } else {
-            None
-        };
+        // Uniform picks ignore the shading point: pick inline, without a ShadingPoint or a
+        // virtual call per sample.
+        let uniform = (use_light && self.selector.kind() == SelectorKind::Uniform)
+            .then_some(self.scene.lights.len() as u32);
         let mis = self.strategy == Strategy::Mis;
         let mut sums = [Rgb::ZERO; PACKET];
         let mut picked = [SelectedLight { index: 0, pmf: 0.0 }; PACKET];

@@ -54,7 +54,7 @@ pub fn render(
         res.y
     );
     anyhow::ensure!(opts.spp > 0, "--spp must be at least 1");
-    let selector = make_selector(&opts.light_selection, scene, opts.seed)?;
+    let selector = make_selector(opts.light_selection, scene, opts.seed);
     let pattern = make_pattern(opts.pattern, opts.seed);
     let est = DirectLighting {
         scene,
