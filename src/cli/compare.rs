@@ -2,6 +2,10 @@
 
 use std::path::PathBuf;
 
+use std::io::Write;
+
+use penumbra::image::io::check_output_path;
+use penumbra::image::metrics::comparison_warnings;
 use penumbra::image::{compare, error_image, read_image, write_image};
 
 /// Arguments of `penumbra compare`.
@@ -18,21 +22,21 @@ pub struct Args {
 
 /// Run the command: prints MSE, relMSE and MAE, one per line.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if let Some(out) = &args.error_image {
+        check_output_path(out)?;
+    }
     let test = read_image(&args.test)?;
     let reference = read_image(&args.reference)?;
-    for (img, path) in [(&test, &args.test), (&reference, &args.reference)] {
-        let bad = img.count_non_finite();
-        if bad > 0 {
-            // The metrics will be NaN/Inf; say why rather than leave the user guessing.
-            eprintln!("warning: {}: {bad} pixel(s) with NaN/Inf", path.display());
-        }
+    for w in comparison_warnings((&test, &args.test), (&reference, &args.reference))? {
+        eprintln!("warning: {w}");
     }
     let stats = compare(&test, &reference)?;
-    println!("MSE     {:.4e}", stats.mse);
-    println!("relMSE  {:.4e}", stats.rel_mse);
-    println!("MAE     {:.4e}", stats.mae);
-    if let Some(out) = &args.error_image {
-        write_image(&error_image(&test, &reference)?, out, 0.0)?;
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "MSE     {:.4e}", stats.mse)?;
+    writeln!(out, "relMSE  {:.4e}", stats.rel_mse)?;
+    writeln!(out, "MAE     {:.4e}", stats.mae)?;
+    if let Some(path) = &args.error_image {
+        write_image(&error_image(&test, &reference)?, path, 0.0)?;
     }
     Ok(())
 }

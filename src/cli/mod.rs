@@ -30,7 +30,10 @@ pub enum Command {
 
 pub mod bench;
 pub mod compare;
+pub mod interrupt;
 pub mod lab;
+pub mod memory;
+pub mod messages;
 pub mod render;
 pub mod warp;
 
@@ -41,10 +44,14 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Compare(a)) => compare::run(a),
         Some(Command::Lab(a)) => lab::run(a),
         Some(Command::Scenes) => {
+            use anyhow::Context;
+            use std::io::Write;
+            let mut out = std::io::stdout().lock();
             for b in penumbra::scene::builtin::BUILTINS {
-                println!("{:<16} {}", b.name, b.description);
+                writeln!(out, "{:<16} {}", b.name, b.description)
+                    .context("writing to standard output")?;
             }
-            Ok(())
+            out.flush().context("writing to standard output")
         }
         Some(Command::Bench(a)) => bench::run(a),
         Some(Command::Warp(a)) => warp::run_cmd(a),

@@ -8,7 +8,14 @@ use penumbra::sampling::PatternKind;
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
 use penumbra::scene::view::ViewOptions;
-use std::path::PathBuf;
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use super::interrupt::Interrupt;
+use super::memory::{self, Need};
+use super::messages;
+use penumbra::image::io::{check_output_path, remove_stale_temps, write_image_with};
 
 /// Arguments of `penumbra render`.
 #[derive(clap::Args, Debug, Clone)]
@@ -71,16 +78,17 @@ pub struct Args {
     /// OBJ: treat the MTL ambient colour Ka as emitted radiance (Embree Cornell-box files).
     #[arg(long)]
     pub obj_ka_emission: bool,
-    /// OBJ/glTF camera eye X,Y,Z (overrides the file's camera / automatic framing).
+    /// Camera eye X,Y,Z (replaces the eye of the scene's camera or of automatic framing).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
     pub look_from: Option<glam::Vec3>,
-    /// OBJ/glTF camera target X,Y,Z.
+    /// Camera target X,Y,Z (default with --look-from: the scene's centre).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
     pub look_at: Option<glam::Vec3>,
-    /// OBJ/glTF camera up vector X,Y,Z (default 0,1,0).
+    /// Camera up vector X,Y,Z (default: the scene camera's, 0,1,0 for automatic framing).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
     pub up: Option<glam::Vec3>,
-    /// OBJ/glTF field of view in degrees along the shorter image axis (default 40).
+    /// Field of view in degrees along the shorter image axis (default: the scene camera's, 40
+    /// for automatic framing).
     #[arg(long)]
     pub fov: Option<f32>,
 }
@@ -148,15 +156,38 @@ pub fn load_options(a: &Args) -> LoadOptions {
     }
 }
 
-/// Run the command.
+/// Run the command: check the output and the memory, load, render, write, print the summary.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let start = Instant::now();
+    let interrupt = Interrupt::install()?;
     anyhow::ensure!(args.shadow_rays >= 1, "--shadow-rays must be at least 1");
     anyhow::ensure!(args.exposure.is_finite(), "--exposure must be finite");
-    let loaded = load(&args.scene, &load_options(&args))?;
+    anyhow::ensure!(args.spp != Some(0), "--spp must be at least 1");
+    anyhow::ensure!(args.threads != Some(0), "--threads must be at least 1");
+    // Everything that can be checked before the scene is loaded is checked now: a bad output
+    // path or too large a film must not cost a load and a render first.
+    if let Some(out) = &args.output {
+        prepare_output(out)?;
+    }
+    let threads = args.threads.unwrap_or_else(rayon::current_num_threads);
+    if let Some(res) = args.res {
+        memory::check(&Need::new(res, threads, 0), memory::available().as_ref())?;
+    }
+
+    let load_start = Instant::now();
+    let loaded = with_spinner(!args.quiet, &format!("loading {}", args.scene), || {
+        load(&args.scene, &load_options(&args))
+    })?;
+    let load_time = load_start.elapsed();
     for w in &loaded.warnings {
-        eprintln!("warning: {w}");
+        eprintln!("{}", messages::format_warning(w));
+    }
+    for n in &loaded.notes {
+        eprintln!("note: {n}");
     }
     let scene = loaded.scene;
+    // The loaders build the BVHs (scene and emitters) as their last step and time them.
+    let bvh_time = scene.geometry.build_time + scene.emitters.build_time;
     let res = args.res.unwrap_or(scene.film.resolution);
     let opts = RenderOptions {
         spp: args.spp.or(scene.film.spp).unwrap_or(64),
@@ -170,36 +201,110 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         mis_light: args.mis_light,
         progress: !args.quiet,
     };
-    anyhow::ensure!(opts.spp >= 1, "--spp must be at least 1");
-    let out = args
-        .output
-        .clone()
-        .or_else(|| scene.film.filename.as_ref().map(PathBuf::from))
-        .unwrap_or_else(|| PathBuf::from("penumbra.png"));
-    let (img, stats) = match args.threads {
-        Some(t) => {
-            anyhow::ensure!(t >= 1, "--threads must be at least 1");
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(t)
-                .build()
-                .context("creating the thread pool")?
-                .install(|| render(&scene, res, &opts))?
+    anyhow::ensure!(
+        opts.spp >= 1,
+        "the scene's pixel samples must be at least 1"
+    );
+    let out = match &args.output {
+        Some(out) => out.clone(),
+        None => {
+            let out = scene
+                .film
+                .filename
+                .as_ref()
+                .map_or_else(|| PathBuf::from("penumbra.png"), PathBuf::from);
+            prepare_output(&out).map_err(|e| {
+                anyhow::anyhow!(
+                    "{} (the scene names this output; -o chooses another)",
+                    messages::format_error(&e)
+                )
+            })?;
+            out
         }
+    };
+    let need = Need::new(res, threads, scene.lights.len());
+    memory::check(&need, memory::available().as_ref())?;
+
+    let render_start = Instant::now();
+    let (img, stats) = match args.threads {
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .context("creating the thread pool")?
+            .install(|| render(&scene, res, &opts))?,
         None => render(&scene, res, &opts)?,
     };
-    penumbra::image::io::write_image(&img, &out, args.exposure)
-        .with_context(|| format!("writing {}", out.display()))?;
-    println!(
-        "{}x{}  {} spp x {} shadow rays  {}  {:.3} s  {:.2} M rays  {:.1} Mrays/s  -> {}",
+    let render_time = render_start.elapsed();
+    // pbrt-v4's film response (ISO, exposure, white balance); the identity leaves it untouched.
+    let mut img = img;
+    scene.film.sensor.apply(&mut img);
+
+    let write_start = Instant::now();
+    interrupt.writing(test_write_pause(), |ctl| {
+        write_image_with(&img, &out, args.exposure, ctl)
+    })?;
+    let write_time = write_start.elapsed();
+
+    let memory = memory::peak_resident()
+        .map(|peak| format!("  peak memory {}", memory::human(peak)))
+        .unwrap_or_default();
+    let secs = |d: Duration| d.as_secs_f64();
+    let line = format!(
+        "{}x{}  {} spp x {} shadow rays  {}  load {:.3} s  bvh {:.3} s  render {:.3} s  \
+         write {:.3} s  total {:.3} s  {:.2} M rays  {:.1} Mrays/s{memory}  -> {}",
         res.x,
         res.y,
         opts.spp,
         opts.shadow_rays,
         opts.strategy,
-        stats.time.as_secs_f64(),
+        secs(load_time.saturating_sub(bvh_time)),
+        secs(bvh_time),
+        secs(render_time),
+        secs(write_time),
+        secs(start.elapsed()),
         stats.rays as f64 / 1e6,
-        stats.mrays_per_s(),
+        stats.rays as f64 / secs(render_time).max(1e-9) / 1e6,
         out.display()
     );
+    writeln!(std::io::stdout(), "{line}").context("writing to standard output")?;
     Ok(())
+}
+
+/// Check that `out` can be written and remove the temp files killed runs left beside it.
+fn prepare_output(out: &Path) -> anyhow::Result<()> {
+    check_output_path(out)?;
+    for stale in remove_stale_temps(out) {
+        eprintln!(
+            "removed {}, left by an interrupted earlier run",
+            stale.display()
+        );
+    }
+    Ok(())
+}
+
+/// Test hook: `PENUMBRA_TEST_WRITE_PAUSE_MS` pauses the image write after every 1 MiB so the
+/// tests can interrupt a write in progress.
+fn test_write_pause() -> Duration {
+    std::env::var("PENUMBRA_TEST_WRITE_PAUSE_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(Duration::ZERO, Duration::from_millis)
+}
+
+/// Run `f` under a spinner with the elapsed time on stderr (when it is a terminal): loading a
+/// large scene takes seconds, and a silent terminal looks like a hang.
+fn with_spinner<T>(show: bool, msg: &str, f: impl FnOnce() -> T) -> T {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    if !show || !std::io::stderr().is_terminal() {
+        return f();
+    }
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} {elapsed}") {
+        bar.set_style(style);
+    }
+    bar.set_message(msg.to_string());
+    bar.enable_steady_tick(Duration::from_millis(100));
+    let r = f();
+    bar.finish_and_clear();
+    r
 }

@@ -124,6 +124,7 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         res: args.res,
     };
     let r = run(&warp, &cfg);
+    r.check_enough_samples()?;
     let c = &r.chi2;
     println!("routine     {}", warp.label);
     println!(

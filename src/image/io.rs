@@ -7,7 +7,8 @@
 
 use std::io::{Cursor, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Duration;
 
 use anyhow::{Context, bail};
 
@@ -70,36 +71,191 @@ pub fn to_rgb8(img: &Image, exposure_stops: f32) -> image::RgbImage {
     out
 }
 
+/// Prefix of the temporary siblings of `path`: `.NAME.tmp-`, followed by `PID-N`.
+fn temp_prefix(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "image".into());
+    format!(".{name}.tmp-")
+}
+
+/// The folder `path` is written into ("." for a bare file name).
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    }
+}
+
 /// Hidden temporary sibling of `path`; pid + a process-wide counter keep concurrent writers
 /// (other processes, or other threads of this one) from sharing a temp file.
 fn temp_path(path: &Path) -> PathBuf {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let name = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "image".into());
-    let tmp = format!(".{name}.tmp-{}-{n}", std::process::id());
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir.join(tmp),
-        _ => PathBuf::from(tmp),
+    let tmp = format!("{}{}-{n}", temp_prefix(path), std::process::id());
+    parent_dir(path).join(tmp)
+}
+
+/// Whether process `pid` may still be running. Without a `/proc` to ask, every process is
+/// assumed alive, so that no temp file of a concurrent writer is ever removed.
+fn process_may_be_alive(pid: u32) -> bool {
+    let proc = Path::new("/proc");
+    !proc.join("self").exists() || proc.join(pid.to_string()).exists()
+}
+
+/// Remove the temporary files that earlier, killed runs left beside `path` (`.NAME.tmp-PID-N`
+/// whose process is gone). Those of running processes, this one included, are kept. Returns
+/// the files removed; a folder that cannot be listed removes nothing.
+pub fn remove_stale_temps(path: &Path) -> Vec<PathBuf> {
+    let prefix = temp_prefix(path);
+    let Ok(entries) = std::fs::read_dir(parent_dir(path)) else {
+        return Vec::new();
+    };
+    let mut removed = Vec::new();
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(rest) = name.to_str().and_then(|n| n.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let Some(pid) = rest
+            .split_once('-')
+            .and_then(|(p, _)| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid == std::process::id() || process_may_be_alive(pid) {
+            continue;
+        }
+        let is_file = entry.file_type().is_ok_and(|t| t.is_file());
+        if is_file && std::fs::remove_file(entry.path()).is_ok() {
+            removed.push(entry.path());
+        }
+    }
+    removed
+}
+
+/// Check, before any work is spent on it, that [`write_image`] can write `path`: a supported
+/// extension, not a folder, in an existing folder where files can be created (probed by
+/// creating and removing a temp file there).
+pub fn check_output_path(path: &Path) -> anyhow::Result<()> {
+    if path.is_dir() {
+        bail!("cannot write {}: it is a folder", path.display());
+    }
+    let ext = extension(path);
+    if !WRITE_EXTENSIONS.contains(&ext.as_str()) {
+        let what = if ext.is_empty() {
+            "it has no extension".to_string()
+        } else {
+            format!("unsupported extension .{ext}")
+        };
+        bail!(
+            "cannot write {}: {what} (supported: {})",
+            path.display(),
+            WRITE_EXTENSIONS
+                .iter()
+                .map(|e| format!(".{e}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    let dir = parent_dir(path);
+    if !dir.exists() {
+        bail!(
+            "cannot write {}: folder {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    if !dir.is_dir() {
+        bail!(
+            "cannot write {}: {} is not a folder",
+            path.display(),
+            dir.display()
+        );
+    }
+    let probe = temp_path(path);
+    match std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+    {
+        Ok(f) => {
+            drop(f);
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => bail!(
+            "cannot write {}: cannot create files in {}: {e}",
+            path.display(),
+            dir.display()
+        ),
     }
 }
+
+/// How a write may be interrupted.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WriteControl<'a> {
+    /// Once set (by a signal handler, say), the write stops at the next chunk: the temp file is
+    /// removed, the destination left as it was, and [`WriteCancelled`] returned.
+    pub cancel: Option<&'a AtomicBool>,
+    /// Pause after each chunk: a test hook that makes a write last long enough to interrupt.
+    pub chunk_pause: Duration,
+}
+
+/// A write abandoned because [`WriteControl::cancel`] was set.
+#[derive(Debug, thiserror::Error)]
+#[error("writing {} was interrupted; the file is unchanged", path.display())]
+pub struct WriteCancelled {
+    /// The destination that was not written.
+    pub path: PathBuf,
+}
+
+/// Bytes written between two looks at [`WriteControl::cancel`].
+const WRITE_CHUNK: usize = 1 << 20;
 
 /// Write `bytes` to `path` atomically (temp file in the same directory, then rename).
 /// On error the temp file is removed and an existing `path` is left untouched.
 pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    write_bytes_atomic_with(path, bytes, &WriteControl::default())
+}
+
+/// [`write_bytes_atomic`] that gives up, cleanly, when `ctl.cancel` is set.
+pub fn write_bytes_atomic_with(
+    path: &Path,
+    bytes: &[u8],
+    ctl: &WriteControl,
+) -> anyhow::Result<()> {
+    let cancelled = || ctl.cancel.is_some_and(|c| c.load(Ordering::SeqCst));
     let tmp = temp_path(path);
-    let result = (|| -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
+    let result = (|| -> anyhow::Result<()> {
+        let mut f = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)?;
+        for chunk in bytes.chunks(WRITE_CHUNK) {
+            if cancelled() {
+                bail!(WriteCancelled { path: path.into() });
+            }
+            f.write_all(chunk)?;
+            if !ctl.chunk_pause.is_zero() {
+                std::thread::sleep(ctl.chunk_pause);
+            }
+        }
         f.sync_all()?;
         drop(f);
-        std::fs::rename(&tmp, path)
+        if cancelled() {
+            bail!(WriteCancelled { path: path.into() });
+        }
+        std::fs::rename(&tmp, path)?;
+        Ok(())
     })();
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
-        return Err(e).with_context(|| format!("writing {}", path.display()));
+        if e.is::<WriteCancelled>() {
+            return Err(e);
+        }
+        return Err(e.context(format!("cannot write {}", path.display())));
     }
     Ok(())
 }
@@ -122,14 +278,19 @@ pub fn save_png_atomic(img: &image::RgbImage, path: &Path) -> anyhow::Result<()>
 /// the exposure is ignored by the linear formats). NaN/Inf pixels are written as black, with
 /// one warning on stderr giving their count. The write is atomic (see the module docs).
 pub fn write_image(img: &Image, path: &Path, exposure_stops: f32) -> anyhow::Result<()> {
+    write_image_with(img, path, exposure_stops, &WriteControl::default())
+}
+
+/// [`write_image`] that gives up, cleanly, when `ctl.cancel` is set.
+pub fn write_image_with(
+    img: &Image,
+    path: &Path,
+    exposure_stops: f32,
+    ctl: &WriteControl,
+) -> anyhow::Result<()> {
     let ext = extension(path);
     if !WRITE_EXTENSIONS.contains(&ext.as_str()) {
-        bail!(
-            "cannot write {}: unsupported extension {:?} (supported: {})",
-            path.display(),
-            ext,
-            WRITE_EXTENSIONS.join(", ")
-        );
+        check_output_path(path)?;
     }
     let expected = img.width as usize * img.height as usize;
     if img.pixels.len() != expected {
@@ -166,7 +327,7 @@ pub fn write_image(img: &Image, path: &Path, exposure_stops: f32) -> anyhow::Res
         _ => encode_png(&to_rgb8(img, exposure_stops)),
     }
     .with_context(|| format!("encoding {}", path.display()))?;
-    write_bytes_atomic(path, &bytes)
+    write_bytes_atomic_with(path, &bytes, ctl)
 }
 
 /// OpenEXR, three f32 channels, default (lossless) compression.
@@ -205,21 +366,38 @@ fn encode_pfm(img: &Image) -> Vec<u8> {
 /// and `.hdr` are linear already; `.png`, `.tga`, `.jpg` are sRGB-decoded to linear.
 pub fn read_image(path: &Path) -> anyhow::Result<Image> {
     let ext = extension(path);
+    if !READ_EXTENSIONS.contains(&ext.as_str()) {
+        bail!(
+            "cannot read {}: unsupported extension {:?} (supported: {})",
+            path.display(),
+            ext,
+            READ_EXTENSIONS.join(", ")
+        );
+    }
+    if let Some(why) = not_a_file(path) {
+        bail!("cannot read {}: {why}", path.display());
+    }
     let result = match ext.as_str() {
         "exr" => read_exr(path),
         "pfm" => std::fs::read(path)
             .map_err(anyhow::Error::from)
             .and_then(|b| decode_pfm(&b)),
         "hdr" => read_with_image_crate(path, false),
-        "png" | "tga" | "jpg" | "jpeg" => read_with_image_crate(path, true),
-        _ => bail!(
-            "cannot read {}: unsupported extension {:?} (supported: {})",
-            path.display(),
-            ext,
-            READ_EXTENSIONS.join(", ")
-        ),
+        _ => read_with_image_crate(path, true),
     };
     result.with_context(|| format!("reading {}", path.display()))
+}
+
+/// Why `path` cannot be opened as a file ("file not found", "a folder, not a file"), or
+/// `None` when it is a file: loaders say this instead of the bare OS error.
+pub fn not_a_file(path: &Path) -> Option<&'static str> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Some("a folder, not a file"),
+        Ok(_) => None,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Some("file not found"),
+        // Permission and other errors are left to the reader, which reports them.
+        Err(_) => None,
+    }
 }
 
 /// Decode via the `image` crate; `srgb` selects whether code values are sRGB-linearised.
@@ -241,9 +419,24 @@ fn read_with_image_crate(path: &Path, srgb: bool) -> anyhow::Result<Image> {
     })
 }
 
+/// Largest image the readers accept (16384², 3 GB as linear RGB).
+pub const MAX_READ_PIXELS: usize = 1 << 28;
+
 /// First RGB(A) layer of an EXR; falls back to a luminance-only ("Y") layer as grey.
 fn read_exr(path: &Path) -> anyhow::Result<Image> {
     use exr::prelude::{RgbaChannels, Vec2, read_first_rgba_layer_from_file};
+    // The header's size is allocated before any pixel is decoded: a corrupt or hostile header
+    // must be an error, not an allocation abort (found by fuzz/, target `image`).
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| anyhow::anyhow!("{e}"))?;
+    for h in &meta.headers {
+        let (w, h) = (h.layer_size.width(), h.layer_size.height());
+        if w.saturating_mul(h) > MAX_READ_PIXELS {
+            bail!(
+                "the header claims {w}x{h} pixels, more than the {MAX_READ_PIXELS} penumbra reads"
+            );
+        }
+    }
     let rgba = read_first_rgba_layer_from_file(
         path,
         |res: Vec2<usize>, _: &RgbaChannels| {
@@ -263,7 +456,8 @@ fn read_exr(path: &Path) -> anyhow::Result<Image> {
                 pixels,
             })
         }
-        Err(rgba_err) => read_exr_grey(path).map_err(|_| anyhow::Error::from(rgba_err)),
+        // exr's errors print their io cause in their own message: keep that one only.
+        Err(rgba_err) => read_exr_grey(path).map_err(|_| anyhow::anyhow!("{rgba_err}")),
     }
 }
 
@@ -288,6 +482,19 @@ fn read_exr_grey(path: &Path) -> anyhow::Result<Image> {
     })
 }
 
+/// A file's first token for an error message: quoted when it is short printable text, else
+/// described, so that binary garbage never reaches the terminal.
+fn describe_magic(token: &str) -> String {
+    let printable = token.chars().all(|c| c.is_ascii_graphic());
+    if printable && token.len() <= 16 {
+        format!("{token:?}")
+    } else if printable {
+        format!("{:?}...", &token[..16])
+    } else {
+        "binary data".to_string()
+    }
+}
+
 /// Decode a PFM file held in memory. The header is three whitespace-separated tokens after the
 /// magic; a single whitespace byte separates it from the raster, as the format requires.
 pub fn decode_pfm(bytes: &[u8]) -> anyhow::Result<Image> {
@@ -309,7 +516,10 @@ pub fn decode_pfm(bytes: &[u8]) -> anyhow::Result<Image> {
     let channels = match magic.as_str() {
         "PF" => 3,
         "Pf" => 1,
-        other => bail!("not a PFM file (magic {other:?}, expected \"PF\" or \"Pf\")"),
+        other => bail!(
+            "not a PFM file (it starts with {}, expected \"PF\" or \"Pf\")",
+            describe_magic(other)
+        ),
     };
     let width: u32 = token()?.parse().context("bad PFM width")?;
     let height: u32 = token()?.parse().context("bad PFM height")?;
@@ -319,8 +529,10 @@ pub fn decode_pfm(bytes: &[u8]) -> anyhow::Result<Image> {
     }
     let little = scale < 0.0;
     pos += 1; // the single whitespace byte ending the header
-    let n = width as usize * height as usize * channels;
-    let need = n.checked_mul(4).context("PFM size overflows")?;
+    let need = (width as usize)
+        .checked_mul(height as usize)
+        .and_then(|n| n.checked_mul(channels * 4))
+        .context("PFM size overflows")?;
     let data = bytes.get(pos..).unwrap_or(&[]);
     if data.len() < need {
         bail!(

@@ -98,3 +98,65 @@ pub fn error_image(test: &Image, reference: &Image) -> anyhow::Result<Image> {
         pixels,
     })
 }
+
+/// How an image file stores its values, as far as a comparison cares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Encoding {
+    /// Linear floating point (EXR, PFM, Radiance HDR): values above 1 survive.
+    LinearFloat,
+    /// 8-bit sRGB display values (PNG, TGA, JPEG): clamped to [0, 1] and quantised.
+    Display8,
+}
+
+impl Encoding {
+    /// The encoding a file of this name has, by extension; `None` when unknown.
+    pub fn of(path: &std::path::Path) -> Option<Encoding> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "exr" | "pfm" | "hdr" => Some(Encoding::LinearFloat),
+            "png" | "tga" | "jpg" | "jpeg" => Some(Encoding::Display8),
+            _ => None,
+        }
+    }
+}
+
+/// What makes a comparison's numbers meaningless (an error) or misleading (warnings): an image
+/// without pixels is an error; NaN/Inf pixels and an 8-bit display image compared with a
+/// linear float one are warnings, each naming the file.
+pub fn comparison_warnings(
+    test: (&Image, &std::path::Path),
+    reference: (&Image, &std::path::Path),
+) -> anyhow::Result<Vec<String>> {
+    let mut warnings = Vec::new();
+    for (img, path) in [test, reference] {
+        if img.pixels.is_empty() {
+            bail!(
+                "{} is {}x{}: it has no pixels to compare",
+                path.display(),
+                img.width,
+                img.height
+            );
+        }
+        let bad = img.count_non_finite();
+        if bad > 0 {
+            // The metrics will be NaN/Inf; say why rather than leave the user guessing.
+            warnings.push(format!("{}: {bad} pixel(s) with NaN/Inf", path.display()));
+        }
+    }
+    if let (Some(a), Some(b)) = (Encoding::of(test.1), Encoding::of(reference.1))
+        && a != b
+    {
+        let (display, linear) = if a == Encoding::Display8 {
+            (test.1, reference.1)
+        } else {
+            (reference.1, test.1)
+        };
+        warnings.push(format!(
+            "{} holds 8-bit sRGB display values (clamped to [0, 1], quantised) and {} linear \
+             floats: the errors include that clamping and quantisation, not only the render's",
+            display.display(),
+            linear.display()
+        ));
+    }
+    Ok(warnings)
+}

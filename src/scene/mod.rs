@@ -5,10 +5,16 @@
 
 pub mod builder;
 pub mod builtin;
+pub mod film;
 pub mod gltf;
+pub mod gltf_check;
+pub mod guard;
 pub mod load;
+pub mod mesh_repair;
 pub mod obj;
+pub mod obj_text;
 pub mod pbrt;
+pub mod polygon;
 pub mod view;
 
 pub use builder::SceneBuilder;
@@ -45,6 +51,8 @@ pub struct FilmSpec {
     pub filename: Option<String>,
     /// Default eye rays per pixel, if the scene names one.
     pub spp: Option<u32>,
+    /// Sensor response applied to the finished image (pbrt-v4 `iso`, exposure, white balance).
+    pub sensor: film::SensorResponse,
 }
 
 /// Emission attached to a shape (pbrt `AreaLightSource "diffuse"`).

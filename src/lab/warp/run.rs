@@ -71,6 +71,30 @@ pub struct RunResult {
     pub independent: bool,
 }
 
+impl RunResult {
+    /// Fail when there were too few samples for the test to say anything: once the sparse
+    /// cells are pooled, fewer than two categories are left, no degrees of freedom, and a
+    /// "pass" would test nothing. (A rejection with 0 dof, e.g. samples outside the support,
+    /// stays a rejection.) The suggestion fills every cell with the harness's minimum.
+    pub fn check_enough_samples(&self) -> anyhow::Result<()> {
+        let c = &self.chi2;
+        if c.dof == 0 && c.passed {
+            let cells = c.res.0 * c.res.1;
+            let min = Chi2Config::default().min_expected;
+            anyhow::bail!(
+                "too few samples for a chi-square test: {} attempts over {}x{} cells leave 0 \
+                 degrees of freedom once cells expecting fewer than {min} samples are pooled; \
+                 use --count {} or more (or a coarser --res)",
+                self.attempts,
+                c.res.0,
+                c.res.1,
+                (cells as f64 * min).ceil() as usize
+            );
+        }
+        Ok(())
+    }
+}
+
 /// Draw `cfg.count` samples of `warp` and run the chi-square test on them.
 ///
 /// Without a pattern the sampler is driven by the harness itself (`chi2_directions` /

@@ -258,10 +258,10 @@ impl TextureTable {
                     )
                 })?;
                 let path = resolve(dir, &file);
-                if !path.is_file() {
+                if let Some(why) = crate::image::io::not_a_file(&path) {
                     return Err(err_at(
                         params.loc_of("filename").as_ref().unwrap_or(loc),
-                        format!("imagemap texture: file not found: {}", path.display()),
+                        format!("imagemap texture: {why}: {}", path.display()),
                     ));
                 }
                 let floc = params.loc_of("filename").unwrap_or(loc.clone());

@@ -1,0 +1,4 @@
+//! cargo-fuzz target: see penumbra_fuzz::harness::pbrt.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| penumbra_fuzz::harness::pbrt(data));
