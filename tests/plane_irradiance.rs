@@ -19,7 +19,7 @@ use penumbra::geometry::interaction::NO_LIGHT;
 use penumbra::geometry::{Backend, PACKET, PrimKind, Ray, RayQuery, SurfaceHit, Transform};
 use penumbra::integrator::direct::{CameraPacket, DirectLighting, PacketScratch};
 use penumbra::integrator::{MisHeuristic, Strategy};
-use penumbra::light_selection::make_selector;
+use penumbra::light_selection::{SelectorKind, make_selector};
 use penumbra::lights::{
     DistantLight, Light, PointLight, SamplingMode, SpotLight, UniformInfiniteLight,
 };
@@ -608,7 +608,7 @@ const ROUNDS: u32 = 72;
 /// Measured samples of one case and configuration: (estimate, exact) pairs.
 fn measure(b: &Built, c: &Case, cfg: &Config, seed: u64) -> Vec<(f64, f64)> {
     let scene = &b.scene;
-    let selector = make_selector("uniform", scene, seed).unwrap();
+    let selector = make_selector(SelectorKind::Uniform, scene, seed);
     let pattern = make_pattern(PatternKind::Random, seed);
     let est = DirectLighting {
         scene,
