@@ -621,3 +621,51 @@ fn every_light_sample_on_the_boundary_is_finite_and_matches_its_pdf() {
     eprintln!("{tested} boundary light samples");
     f.assert_none("light samplers");
 }
+
+/// The endpoint fix is a clamp and nothing more: ξ₁ = 0 samples what ξ₁ = 2⁻²⁴ samples (the
+/// next point of the 24-bit grid, inside the same stratum), and every other input maps exactly
+/// as the plain formula (cos θ = ξ₁, √ξ₁, ξ₁^(1/(n+1)); the tent's inverse cdf), so images
+/// drawn from ξ ≥ 2⁻²⁴ stay bit-identical to the unclamped maps.
+#[test]
+fn the_warps_only_clamp_their_zero_endpoint() {
+    let grid = 1.0 / 16_777_216.0;
+    assert_eq!(open_unit(0.0), grid);
+    assert_eq!(open_unit(grid * 0.25), grid);
+    for &x in &[grid, 2.0 * grid, 0.125, 0.5, TOP] {
+        assert_eq!(open_unit(x), x);
+    }
+    for &v in &EDGE {
+        let (zero, first) = (Vec2::new(0.0, v), Vec2::new(grid, v));
+        assert_eq!(uniform_hemisphere(zero), uniform_hemisphere(first), "v {v}");
+        assert_eq!(cosine_hemisphere(zero), cosine_hemisphere(first), "v {v}");
+        for n in [0.0, 1.0, 100.0, 1e4] {
+            let (a, b) = (
+                cosine_power_hemisphere(zero, n),
+                cosine_power_hemisphere(first, n),
+            );
+            assert_eq!(a, b, "n {n}, v {v}");
+        }
+        // The plain maps' cos θ for every other input.
+        for &x in &EDGE[1..] {
+            let u = Vec2::new(x, v);
+            assert_eq!(uniform_hemisphere(u).z, x, "u {u}");
+            assert_eq!(cosine_hemisphere(u).z, x.sqrt(), "u {u}");
+        }
+    }
+    for r in [0.5, 1.0, 2.0] {
+        assert_eq!(tent(0.0, r), tent(grid / 2.0, r), "r {r}");
+        assert!(
+            tent(0.0, r) > -r && tent_pdf(tent(0.0, r), r) > 0.0,
+            "r {r}"
+        );
+        for &u in &EDGE[1..] {
+            // The plain inverse cdf of each half.
+            let plain = if u < 0.5 {
+                -(r * (1.0 - (2.0 * u).sqrt()))
+            } else {
+                r * (1.0 - (1.0 - (2.0 * u - 1.0)).sqrt())
+            };
+            assert_eq!(tent(u, r), plain, "u {u}, r {r}");
+        }
+    }
+}

@@ -241,19 +241,18 @@ fn azimuth(d: Vec3) -> f32 {
 /// grid k·2⁻²⁴, k < 2²⁴.
 pub const XI_MIN: f32 = 1.0 / (1u32 << 24) as f32;
 
-/// ξ ∈ [0, 1) moved into (0, 1] for the warps that map ξ = 0 to the edge of their support —
-/// the horizon (cos θ = 0), the rim of the tent — where the pdf is 0: ξ = 0 becomes 1 (the
-/// pole, the centre), so that the 24-bit grid {0, 2⁻²⁴, …, 1 − 2⁻²⁴} becomes
-/// {2⁻²⁴, …, 1}, exactly as uniform; the finer values some patterns give below 2⁻²⁴ are raised
-/// to it (mass < 2⁻²⁴, kept in its stratum). Every other input is returned as is, so the
-/// samples of every ξ ≥ 2⁻²⁴ are bit-identical to the plain map's.
+/// ξ ∈ [0, 1) clamped to [2⁻²⁴, 1) for the warps that map ξ = 0 to the edge of their
+/// support — the horizon (cos θ = 0), the rim of the tent — where the pdf is 0: ξ = 0 (and the
+/// finer values some patterns give below 2⁻²⁴) becomes 2⁻²⁴, the next point of the 24-bit
+/// grid, in the same stratum (a bias below 2⁻²⁴ of the mass). Every other input is returned as
+/// is, so the samples of every ξ ≥ 2⁻²⁴ are bit-identical to the plain map's.
 #[inline(always)]
 pub fn open_unit(xi: f32) -> f32 {
-    if xi > 0.0 { xi.max(XI_MIN) } else { 1.0 }
+    xi.max(XI_MIN)
 }
 
 /// Uniform hemisphere: cos θ = ξ₁, φ = 2πξ₂ (marginal of θ is sin θ, conditional of φ uniform),
-/// with ξ₁ in (0, 1] ([`open_unit`]), so no sample lies on the horizon.
+/// with ξ₁ ≥ 2⁻²⁴ ([`open_unit`]), so no sample lies on the horizon.
 #[inline]
 pub fn uniform_hemisphere(u: Vec2) -> Vec3 {
     spherical_direction_turn(open_unit(u.x), u.y)
@@ -271,8 +270,8 @@ pub fn uniform_hemisphere_inverse(d: Vec3) -> Vec2 {
     Vec2::new(d.z, azimuth(d) / TAU)
 }
 
-/// Cosine-weighted hemisphere: cos θ = √ξ₁, φ = 2πξ₂ (Malley's method by inversion), with ξ₁
-/// in (0, 1] ([`open_unit`]), so cos θ ≥ 2⁻¹²: no sample lies on the horizon, where the pdf
+/// Cosine-weighted hemisphere: cos θ = √ξ₁, φ = 2πξ₂ (Malley's method by inversion), with
+/// ξ₁ ≥ 2⁻²⁴ ([`open_unit`]), so cos θ ≥ 2⁻¹²: no sample lies on the horizon, where the pdf
 /// is 0.
 #[inline]
 pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
@@ -294,7 +293,7 @@ pub fn cosine_hemisphere_inverse(d: Vec3) -> Vec2 {
 /// Cosine-power (Phong lobe) hemisphere, pdf ∝ cosⁿθ: the marginal cdf of θ is
 /// 1 − cos^(n+1)θ, so cos θ = ξ₁^(1/(n+1)); φ = 2πξ₂.
 ///
-/// ξ₁ in (0, 1] ([`open_unit`]) keeps ln ξ₁ ≥ −16.7, so cos θ ≥ 2^(−24/(n+1)) > 0. With
+/// ξ₁ ≥ 2⁻²⁴ ([`open_unit`]) keeps ln ξ₁ ≥ −16.7, so cos θ ≥ 2^(−24/(n+1)) > 0. With
 /// ξ₁ = 0 itself, ln 0 = −∞ gave a direction exactly on the horizon with pdf 0 (issue 16:
 /// `penumbra warp cosine-power -p n=100` with seed 5 and 10⁶ samples rejected its own
 /// chi-square test).
@@ -524,8 +523,8 @@ pub fn balance_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
 }
 
 /// 1D tent (triangle filter) of radius r centred at 0, by inverting its cdf on each half:
-/// pdf(x) = (r − |x|)/r². The left half's w = 2u is moved into (0, 1] ([`open_unit`]), so
-/// u = 0 lands at the centre instead of on the rim −r, where the pdf is 0 (the right half
+/// pdf(x) = (r − |x|)/r². The left half's w = 2u is clamped to ≥ 2⁻²⁴ ([`open_unit`]), so
+/// u = 0 lands at −r(1 − 2⁻¹²) instead of on the rim −r, where the pdf is 0 (the right half
 /// never reaches r).
 #[inline]
 pub fn tent(u: f32, r: f32) -> f32 {
