@@ -187,6 +187,27 @@ fn sample_by_hemisphere(
     })
 }
 
+/// The sample at `wi` of a reflection lobe drawn by the BSDF's own importance sampler: `None`
+/// below the horizon (a glossy lobe around the mirror direction pokes under it, and such
+/// directions carry zero weight) or where the pdf is 0 or not finite; else f and pdf at `wi`.
+/// The common tail of the samplers of phong, conductor and coated diffuse.
+#[inline]
+fn reflection_sample(bsdf: &impl Bxdf, wo: Vec3, wi: Vec3) -> Option<BsdfSample> {
+    if wi.z <= 0.0 {
+        return None;
+    }
+    let pdf = bsdf.pdf(wo, wi);
+    if pdf <= 0.0 || !pdf.is_finite() {
+        return None;
+    }
+    Some(BsdfSample {
+        wi,
+        f: bsdf.f(wo, wi),
+        pdf,
+        delta: false,
+    })
+}
+
 /// Closed set of BSDFs (enum dispatch keeps the per-sample path free of virtual calls).
 #[derive(Clone, Debug)]
 pub enum Bsdf {
@@ -225,13 +246,6 @@ macro_rules! dispatch {
 }
 
 impl Bsdf {
-    /// `(f(wo, wi), pdf(wo, wi))` in one dispatch: MIS light sampling needs both for the same
-    /// pair, and one call instead of two saves a call and a match per light sample.
-    #[inline]
-    pub fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        dispatch!(self, b => (b.f(wo, wi), b.pdf(wo, wi)))
-    }
-
     /// Choose how every non-delta lobe is sampled (the lab's I₁/I₂ comparison); delta BSDFs
     /// ignore it because a delta lobe can only be sampled one way.
     pub fn set_sampling(&mut self, s: LobeSampling) {
