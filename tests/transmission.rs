@@ -15,7 +15,7 @@ use penumbra::Rgb;
 use penumbra::bsdf::{Bxdf, Dielectric};
 use penumbra::camera::Camera;
 use penumbra::geometry::{Ray, Transform};
-use penumbra::integrator::direct::DirectLighting;
+use penumbra::integrator::stages::Integrator;
 use penumbra::integrator::{MisHeuristic, Strategy};
 use penumbra::light_selection::{SelectorKind, make_selector};
 use penumbra::lights::{Light, UniformInfiniteLight};
@@ -90,7 +90,7 @@ fn estimate(
     let selector = make_selector(selector, scene, 7);
     let pattern = make_pattern(PatternKind::Stratified, 7);
     let spp = 16;
-    let est = DirectLighting {
+    let est = Integrator {
         scene,
         selector: selector.as_ref(),
         pattern: pattern.as_ref(),

@@ -245,7 +245,31 @@ macro_rules! dispatch {
     };
 }
 
+/// A BSDF as the integrator's vector kernels (`integrator/lanes.rs`) take it: which kernel
+/// evaluates and samples it exactly as its own [`Bxdf`] methods do, with the data it reads.
+#[derive(Clone, Copy, Debug)]
+pub enum LaneBsdf {
+    /// Lambertian with cosine-weighted sampling (importance and cosine coincide): its albedo.
+    Lambert(Rgb),
+}
+
 impl Bsdf {
+    /// The vector kernel for this BSDF, if one exists (`None`: one sample at a time).
+    #[inline(always)]
+    pub fn lane_kind(&self) -> Option<LaneBsdf> {
+        match self {
+            Bsdf::Lambert(b) if b.sampling != LobeSampling::Uniform => Some(LaneBsdf::Lambert(b.r)),
+            _ => None,
+        }
+    }
+
+    /// `(f(wo, wi), pdf(wo, wi))` in one dispatch: MIS light sampling needs both for the same
+    /// pair, and one call instead of two saves a call and a match per light sample.
+    #[inline]
+    pub fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        dispatch!(self, b => (b.f(wo, wi), b.pdf(wo, wi)))
+    }
+
     /// Choose how every non-delta lobe is sampled (the lab's I₁/I₂ comparison); delta BSDFs
     /// ignore it because a delta lobe can only be sampled one way.
     pub fn set_sampling(&mut self, s: LobeSampling) {
@@ -274,11 +298,10 @@ impl Bxdf for Bsdf {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         dispatch!(self, b => b.pdf(wo, wi))
     }
-    /// One dispatch for both: one call instead of two saves a call and a match per light
-    /// sample.
+    /// [`Bsdf::f_pdf`]: one dispatch for both.
     #[inline]
     fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        dispatch!(self, b => (b.f(wo, wi), b.pdf(wo, wi)))
+        Bsdf::f_pdf(self, wo, wi)
     }
     #[inline]
     fn is_delta(&self) -> bool {
