@@ -57,7 +57,7 @@ pub fn render(
     );
     anyhow::ensure!(opts.spp > 0, "--spp must be at least 1");
     let samples = opts.samples()?;
-    let selector = make_selector(&opts.light_selection, scene, opts.seed)?;
+    let selector = make_selector(opts.light_selection, scene, opts.seed);
     let pattern = make_pattern(opts.pattern, opts.seed);
     let est = Integrator {
         scene,

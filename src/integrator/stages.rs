@@ -31,7 +31,9 @@ use crate::bsdf::{Bsdf, Bxdf, LaneBsdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::packet::bits;
 use crate::geometry::{PACKET, Ray, RayPacket, SurfaceHit};
-use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
+use crate::light_selection::{
+    LightSelector, SelectedLight, SelectorKind, ShadingPoint, UniformSelector,
+};
 use crate::lights::{Emitter, LaneLight, LightSampleContext, LightSource, SamplingMode};
 use crate::sampling::{Frame, PixelSamples, SamplePattern};
 use crate::scene::Scene;
@@ -325,7 +327,10 @@ impl<'a> Integrator<'a> {
         let scene = self.scene;
         q.tri_lanes.active = 0;
         q.lone_light = 0;
-        let uniform = self.selector.uniform_count();
+        // Uniform picks ignore the shading point: pick inline, without a ShadingPoint or a
+        // virtual call per sample.
+        let uniform =
+            (self.selector.kind() == SelectorKind::Uniform).then_some(scene.lights.len() as u32);
         for k in bits(q.shaded) {
             let u = q.drawn.light_select[k];
             let sel = match uniform {

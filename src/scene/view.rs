@@ -16,7 +16,7 @@
 
 use crate::camera::Camera;
 use crate::geometry::interaction::NO_LIGHT;
-use crate::geometry::{PrimKind, Primitive, Ray, RayQuery, Transform};
+use crate::geometry::{PrimKind, Primitive, RayQuery, Transform};
 use crate::lights::{Emitter, LightSampleContext, LightSource, SamplingMode};
 use crate::scene::{FilmSpec, Filter, Scene};
 use anyhow::ensure;
@@ -202,13 +202,7 @@ pub fn lit_rays(scene: &Scene, cam: &Camera) -> usize {
                     if !(s.pdf > 0.0 && s.li.max_element() > 0.0) || s.wi.dot(ctx.n) <= 0.0 {
                         return false;
                     }
-                    let o = hit.spawn_origin(s.wi);
-                    let shadow = Ray {
-                        o,
-                        d: s.p_light - o,
-                        t_max: 1.0 - 1e-4,
-                    };
-                    !scene.geometry.occluded(&shadow)
+                    !scene.geometry.occluded(&hit.spawn_ray_to(s.p_light))
                 })
             });
             lit += usize::from(reached);
