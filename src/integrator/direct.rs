@@ -29,6 +29,10 @@ pub const DIM_LIGHT: u32 = 2;
 pub const DIM_LOBE: u32 = 3;
 /// Pattern dimension of the BSDF direction.
 pub const DIM_BSDF: u32 = 4;
+/// Pattern dimension of the thin-lens sample (index: the eye sample, count N). The last
+/// dimension, beyond those of any path vertex, so that adding it changed no other decision's
+/// numbers (pinhole images are bit-identical to before); read only by cameras with a lens.
+pub const DIM_LENS: u32 = u32::MAX;
 
 /// Shadow rays stop this fraction short of the light point so they do not hit the light itself.
 const SHADOW_EPSILON: f32 = 1e-4;

@@ -68,8 +68,7 @@ pub fn right_handed_look_at(
         .ok_or_else(|| anyhow::anyhow!("mirror transform is singular"))?;
     Ok(Camera {
         camera_to_world: lh.camera_to_world.then_apply_to(&mirror),
-        fov_deg,
-        screen_window: None,
+        ..lh
     })
 }
 
