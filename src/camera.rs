@@ -232,7 +232,7 @@ impl CameraRays {
     #[inline(always)]
     pub fn direction(&self, p: Vec2) -> Vec3 {
         let d = self.screen(p) * self.tan_half;
-        self.to_world(Vec3::new(d.x, d.y, 1.0)).normalize_fast()
+        self.world_vector(Vec3::new(d.x, d.y, 1.0)).normalize_fast()
     }
 
     /// Screen-window coordinates of raster position `p`.
@@ -246,7 +246,7 @@ impl CameraRays {
 
     /// Camera-space vector `d` in world space, multiplied and added in glam's order.
     #[inline(always)]
-    fn to_world(&self, d: Vec3) -> Vec3 {
+    fn world_vector(&self, d: Vec3) -> Vec3 {
         let [ax, ay, az] = self.axes;
         az * d.z + (ay * d.y + ax * d.x)
     }
@@ -295,7 +295,10 @@ impl CameraRays {
 
     /// The world ray of camera-space origin `o` and direction `d`.
     fn camera_ray(&self, o: Vec3, d: Vec3) -> Ray {
-        Ray::new(self.origin + self.to_world(o), self.to_world(d).normalize_fast())
+        Ray::new(
+            self.origin + self.world_vector(o),
+            self.world_vector(d).normalize_fast(),
+        )
     }
 }
 

@@ -86,12 +86,13 @@ fn cornell_box_bitterli_parses() {
 }
 
 #[test]
-fn defaults_film_1280x720_fov_90_box_filter() {
+fn defaults_film_1280x720_fov_90_gaussian_filter() {
     let s = parse("WorldBegin");
     assert_eq!(s.film.resolution, glam::UVec2::new(1280, 720));
     assert_eq!(s.camera.fov_deg, 90.0);
     assert_eq!(s.film.spp, None);
-    assert!(matches!(s.film.filter, Filter::Box { .. }));
+    // pbrt-v4's default filter.
+    assert!(matches!(s.film.filter, Filter::Gaussian { sigma: 0.5, .. }));
     assert!(s.shapes.is_empty() && s.materials.is_empty());
 }
 
@@ -342,19 +343,18 @@ WorldBegin"#,
         }
     );
     assert_eq!(s.max_depth, Some(3));
-    assert!(
-        s.warnings
-            .iter()
-            .any(|w| w.starts_with("t.pbrt:6:") && w.contains("lensradius"))
-    );
+    // The thin lens is rendered: no warning about it.
+    assert!(!s.warnings.iter().any(|w| w.contains("lensradius")));
+    assert_eq!(s.camera.lens.radius, 0.1);
     let s = parse("PixelFilter \"gaussian\"\nWorldBegin");
     assert_eq!(
         s.film.filter,
-        Filter::Triangle {
-            radius: Vec2::splat(1.5)
+        Filter::Gaussian {
+            radius: Vec2::splat(1.5),
+            sigma: 0.5
         }
     );
-    assert!(s.warnings.iter().any(|w| w.contains("gaussian")));
+    assert!(!s.warnings.iter().any(|w| w.contains("gaussian")));
 }
 
 #[test]

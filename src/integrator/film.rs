@@ -61,7 +61,8 @@ impl Filter {
 fn mitchell_1d(x: f64, b: f64, c: f64) -> f64 {
     let x = x.abs();
     if x <= 1.0 {
-        ((12.0 - 9.0 * b - 6.0 * c) * x * x * x + (-18.0 + 12.0 * b + 6.0 * c) * x * x
+        ((12.0 - 9.0 * b - 6.0 * c) * x * x * x
+            + (-18.0 + 12.0 * b + 6.0 * c) * x * x
             + (6.0 - 2.0 * b))
             / 6.0
     } else if x <= 2.0 {
@@ -202,7 +203,10 @@ impl FilterSampler {
             Some(t) => {
                 let (x, wx) = t[0].sample(u.x);
                 let (y, wy) = t[1].sample(u.y);
-                (pixel.as_vec2() + Vec2::splat(0.5) + Vec2::new(x, y), wx * wy)
+                (
+                    pixel.as_vec2() + Vec2::splat(0.5) + Vec2::new(x, y),
+                    wx * wy,
+                )
             }
         }
     }
@@ -219,7 +223,10 @@ impl FilterSampler {
                 }
                 match self.filter {
                     Filter::Box { .. } => 1.0 / (4.0 * r.x * r.y),
-                    _ => crate::sampling::tent_pdf(offset.x, r.x) * crate::sampling::tent_pdf(offset.y, r.y),
+                    _ => {
+                        crate::sampling::tent_pdf(offset.x, r.x)
+                            * crate::sampling::tent_pdf(offset.y, r.y)
+                    }
                 }
             }
         }
@@ -250,9 +257,7 @@ pub fn filter_sample(filter: &Filter, pixel: UVec2, u: Vec2) -> Vec2 {
     let center = pixel.as_vec2() + Vec2::splat(0.5);
     match *filter {
         Filter::Box { radius } => center + (u * 2.0 - Vec2::ONE) * radius,
-        Filter::Triangle { radius } => {
-            center + Vec2::new(tent(u.x, radius.x), tent(u.y, radius.y))
-        }
+        Filter::Triangle { radius } => center + Vec2::new(tent(u.x, radius.x), tent(u.y, radius.y)),
         _ => FilterSampler::new(filter)
             .map(|s| s.sample(pixel, u).0)
             .unwrap_or(center),

@@ -116,23 +116,23 @@ pub fn render(
                                  pxs: &[PixelSamples],
                                  owner: &[usize; PACKET],
                                  weight: &[f32; PACKET]| {
-                        tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut scratch);
-                        for k in 0..cam.n {
-                            // Filters with negative lobes weight their samples (mean weight 1);
-                            // box, tent and gaussian samples all weigh exactly 1.
-                            let l = if filter.is_analytic() {
-                                radiance[k]
-                            } else {
-                                radiance[k] * weight[k]
-                            };
-                            if l.is_finite() {
-                                sums[owner[cam.pixel[k] as usize]] += l;
-                            } else {
-                                tile_bad += 1;
-                            }
+                    tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut scratch);
+                    for k in 0..cam.n {
+                        // Filters with negative lobes weight their samples (mean weight 1);
+                        // box, tent and gaussian samples all weigh exactly 1.
+                        let l = if filter.is_analytic() {
+                            radiance[k]
+                        } else {
+                            radiance[k] * weight[k]
+                        };
+                        if l.is_finite() {
+                            sums[owner[cam.pixel[k] as usize]] += l;
+                        } else {
+                            tile_bad += 1;
                         }
-                        cam.clear();
-                    };
+                    }
+                    cam.clear();
+                };
                 // Per lane: the pixel and filter draw; the camera rays of a full packet are then
                 // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
                 let mut lanes = CameraLanes::new();

@@ -500,7 +500,9 @@ impl Parser {
                     "perspective" => Projection::Perspective,
                     "orthographic" => Projection::Orthographic,
                     "spherical" => match ps.string("mapping")?.as_deref() {
-                        None | Some("equalarea") => Projection::Spherical(SphericalMapping::EqualArea),
+                        None | Some("equalarea") => {
+                            Projection::Spherical(SphericalMapping::EqualArea)
+                        }
                         Some("equirectangular") => {
                             Projection::Spherical(SphericalMapping::Equirectangular)
                         }
@@ -563,7 +565,9 @@ impl Parser {
                         format!("Camera: lensradius must be ≥ 0, found {}", lens.radius),
                     ));
                 }
-                if lens.radius > 0.0 && !(lens.focal_distance > 0.0 && lens.focal_distance.is_finite()) {
+                if lens.radius > 0.0
+                    && !(lens.focal_distance > 0.0 && lens.focal_distance.is_finite())
+                {
                     return Err(err_at(
                         &loc,
                         format!(
@@ -582,11 +586,13 @@ impl Parser {
                 // pbrt-v4: 'frameaspectratio' replaces the image's aspect ratio in the default
                 // screen window.
                 let sw = match (sw, ps.opt_float("frameaspectratio")?) {
-                    (None, Some(frame)) if frame > 0.0 && frame.is_finite() => Some(if frame > 1.0 {
-                        [-frame, frame, -1.0, 1.0]
-                    } else {
-                        [-1.0, 1.0, -1.0 / frame, 1.0 / frame]
-                    }),
+                    (None, Some(frame)) if frame > 0.0 && frame.is_finite() => {
+                        Some(if frame > 1.0 {
+                            [-frame, frame, -1.0, 1.0]
+                        } else {
+                            [-1.0, 1.0, -1.0 / frame, 1.0 / frame]
+                        })
+                    }
                     (None, Some(frame)) => {
                         return Err(err_at(
                             &loc,
@@ -694,7 +700,9 @@ impl Parser {
                     } else {
                         Err(err_at(
                             &loc,
-                            format!("PixelFilter \"{ty}\": expected a positive '{what}', found {v}"),
+                            format!(
+                                "PixelFilter \"{ty}\": expected a positive '{what}', found {v}"
+                            ),
                         ))
                     }
                 };
