@@ -618,10 +618,13 @@ LightSource "goniometric"
         LightDesc::EnvMap {
             path,
             scale,
+            layout,
             light_to_world,
         } => {
             assert_eq!(path, &d.join("sky.exr"));
             assert_eq!(*scale, 2.0);
+            // 8×4 is not square: read as lat-long, with a warning.
+            assert_eq!(*layout, penumbra::lights::envmap::EnvLayout::LatLong);
             assert!(close(
                 light_to_world.point(Vec3::ZERO),
                 Vec3::new(0.0, 5.0, 0.0)
