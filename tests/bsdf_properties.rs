@@ -597,6 +597,7 @@ fn materials_map_to_bsdfs() {
         reflectance: c(2.0),
         alpha: Vec2::splat(0.1),
         eta: 1.5,
+        layer: None,
     };
     match m.bsdf(&h, true) {
         Bsdf::CoatedDiffuse(b) => assert_eq!(b.reflectance, Rgb::ONE),

@@ -29,6 +29,7 @@ fn film() -> FilmSpec {
         },
         filename: None,
         spp: None,
+        sensor: Default::default(),
     }
 }
 

@@ -22,6 +22,7 @@ fn film() -> FilmSpec {
         },
         filename: None,
         spp: None,
+        sensor: Default::default(),
     }
 }
 
@@ -199,6 +200,179 @@ fn spawned_rays_do_not_reintersect_their_surface() {
             "inward ray lost or hit its origin"
         );
     }
+}
+
+#[test]
+fn spawned_origins_lie_on_the_side_they_leave_to() {
+    // The spawn rule without the intersection test's help: for hits on random triangles of
+    // every size, orientation and distance from the origin (axis-aligned ones included), the
+    // spawned origin lies on the side of the triangle's exact plane that the ray leaves to,
+    // or exactly on it (checked in f64).
+    use penumbra::geometry::{Geometry, MeshShading};
+    let mut rng = pcg_from_keys(&[41]);
+    let mut f = || next_f32(&mut rng);
+    let (mut checked, mut on_plane, mut least) = (0, 0, f64::INFINITY);
+    for k in 0..3000 {
+        let size = 10f32.powf(-3.0 + 7.0 * f());
+        let far = 10f32.powf(3.0 * f()) * size;
+        let centre = uniform_sphere(Vec2::new(f(), f())) * far * (k % 2) as f32;
+        let mut p = [0; 3].map(|_| centre + uniform_sphere(Vec2::new(f(), f())) * size);
+        if k % 3 == 0 {
+            // In a plane x, y or z = c (c = 0 for every sixth).
+            let axis = k / 3 % 3;
+            let c = if k % 2 == 0 { 0.0 } else { centre[axis] };
+            for v in &mut p {
+                v[axis] = c;
+            }
+        }
+        let g = Geometry::new(
+            vec![lone_triangle(p)],
+            vec![MeshShading::default()],
+            Vec::new(),
+        );
+        let (a, b) = (f(), f());
+        let (a, b) = if a + b > 1.0 {
+            (1.0 - a, 1.0 - b)
+        } else {
+            (a, b)
+        };
+        let target = p[0] + (p[1] - p[0]) * a + (p[2] - p[0]) * b;
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let eye = target + (n.normalize() + uniform_sphere(Vec2::new(f(), f()))) * size;
+        let Some(h) = g.intersect(&Ray::new(eye, target - eye)) else {
+            continue;
+        };
+        let pd = p.map(|v| v.as_dvec3());
+        let nd = (pd[1] - pd[0]).cross(pd[2] - pd[0]).normalize();
+        for _ in 0..8 {
+            let w = uniform_sphere(Vec2::new(f(), f()));
+            let side =
+                if w.dot(h.ng) >= 0.0 { 1.0 } else { -1.0 } * nd.dot(h.ng.as_dvec3()).signum();
+            let dist = side * nd.dot(h.spawn_origin(w).as_dvec3() - pd[0]);
+            checked += 1;
+            assert!(
+                dist >= 0.0,
+                "origin {dist} behind the plane of {p:?}, leaving along {w}"
+            );
+            if dist == 0.0 {
+                on_plane += 1;
+            } else {
+                least = least.min(dist / h.p_error as f64);
+            }
+        }
+    }
+    eprintln!(
+        "{checked} origins, {on_plane} exactly on their plane, the others at ≥ {least:.3} of the bound"
+    );
+    assert!(
+        checked > 20_000 && on_plane > 1000,
+        "{checked} checked, {on_plane} on the plane"
+    );
+}
+
+/// Triangle `p` as a primitive (material 0, no light).
+fn lone_triangle(p: [Vec3; 3]) -> penumbra::geometry::Primitive {
+    penumbra::geometry::Primitive {
+        p,
+        kind: penumbra::geometry::PrimKind::Triangle {
+            mesh: 0,
+            v: [0, 1, 2],
+        },
+        material: 0,
+        light: u32::MAX,
+    }
+}
+
+#[test]
+fn quadric_error_bounds_cover_the_intersections_own_rounding() {
+    // Spheres and disks far from the origin, rotated, uniformly and anisotropically scaled:
+    // a spawned ray's origin is mapped back to object space (f32) to be intersected, and the
+    // hit's error bound must clear that mapping's error too, with margin (measured: at most
+    // 37% of the bound), so that no spawned ray re-hits its quadric and inward rays reach the
+    // far side.
+    use penumbra::geometry::{Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind};
+    use penumbra::sampling::concentric_disk;
+    let mut rng = pcg_from_keys(&[31]);
+    let mut u2 = || Vec2::new(next_f32(&mut rng), next_f32(&mut rng));
+    let configs = [
+        (1e4f32, 1.0f32, Vec3::ONE),
+        (3e3, 0.05, Vec3::ONE),
+        (2e4, 10.0, Vec3::ONE),
+        (1e3, 1.0, Vec3::splat(7.3)),
+        (1e3, 1.0, Vec3::splat(0.013)),
+        (1e3, 1.0, Vec3::new(1.0, 6.0, 0.15)),
+    ];
+    let (mut worst, mut rays) = (0.0f64, 0);
+    for (dist, radius, scale) in configs {
+        for sphere in [true, false] {
+            for _ in 0..40 {
+                let (a, b) = (u2(), u2());
+                let rot = glam::Quat::from_axis_angle(uniform_sphere(a), 6.0 * b.x);
+                let m = Mat4::from_scale_rotation_translation(scale, rot, uniform_sphere(b) * dist);
+                let kind = if sphere {
+                    QuadricKind::Sphere { radius }
+                } else {
+                    QuadricKind::Disk {
+                        height: 0.3,
+                        radius,
+                    }
+                };
+                let q = Quadric {
+                    kind,
+                    to_world: Transform::new(m).unwrap(),
+                    flip: false,
+                };
+                let prim = Primitive {
+                    p: [Vec3::ZERO; 3],
+                    kind: PrimKind::Quadric(0),
+                    material: 0,
+                    light: u32::MAX,
+                };
+                let g = Geometry::new(vec![prim], vec![MeshShading::default()], vec![q]);
+                let exact_inv = m.as_dmat4().inverse();
+                for _ in 0..20 {
+                    let u = u2();
+                    let local = if sphere {
+                        uniform_sphere(u) * radius
+                    } else {
+                        let d = concentric_disk(u) * (0.95 * radius);
+                        Vec3::new(d.x, d.y, 0.3)
+                    };
+                    let target = q.to_world.point(local);
+                    let n = q.to_world.normal(if sphere { local } else { Vec3::Z });
+                    let view = (n.normalize() + uniform_sphere(u2()) * 0.5).normalize();
+                    let eye = target + view * (3.0 * radius * scale.max_element());
+                    let Some(h) = g.intersect(&Ray::new(eye, target - eye)) else {
+                        continue;
+                    };
+                    for _ in 0..8 {
+                        let w = uniform_sphere(u2());
+                        let r = Ray::new(h.spawn_origin(w), w);
+                        rays += 1;
+                        // The object-space origin the intersection uses against the exact
+                        // one, seen along the normal in world space, relative to the bound.
+                        let mapped = q.to_world.m_inv.transform_point3(r.o).as_dvec3();
+                        let exact = exact_inv.transform_point3(r.o.as_dvec3());
+                        let off = m.as_dmat4().transform_vector3(mapped - exact);
+                        worst = worst.max(off.dot(h.ng.as_dvec3()).abs() / h.p_error as f64);
+                        let hit = g.intersect(&r);
+                        let cos = w.dot(h.ng);
+                        if cos >= 0.0 || !sphere {
+                            assert!(hit.is_none(), "self-hit leaving {} along {w}", h.p);
+                        } else if cos < -1e-3 {
+                            assert!(hit.is_some(), "inward ray from {} escaped", h.p);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("{rays} spawned rays; the back mapping used at most {worst:.3} of the bound");
+    assert!(rays > 10_000, "{rays} rays");
+    assert!(
+        worst < 0.75,
+        "the back mapping used {worst} of the error bound"
+    );
 }
 
 #[test]

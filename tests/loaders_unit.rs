@@ -587,6 +587,7 @@ fn gltf_metallic_roughness_mapping() {
             reflectance: Texture::Constant(r),
             alpha,
             eta,
+            layer: None,
         } => {
             assert!((r - 0.75 * c).abs().max_element() < 1e-6);
             assert!(

@@ -133,6 +133,7 @@ fn test_scene() -> Scene {
         },
         filename: None,
         spp: None,
+        sensor: Default::default(),
     };
     b.build(camera, film).unwrap()
 }

@@ -3,7 +3,8 @@
 //! inactive lanes empty: coherent camera packets, incoherent random rays, shadow rays to points
 //! on the light, partial masks, rays leaving surfaces, on every backend and on cornell, a dense
 //! mesh (rays aimed at shared vertices and edges: exact ties), triangles with quadrics and an
-//! empty scene.
+//! empty scene; and rays leaving a lone surface must miss it on every path (the self-hit
+//! rejection is part of the test that all paths share).
 
 mod geometry_support;
 
@@ -12,9 +13,15 @@ use geometry_support::{
     soup_with_quadrics, tie_rays, triangle_soup,
 };
 use glam::{UVec2, Vec2, Vec3};
-use penumbra::geometry::{Backend, Geometry, MeshShading, PACKET, Primitive, Ray, RayQuery};
+use penumbra::geometry::{
+    Backend, Geometry, MeshShading, PACKET, PrimKind, Primitive, QuadricKind, Ray, RayQuery,
+    SurfaceHit,
+};
+use penumbra::integrator::direct::shadow_ray;
 use penumbra::isa::Isa;
-use penumbra::sampling::{PatternKind, make_pattern};
+use penumbra::sampling::{
+    PatternKind, concentric_disk, make_pattern, uniform_sphere, uniform_triangle_point,
+};
 
 /// Active masks cycled through the packets: full, partial, single lanes.
 const MASKS: [u32; 5] = [0xffff, 0xa5c3, 0x0001, 0x8000, 0x7ffe];
@@ -191,4 +198,171 @@ fn packets_match_scalar_queries_on_a_single_leaf() {
     }
     let hits = check(&g, &rays);
     assert!(hits > 100 && hits < rays.len() as u32 / 2, "{hits} hits");
+}
+
+/// `n` points of the lone surface `g` seen from `eye` (the closest hits of rays toward random
+/// points of its primitives), each with 16 directions drawn uniformly on the sphere (pattern
+/// seed `seed`).
+fn surface_points(g: &Geometry, eye: Vec3, n: u32, seed: u64) -> Vec<(SurfaceHit, [Vec3; PACKET])> {
+    let pat = make_pattern(PatternKind::Random, seed);
+    let mut out = Vec::new();
+    for k in 0..n {
+        let u = pat.sample_2d(UVec2::new(k, 7), 0, 0, 1);
+        let Some(p) = g.primitive(k % g.len() as u32) else {
+            continue;
+        };
+        let target = match p.kind {
+            PrimKind::Triangle { .. } => uniform_triangle_point(u, p.p[0], p.p[1], p.p[2]),
+            PrimKind::Quadric(q) => {
+                // A point of the disk z = height, radius r of object space.
+                let q = &g.quadrics[q as usize];
+                let QuadricKind::Disk { height, radius } = q.kind else {
+                    unreachable!("only disks here")
+                };
+                let d = concentric_disk(u) * (0.9 * radius);
+                q.to_world.point(Vec3::new(d.x, d.y, height))
+            }
+        };
+        let Some(h) = g.intersect(&Ray::new(eye, target - eye)) else {
+            continue;
+        };
+        let w = std::array::from_fn(|s| {
+            uniform_sphere(pat.sample_2d(UVec2::new(k, 8), 0, s as u32, PACKET as u32))
+        });
+        out.push((h, w));
+    }
+    assert!(
+        out.len() as u32 > n * 9 / 10,
+        "{} of {n} points found",
+        out.len()
+    );
+    out
+}
+
+/// Asserts that none of `rays` (packets of 16) hits anything in `g`, by the scalar queries
+/// and by the packet queries on every vector backend.
+fn assert_clear(g: &Geometry, rays: &[[Ray; PACKET]], what: &str) {
+    for pk in rays {
+        for ray in pk {
+            assert!(
+                g.intersect(ray).is_none(),
+                "{what}: {ray:?} hits {:?}",
+                g.intersect(ray)
+            );
+            assert!(!g.occluded(ray), "{what}: {ray:?} occluded");
+        }
+        for isa in ISAS {
+            let mut out = [None; PACKET];
+            g.intersect_packet_on(isa, pk, 0xffff, &mut out);
+            assert!(
+                out.iter().all(Option::is_none),
+                "{what} on {isa:?}: {out:?}"
+            );
+            assert_eq!(
+                g.occluded_packet_on(isa, pk, 0xffff),
+                0,
+                "{what} on {isa:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn rays_leaving_a_lone_surface_hit_nothing_on_any_path() {
+    // A ray spawned at a surface must not hit it, nor its coplanar neighbours, whatever the
+    // direction: on the 19×19 floors at y = 0 (where the hit points' error bound, and
+    // so the spawn offset, is exactly zero) and y = 0.37, as two triangles (a single BVH leaf:
+    // the 4-wide one-ray test and the 16-lane any-hit kernel) and as a 12×12 grid (several
+    // leaves: the 16-lane closest-hit kernel), on the BVH2 too (the one-ray test), and on a
+    // tilted quad and a disk far from the origin.
+    let quad = |corner: Vec3, e1: Vec3, e2: Vec3, k: u32| {
+        let mut prims = Vec::new();
+        let at = |i: u32, j: u32| corner + e1 * (i as f32 / k as f32) + e2 * (j as f32 / k as f32);
+        for j in 0..k {
+            for i in 0..k {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                prims.push(geometry_support::triangle(0, [a, b, c]));
+                prims.push(geometry_support::triangle(0, [a, c, d]));
+            }
+        }
+        Geometry::new(prims, vec![MeshShading::default()], Vec::new())
+    };
+    let (x, z) = (Vec3::X * 19.0, Vec3::Z * 19.0);
+    let tilted_e1 = Vec3::new(3.0, 1.0, -2.0) * 2.0;
+    let tilted_e2 = tilted_e1.cross(Vec3::new(0.3, 1.0, 0.2)).normalize() * 11.0;
+    let disk = {
+        use penumbra::geometry::{Quadric, Transform};
+        let m = glam::Mat4::from_rotation_translation(
+            glam::Quat::from_axis_angle(Vec3::new(1.0, 2.0, 0.5).normalize(), 0.7),
+            Vec3::new(130.0, -40.0, 75.0),
+        );
+        let q = Quadric {
+            kind: QuadricKind::Disk {
+                height: 0.0,
+                radius: 9.0,
+            },
+            to_world: Transform::new(m).unwrap(),
+            flip: false,
+        };
+        let p = Primitive {
+            p: [Vec3::ZERO; 3],
+            kind: PrimKind::Quadric(0),
+            material: 0,
+            light: u32::MAX,
+        };
+        Geometry::new(vec![p], vec![MeshShading::default()], vec![q])
+    };
+    // (name, surface, whether its hit points lie exactly on it)
+    let cases = [
+        (
+            "y = 0 quad",
+            quad(Vec3::new(-9.5, 0.0, -9.5), x, z, 1),
+            true,
+        ),
+        (
+            "y = 0 grid",
+            quad(Vec3::new(-9.5, 0.0, -9.5), x, z, 12),
+            true,
+        ),
+        (
+            "y = 0.37 quad",
+            quad(Vec3::new(-9.5, 0.37, -9.5), x, z, 1),
+            false,
+        ),
+        (
+            "y = 0.37 grid",
+            quad(Vec3::new(-9.5, 0.37, -9.5), x, z, 12),
+            false,
+        ),
+        (
+            "tilted grid",
+            quad(Vec3::new(310.0, -20.0, 45.0), tilted_e1, tilted_e2, 6),
+            false,
+        ),
+        ("tilted disk", disk, false),
+    ];
+    for (name, g, exact_plane) in cases {
+        let (lo, hi) = g.bounds();
+        let eye = (lo + hi) * 0.5 + Vec3::new(0.3, 1.0, 0.2).normalize() * (hi - lo).length();
+        for backend in [Backend::Wide, Backend::Own] {
+            let g = g.rebuild(backend);
+            let points = surface_points(&g, eye, 120, 21);
+            let mut spawned = Vec::new();
+            let mut from_p = Vec::new();
+            let mut to = Vec::new();
+            for (h, w) in &points {
+                spawned.push(w.map(|w| Ray::new(h.spawn_origin(w), w)));
+                // Straight from the hit point: exactly on the plane y = 0 (elsewhere the
+                // rounded point may lie a little behind the plane, and the ray truly cross it).
+                from_p.push(w.map(|w| Ray::new(h.p, w)));
+                to.push(w.map(|w| shadow_ray(h, h.p + w * 50.0)));
+            }
+            let what = format!("{name} on {backend:?}");
+            assert_clear(&g, &spawned, &format!("{what}, spawned rays"));
+            assert_clear(&g, &to, &format!("{what}, shadow rays"));
+            if exact_plane {
+                assert_clear(&g, &from_p, &format!("{what}, rays from the hit points"));
+            }
+        }
+    }
 }

@@ -6,15 +6,20 @@
 //! Delta lobes report `delta = true` with `pdf = 1` by convention and `f` chosen so that
 //! `f·|cos θi| / pdf` is the sample's throughput weight (e.g. `R / |cos θi|`); `f()`/`pdf()`
 //! never see them (they return 0 for delta directions).
+//! One exception: the layered BSDFs (`layered`, pbrt-v4's coated diffuse and coated conductor)
+//! are stochastic, like pbrt-v4's; their `pdf` is a positive density for MIS weights, not the
+//! random walk's (intractable) density, and their samples carry the walk's weight.
 //! The integrator builds the frame with the shading normal flipped toward `wo`, so `wo.z ≥ 0`
 //! for every call; transmissive BSDFs are told which side they are entered from at construction.
 
 pub mod coated;
+pub mod coated_conductor;
 pub mod conductor;
 pub mod dielectric;
 pub mod fresnel;
 pub mod ggx;
 pub mod lambert;
+pub mod layered;
 pub mod mirror;
 pub mod phong;
 
@@ -23,6 +28,7 @@ pub use conductor::{Conductor, named_metal};
 pub use dielectric::Dielectric;
 pub use ggx::{TrowbridgeReitz, roughness_to_alpha};
 pub use lambert::Lambert;
+pub use layered::{LayerParams, Layered};
 pub use mirror::Mirror;
 pub use phong::Phong;
 
@@ -167,6 +173,9 @@ pub enum Bsdf {
     CoatedDiffuse(CoatedDiffuse),
     /// Ideal mirror.
     Mirror(Mirror),
+    /// pbrt-v4's stochastic layered BSDF (coated diffuse / coated conductor); boxed so that
+    /// its 80 bytes do not double the size of every other BSDF in the integrator's lanes.
+    Layered(Box<Layered>),
 }
 
 macro_rules! dispatch {
@@ -178,6 +187,7 @@ macro_rules! dispatch {
             Bsdf::Dielectric($b) => $e,
             Bsdf::CoatedDiffuse($b) => $e,
             Bsdf::Mirror($b) => $e,
+            Bsdf::Layered($b) => $e,
         }
     };
 }
@@ -198,6 +208,7 @@ impl Bsdf {
             Bsdf::Phong(b) => b.sampling = s,
             Bsdf::Conductor(b) => b.sampling = s,
             Bsdf::CoatedDiffuse(b) => b.sampling = s,
+            Bsdf::Layered(b) => b.sampling = s,
             Bsdf::Dielectric(_) | Bsdf::Mirror(_) => {}
         }
     }

@@ -229,6 +229,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => render(&scene, res, &opts)?,
     };
     let render_time = render_start.elapsed();
+    // pbrt-v4's film response (ISO, exposure, white balance); the identity leaves it untouched.
+    let mut img = img;
+    scene.film.sensor.apply(&mut img);
 
     let write_start = Instant::now();
     interrupt.writing(test_write_pause(), |ctl| {

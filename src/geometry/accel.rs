@@ -3,14 +3,13 @@
 //! obvhs's compressed-wide BVH (CWBVH), see [`Backend`].
 
 use super::bvh::Bvh;
-use super::float::gamma;
 use super::packet::{ColumnSink, PACKET, PacketHits, PacketRays, bits};
 use super::quadric::Quadric;
 #[cfg(target_arch = "x86_64")]
 use super::simd16::{Avx2, Avx512};
 use super::simd16::{Portable, Simd};
 use super::tree2::Tree2;
-use super::triangle::{RayShear, barycentric_error};
+use super::triangle::{POINT_ERROR_GAMMA, RayShear, barycentric_error};
 use super::wide::{Bary, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use crate::isa::Isa;
@@ -464,7 +463,7 @@ impl Geometry {
                 sp(verts[2][a]) * b[2],
             ];
             pos[a] = q[0] + q[1] + q[2];
-            err[a] = (S::abs(q[0]) + S::abs(q[1]) + S::abs(q[2])) * sp(gamma(7));
+            err[a] = (S::abs(q[0]) + S::abs(q[1]) + S::abs(q[2])) * sp(POINT_ERROR_GAMMA);
         }
         // SAFETY: `tri_ng` has one entry per primitive, and `id` indexes `prims`.
         let tri_ng = unsafe { *self.tri_ng.get_unchecked(id) }.to_array();

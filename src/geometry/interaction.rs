@@ -1,5 +1,6 @@
 //! What a closest-hit query returns.
 
+use super::Ray;
 use crate::sampling::Frame;
 use glam::{Vec2, Vec3};
 
@@ -27,7 +28,8 @@ pub struct SurfaceHit {
     pub ns: Vec3,
     /// Surface parameterisation (texture coordinates).
     pub uv: Vec2,
-    /// Conservative absolute error bound of `p`, used to offset spawned rays.
+    /// Conservative absolute error bound of `p` along `ng` (with room for the rounding of a
+    /// spawned ray's origin), the offset of spawned rays.
     pub p_error: f32,
     /// Index of the primitive in the scene's geometry.
     pub prim: u32,
@@ -51,8 +53,15 @@ impl SurfaceHit {
         unsafe { std::mem::transmute::<[f32; 16], SurfaceHit>(a) }
     }
 
-    /// Origin for a ray leaving the surface toward direction `w` (offset along ±ng by the
-    /// error bound so it cannot re-hit the surface it leaves).
+    /// Origin for a ray leaving the surface toward direction `w`: `p` moved along ±ng (the
+    /// side of `w`) by `p_error`, which bounds both the point's error and the rounding of
+    /// this sum (pbrt-v4's `OffsetRayOrigin`, its step of one ulp per coordinate folded into
+    /// the bound). The origin is then on the surface's `w` side or, where the bound is zero
+    /// (a hit on the plane x = 0 has an exact x), exactly on it; either way the surface lies
+    /// at t ≤ 0 of the spawned ray, and the triangle tests reject hits that are not provably
+    /// beyond t = 0 (`self_hit_bound`), so the ray cannot hit the surface it leaves. (Quadrics
+    /// are solved in f64 after an f32 map to object space: the offset alone suffices, with
+    /// the margin over that map's error that tests/geometry.rs measures.)
     #[inline]
     pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
         let off = self.ng * self.p_error;
@@ -62,7 +71,36 @@ impl SurfaceHit {
             self.p - off
         }
     }
+
+    /// A shadow ray from this hit to just short of `target`: leaving from
+    /// [`Self::spawn_origin`] toward `target`, with direction `target − origin` and
+    /// t_max = [`SHADOW_T_MAX`].
+    ///
+    /// The far end is shortened by a relative [`SHADOW_EPSILON`] instead of being offset by
+    /// an error bound as the near end is (pbrt-v4's `SpawnRayTo` offsets both): a light
+    /// sample carries no error bound here (solid-angle samples are not barycentric
+    /// combinations, whose bound the hit records use), and the relative gap, 1e-4 of the
+    /// distance, exceeds the few-ulp error of the sampled point (~1e-7 of its coordinates)
+    /// unless the receiver is closer to the light point than ~1e-3 of that point's distance
+    /// from the origin: receivers in contact with a light, which this rule accepts. At the
+    /// near end no relative gap can work: there the rounding is absolute and t starts at 0.
+    #[inline]
+    pub fn spawn_ray_to(&self, target: Vec3) -> Ray {
+        let o = self.spawn_origin(target - self.p);
+        Ray {
+            o,
+            d: target - o,
+            t_max: SHADOW_T_MAX,
+        }
+    }
 }
+
+/// Shadow rays stop this fraction of their length short of the light point so they do not
+/// hit the light itself.
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
+/// The `t_max` of every shadow ray (its direction spans origin to light point).
+pub const SHADOW_T_MAX: f32 = 1.0 - SHADOW_EPSILON;
 
 /// How a hit is seen along a ray: the set-up every estimator does before sampling there.
 #[derive(Clone, Copy, Debug)]

@@ -23,7 +23,7 @@ use super::bvh::{NEAR_SLACK, ROUNDING_SLACK};
 use super::simd16::{Avx2, Avx512};
 use super::simd16::{Lanes, Portable, Simd};
 use super::tri4::TriPacket;
-use super::triangle::RayShear;
+use super::triangle::{RayShear, self_hit_bound};
 use super::wide::{Bary, LEAF, Node4, STACK, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
 use crate::isa::Isa;
@@ -545,6 +545,8 @@ struct PacketShear<S: Simd> {
     pick: [[S::M; 2]; 3],
     o: [S::F; 3],
     s: [S::F; 3],
+    /// |d| along the sheared x and y axes (for `self_hit_bound`).
+    ad: [S::F; 2],
 }
 
 /// Lane-wise `a[k]`, where `m` = [lanes with k = 0, lanes with k = 1] (disjoint).
@@ -615,12 +617,14 @@ impl<S: Simd> PacketShear<S> {
                 S::div(dy, dz) * minus,
                 S::div(S::splat(1.0), dz),
             ],
+            ad: [S::abs(dx), S::abs(dy)],
         }
     }
 }
 
 /// One triangle against every ray of the packet: each lane performs the f32 operations of
-/// [`RayShear4`](super::tri4::RayShear4)'s lane test for that ray (same order, hence the same bits).
+/// [`RayShear4`](super::tri4::RayShear4)'s lane test for that ray (same order, hence the same
+/// bits, self-hit rejection included).
 struct TriLanes<S: Simd> {
     /// Rays accepted by the f32 test with t in (0, t_max).
     hit: u32,
@@ -699,9 +703,17 @@ fn triangle_lanes<S: Simd>(
             inv: zero,
         };
     }
+    // Hits not provably in front of the origin (the scalar test's `self_hit_bound`), only
+    // for packets with a candidate: the common miss above does not pay for the bound.
+    let (mx, my, mz) = (
+        max_abs3::<S>(ax, bx, cx),
+        max_abs3::<S>(ay, by, cy),
+        max_abs3::<S>(az, bz, cz),
+    );
+    let bound = self_hit_bound(mx, my, mz, ps.ad[0], ps.ad[1], S::splat);
     let inv = S::div(S::splat(1.0), det);
     let t = t_scaled * inv;
-    let ok = S::and(S::lt(zero, t), S::lt(t, t_max));
+    let ok = S::and(S::and(S::lt(zero, t), S::lt(t, t_max)), S::lt(bound, ts));
     TriLanes {
         hit: S::bits(S::and(ok, cand)),
         redo,
@@ -709,6 +721,12 @@ fn triangle_lanes<S: Simd>(
         e: [e0, e1, e2],
         inv,
     }
+}
+
+/// Lane-wise max(|a|, |b|, |c|) (a function, not a closure, for the caller's target features).
+#[inline(always)]
+fn max_abs3<S: Simd>(a: S::F, b: S::F, c: S::F) -> S::F {
+    S::max(S::max(S::abs(a), S::abs(b)), S::abs(c))
 }
 
 /// Vertices of triangle `lane` of `pk` as `[vertex][axis]`.

@@ -3,11 +3,12 @@
 //!
 //! Every lane performs the same f32 operations in the same order as [`RayShear::intersect`]
 //! (the shear rows there have one unit and one zero entry, so their dot products round exactly
-//! like `a[kx] + sx·a[kz]` here), hence t and the barycentrics are bit-identical. Lanes whose
+//! like `a[kx] + sx·a[kz]` here), hence t, the barycentrics and the self-hit rejection
+//! ([`self_hit_bound`]) are bit-identical. Lanes whose
 //! edge functions are exactly 0 in f32 are redone by the scalar test, whose f64 fallback keeps
 //! neighbouring triangles in agreement on shared edges (watertightness).
 
-use super::triangle::{RayShear, shear_axes};
+use super::triangle::{RayShear, self_hit_bound, shear_axes};
 use glam::{Vec3, Vec4};
 
 /// Four triangles in SoA layout, one leaf packet of the wide BVH.
@@ -74,6 +75,8 @@ pub struct RayShear4 {
     k: [usize; 3],
     o: [Vec4; 3],
     s: [Vec4; 3],
+    /// |d| along the sheared x and y axes, splatted (for `self_hit_bound`).
+    ad: [Vec4; 2],
     /// The ray, for the scalar redo of exact-zero lanes (rare, so its shear is built lazily).
     ray: (Vec3, Vec3),
 }
@@ -108,6 +111,7 @@ impl RayShear4 {
                 Vec4::splat(oa[k[2]]),
             ],
             s: [Vec4::splat(q.x), Vec4::splat(q.y), Vec4::splat(q.z)],
+            ad: [Vec4::splat(da[k[0]].abs()), Vec4::splat(da[k[1]].abs())],
             ray: (o, d),
         }
     }
@@ -154,9 +158,14 @@ impl RayShear4 {
                 inv: zero,
             };
         }
+        // Hits not provably in front of the origin (the scalar test's `self_hit_bound`).
+        let max3 = |a: Vec4, b: Vec4, c: Vec4| a.abs().max(b.abs()).max(c.abs());
+        let (mx, my, mz) = (max3(ax, bx, cx), max3(ay, by, cy), max3(az, bz, cz));
+        let bound = self_hit_bound(mx, my, mz, self.ad[0], self.ad[1], Vec4::splat);
+        let clear = ts.cmpgt(bound);
         let inv = Vec4::ONE / det;
         let t = t_scaled * inv;
-        let ok = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
+        let ok = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max)) & clear;
         Lanes {
             hit: ok.bitmask() & candidates,
             redo,
@@ -256,7 +265,7 @@ mod tests {
     fn lanes_match_the_scalar_test_bit_for_bit() {
         let mut s = pcg_from_keys(&[7]);
         let rnd3 = |s: &mut Pcg32| Vec3::new(next_f32(s), next_f32(s), next_f32(s)) * 2.0 - 1.0;
-        let (mut hits, mut checked) = (0, 0);
+        let (mut hits, mut checked, mut spawned) = (0, 0, 0);
         for _ in 0..20_000 {
             let mut pk = TriPacket::EMPTY;
             let mut tris = Vec::new();
@@ -269,13 +278,27 @@ mod tests {
             let p = [tris[0][1], tris[0][0], rnd3(&mut s)];
             pk.set_triangle(3, 3, p);
             tris.push(p);
-            let o = rnd3(&mut s) * 2.0;
-            let d = if next_f32(&mut s) < 0.2 {
+            let mut o = rnd3(&mut s) * 2.0;
+            let pick = next_f32(&mut s);
+            let d = if pick < 0.2 {
                 // Rays through a shared vertex.
                 tris[0][0] - o
             } else {
                 rnd3(&mut s)
             };
+            let from_lane0 = pick > 0.8;
+            if from_lane0 {
+                // Rays leaving a point of lane 0's triangle: its own hit, at t ≈ 0 in
+                // rounding, must be rejected by both tests alike (`self_hit_bound`).
+                let (a, b) = (next_f32(&mut s), next_f32(&mut s));
+                let (a, b) = if a + b > 1.0 {
+                    (1.0 - a, 1.0 - b)
+                } else {
+                    (a, b)
+                };
+                let t = tris[0];
+                o = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
+            }
             let t_max = if next_f32(&mut s) < 0.5 {
                 f32::INFINITY
             } else {
@@ -295,6 +318,14 @@ mod tests {
                 );
             let got = r4.closest(&pk, t_max);
             checked += 1;
+            if from_lane0 {
+                spawned += 1;
+                let scalar_self = intersect_triangle(o, d, t_max, tris[0]);
+                assert!(
+                    scalar_self.is_none_or(|h| h.0 > 1e-3),
+                    "self-hit {scalar_self:?} from {o} along {d}"
+                );
+            }
             match (want, got) {
                 (None, None) => {}
                 (Some((i, (t, b0, b1, b2))), Some((lane, tg, bg))) => {
@@ -306,5 +337,9 @@ mod tests {
             assert_eq!(r4.any(&pk, t_max), want.is_some());
         }
         assert!(hits > checked / 20, "{hits} hits of {checked}");
+        assert!(
+            spawned > checked / 10,
+            "{spawned} rays from lane 0 of {checked}"
+        );
     }
 }

@@ -34,11 +34,6 @@ pub const DIM_BSDF: u32 = 4;
 /// numbers (pinhole images are bit-identical to before); read only by cameras with a lens.
 pub const DIM_LENS: u32 = u32::MAX;
 
-/// Shadow rays stop this fraction short of the light point so they do not hit the light itself.
-const SHADOW_EPSILON: f32 = 1e-4;
-/// The `t_max` of every shadow ray (its direction spans origin to light point).
-pub(super) const SHADOW_T_MAX: f32 = 1.0 - SHADOW_EPSILON;
-
 /// One estimator configured for one render.
 pub struct DirectLighting<'a> {
     /// The scene.
@@ -699,14 +694,9 @@ pub(super) fn bsdf_ray_of(
     })
 }
 
-/// A shadow ray from `hit` to just short of `target`: offset at the origin by the hit's error
-/// bound, shortened at the far end by [`SHADOW_EPSILON`].
+/// A shadow ray from `hit` to just short of `target` ([`SurfaceHit::spawn_ray_to`], the one
+/// rule for every shadow ray).
 #[inline]
 pub fn shadow_ray(hit: &SurfaceHit, target: Vec3) -> Ray {
-    let o = hit.spawn_origin(target - hit.p);
-    Ray {
-        o,
-        d: target - o,
-        t_max: SHADOW_T_MAX,
-    }
+    hit.spawn_ray_to(target)
 }

@@ -6,7 +6,7 @@
 //! gathered in pixel order, so the passes are deterministic under any thread schedule.
 
 use crate::bsdf::{Bsdf, Bxdf};
-use crate::geometry::{Ray, RayQuery, ShadingGeometry, SurfaceHit};
+use crate::geometry::{RayQuery, ShadingGeometry, SurfaceHit};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode};
 use crate::luminance;
 use crate::sampling::Frame;
@@ -87,14 +87,8 @@ pub fn contribution(scene: &Scene, eh: &EyeHit, light: u32, u: Vec2) -> f32 {
     if (v.is_nan() || v <= 0.0) || !v.is_finite() {
         return 0.0;
     }
-    // Shadow ray from just off the surface to just short of the light point.
-    let o = eh.hit.spawn_origin(ls.p_light - eh.hit.p);
-    let ray = Ray {
-        o,
-        d: ls.p_light - o,
-        t_max: 1.0 - 1e-4,
-    };
-    if scene.geometry.occluded(&ray) {
+    // The renderer's shadow ray: from just off the surface to just short of the light point.
+    if scene.geometry.occluded(&eh.hit.spawn_ray_to(ls.p_light)) {
         0.0
     } else {
         v

@@ -6,9 +6,12 @@ pub mod texture;
 pub use texture::Texture;
 
 use crate::Rgb;
+use crate::bsdf::coated_conductor::{coated_conductor, layered_diffuse};
 use crate::bsdf::fresnel::k_from_reflectance;
 use crate::bsdf::ggx::is_smooth;
-use crate::bsdf::{Bsdf, CoatedDiffuse, Conductor, Dielectric, Lambert, Mirror, Phong};
+use crate::bsdf::{
+    Bsdf, CoatedDiffuse, Conductor, Dielectric, Lambert, LayerParams, Mirror, Phong,
+};
 use crate::geometry::SurfaceHit;
 use glam::Vec2;
 
@@ -48,6 +51,26 @@ pub enum Material {
         alpha: Vec2,
         /// Coat index of refraction.
         eta: f32,
+        /// pbrt-v4's layered evaluation (slab thickness, albedo, g, walk budget); `None` is
+        /// the closed-form thin-coat model of [`CoatedDiffuse`].
+        layer: Option<LayerParams>,
+    },
+    /// pbrt-v4 `coatedconductor`: a dielectric coat over a GGX conductor (layered BSDF).
+    CoatedConductor {
+        /// Coat index of refraction.
+        coat_eta: f32,
+        /// Coat GGX widths.
+        coat_alpha: Vec2,
+        /// Conductor η in air (per channel).
+        eta: Rgb,
+        /// Conductor k in air (per channel).
+        k: Rgb,
+        /// Conductor GGX widths.
+        alpha: Vec2,
+        /// pbrt's "reflectance" mode: normal-incidence reflectance overriding η/k.
+        reflectance: Option<Texture>,
+        /// Slab and walk parameters.
+        layer: LayerParams,
     },
     /// Glass-like dielectric (smooth or GGX rough).
     Dielectric {
@@ -113,7 +136,40 @@ impl Material {
                 reflectance,
                 alpha,
                 eta,
-            } => Bsdf::CoatedDiffuse(CoatedDiffuse::new(reflectance.eval(hit.uv), *alpha, *eta)),
+                layer,
+            } => match layer {
+                None => {
+                    Bsdf::CoatedDiffuse(CoatedDiffuse::new(reflectance.eval(hit.uv), *alpha, *eta))
+                }
+                Some(p) => Bsdf::Layered(Box::new(layered_diffuse(
+                    reflectance.eval(hit.uv),
+                    *eta,
+                    *alpha,
+                    *p,
+                ))),
+            },
+            Material::CoatedConductor {
+                coat_eta,
+                coat_alpha,
+                eta,
+                k,
+                alpha,
+                reflectance,
+                layer,
+            } => {
+                let (eta, k) = match reflectance {
+                    Some(r) => (Rgb::ONE, k_from_reflectance(r.eval(hit.uv))),
+                    None => (*eta, *k),
+                };
+                Bsdf::Layered(Box::new(coated_conductor(
+                    *coat_eta,
+                    *coat_alpha,
+                    eta,
+                    k,
+                    *alpha,
+                    *layer,
+                )))
+            }
             Material::Dielectric { eta, alpha } => Bsdf::Dielectric(Dielectric {
                 eta: *eta,
                 alpha: *alpha,
@@ -130,6 +186,12 @@ impl Material {
             Material::Conductor { alpha, .. } | Material::Dielectric { alpha, .. } => {
                 is_smooth(*alpha)
             }
+            Material::CoatedConductor {
+                coat_alpha,
+                alpha,
+                layer,
+                ..
+            } => is_smooth(*coat_alpha) && is_smooth(*alpha) && layer.albedo == Rgb::ZERO,
             Material::Diffuse { .. } | Material::Phong { .. } | Material::CoatedDiffuse { .. } => {
                 false
             }

@@ -425,6 +425,7 @@ fn gltf_material(
             reflectance,
             alpha,
             eta: 1.5,
+            layer: None,
         }
     } else {
         Material::Conductor {

@@ -5,6 +5,7 @@
 
 pub mod builder;
 pub mod builtin;
+pub mod film;
 pub mod gltf;
 pub mod load;
 pub mod obj;
@@ -69,6 +70,8 @@ pub struct FilmSpec {
     pub filename: Option<String>,
     /// Default eye rays per pixel, if the scene names one.
     pub spp: Option<u32>,
+    /// Sensor response applied to the finished image (pbrt-v4 `iso`, exposure, white balance).
+    pub sensor: film::SensorResponse,
 }
 
 /// Emission attached to a shape (pbrt `AreaLightSource "diffuse"`).

@@ -43,6 +43,7 @@ pub fn default_film() -> FilmSpec {
         filter: Filter::Triangle { radius: Vec2::ONE },
         filename: None,
         spp: None,
+        sensor: Default::default(),
     }
 }
 

@@ -34,6 +34,7 @@ pub fn cornell_film() -> FilmSpec {
         filter: Filter::Triangle { radius: Vec2::ONE },
         filename: None,
         spp: Some(64),
+        sensor: Default::default(),
     }
 }
 

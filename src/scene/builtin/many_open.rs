@@ -86,5 +86,6 @@ pub fn film() -> FilmSpec {
         },
         filename: None,
         spp: Some(16),
+        sensor: Default::default(),
     }
 }

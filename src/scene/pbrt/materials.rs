@@ -1,22 +1,25 @@
 //! pbrt materials → an internal [`MaterialDesc`], converted to [`Material`] by [`to_material`].
 //! The description keeps what the file said; the conversion says what penumbra approximates.
 
+use super::named_spectra;
 use super::params::{ParamSet, SpecVal};
-use super::spectra::{SpectrumUse, named_glass_ior, sampled_at, to_rgb};
+use super::spectra::{
+    SpectrumUse, conductor_rgb, named_glass_ior, sampled_at, spectrum_to_rgb, to_rgb,
+};
 use super::textures::{ImageCache, TextureDesc, TextureTable, Warn};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
-use crate::bsdf::{named_metal, roughness_to_alpha};
+use crate::bsdf::{LayerParams, roughness_to_alpha};
 use crate::material::{Material, Texture};
 use glam::Vec2;
 
-/// A metal's eta or k: RGB, or one of pbrt's named spectra (`metal-Cu-eta`, …).
+/// A metal's eta or k: RGB, or a spectrum (named `metal-*`, inline or from a `.spd` file).
 #[derive(Clone, Debug, PartialEq)]
 pub enum MetalSpectrum {
     /// Explicit RGB.
     Rgb(Rgb),
-    /// pbrt named spectrum (resolved by `bsdf::named_metal`).
-    Named(String),
+    /// (λ nm, value) pairs, reduced to RGB with the other half by `spectra::conductor_rgb`.
+    Spectral(Vec<(f32, f32)>),
 }
 
 /// A material as the scene file describes it.
@@ -50,6 +53,27 @@ pub enum MaterialDesc {
         eta: f32,
         /// pbrt's `remaproughness`.
         remap: bool,
+        /// `thickness`, `albedo`, `g`, `maxdepth`, `nsamples`.
+        layer: LayerParams,
+    },
+    /// `coatedconductor`.
+    CoatedConductor {
+        /// `interface.eta`.
+        coat_eta: f32,
+        /// `interface.(u|v)roughness` as given.
+        coat_roughness: Vec2,
+        /// `conductor.eta`.
+        eta: MetalSpectrum,
+        /// `conductor.k`.
+        k: MetalSpectrum,
+        /// `reflectance` instead of eta/k.
+        reflectance: Option<TextureDesc>,
+        /// `conductor.(u|v)roughness` as given.
+        roughness: Vec2,
+        /// pbrt's `remaproughness` (both layers).
+        remap: bool,
+        /// `thickness`, `albedo`, `g`, `maxdepth`, `nsamples`.
+        layer: LayerParams,
     },
     /// `dielectric` / `thindielectric`.
     Dielectric {
@@ -81,42 +105,137 @@ fn roughness(
     default: f32,
     warn: &mut Warn,
 ) -> anyhow::Result<Vec2> {
-    let r = tex.float_param(params, "roughness", default, warn)?;
-    let u = if params.has("uroughness") {
-        tex.float_param(params, "uroughness", r, warn)?
+    prefixed_roughness(params, tex, "", default, warn)
+}
+
+/// `{prefix}roughness`, overridden per axis by `{prefix}uroughness` / `{prefix}vroughness`.
+fn prefixed_roughness(
+    params: &ParamSet,
+    tex: &TextureTable,
+    prefix: &str,
+    default: f32,
+    warn: &mut Warn,
+) -> anyhow::Result<Vec2> {
+    let (rn, un, vn) = (
+        format!("{prefix}roughness"),
+        format!("{prefix}uroughness"),
+        format!("{prefix}vroughness"),
+    );
+    let r = tex.float_param(params, &rn, default, warn)?;
+    let u = if params.has(&un) {
+        tex.float_param(params, &un, r, warn)?
     } else {
         r
     };
-    let v = if params.has("vroughness") {
-        tex.float_param(params, "vroughness", r, warn)?
+    let v = if params.has(&vn) {
+        tex.float_param(params, &vn, r, warn)?
     } else {
         r
     };
     Ok(Vec2::new(u, v).max(Vec2::ZERO))
 }
 
+/// pbrt-v4's layered-material parameters (`thickness`, `albedo`, `g`, `maxdepth`,
+/// `nsamples`), checked.
+fn layer_params(
+    params: &ParamSet,
+    tex: &TextureTable,
+    loc: &Loc,
+    warn: &mut Warn,
+) -> anyhow::Result<LayerParams> {
+    let thickness = tex.float_param(params, "thickness", 0.01, warn)?;
+    let g = tex.float_param(params, "g", 0.0, warn)?;
+    let albedo = match tex.spectrum_param(params, "albedo", Some(Rgb::ZERO))? {
+        Some(TextureDesc::Constant(c)) => c,
+        Some(_) => {
+            warn(
+                "layer-albedo-texture",
+                loc,
+                "varying 'albedo' texture of a layered material approximated by 0.5".into(),
+            );
+            Rgb::splat(0.5)
+        }
+        None => Rgb::ZERO,
+    };
+    let max_depth = params.int("maxdepth", 10)?;
+    let n_samples = params.int("nsamples", 1)?;
+    if !(thickness.is_finite() && thickness >= 0.0) {
+        return Err(err_at(
+            loc,
+            format!("'thickness' must be ≥ 0, found {thickness}"),
+        ));
+    }
+    if !(g.is_finite() && g > -1.0 && g < 1.0) {
+        return Err(err_at(loc, format!("'g' must be in (−1, 1), found {g}")));
+    }
+    if !(1..=1000).contains(&max_depth) || !(1..=1000).contains(&n_samples) {
+        return Err(err_at(
+            loc,
+            format!(
+                "'maxdepth' and 'nsamples' must be in 1..=1000, found {max_depth}, {n_samples}"
+            ),
+        ));
+    }
+    Ok(LayerParams {
+        thickness,
+        albedo,
+        g,
+        max_depth: max_depth as u32,
+        n_samples: n_samples as u32,
+    })
+}
+
 fn metal(params: &ParamSet, name: &str, default: &str) -> anyhow::Result<MetalSpectrum> {
+    let table = |n: &str| named_spectra::spectrum(n).map(MetalSpectrum::Spectral);
     Ok(match params.spectrum(name)? {
-        None => MetalSpectrum::Named(default.into()),
-        Some(SpecVal::Named(n)) => MetalSpectrum::Named(n),
+        None => table(default).unwrap_or(MetalSpectrum::Rgb(Rgb::ONE)),
+        Some(SpecVal::Sampled(p)) => MetalSpectrum::Spectral(p),
+        Some(SpecVal::Named(n)) => table(&n).unwrap_or_else(|| {
+            MetalSpectrum::Rgb(
+                to_rgb(&SpecVal::Named(n), SpectrumUse::Unbounded).unwrap_or(Rgb::ONE),
+            )
+        }),
         Some(v) => MetalSpectrum::Rgb(to_rgb(&v, SpectrumUse::Unbounded).unwrap_or(Rgb::ONE)),
     })
 }
 
-fn ior(params: &ParamSet, loc: &Loc) -> anyhow::Result<f32> {
+fn ior(params: &ParamSet, name: &str, loc: &Loc, warn: &mut Warn) -> anyhow::Result<f32> {
     use super::params::ParamType;
-    let eta = match params.type_of("eta") {
-        None | Some(ParamType::Float | ParamType::Integer) => params.float("eta", 1.5)?,
-        Some(_) => match params.spectrum("eta")? {
-            Some(SpecVal::Named(n)) => named_glass_ior(&n)
-                .ok_or_else(|| err_at(loc, format!("'eta': unknown named spectrum \"{n}\"")))?,
-            Some(SpecVal::Sampled(p)) => sampled_at(&p, 550.0) as f32,
+    let mut dispersive = || {
+        warn(
+            "dispersion",
+            loc,
+            format!(
+                "spectral '{name}': dispersion approximated by the index at 550 nm (penumbra renders RGB)"
+            ),
+        )
+    };
+    let eta = match params.type_of(name) {
+        None | Some(ParamType::Float | ParamType::Integer) => params.float(name, 1.5)?,
+        Some(_) => match params.spectrum(name)? {
+            Some(SpecVal::Named(n)) => {
+                let v = named_glass_ior(&n).ok_or_else(|| {
+                    err_at(
+                        loc,
+                        format!("'{name}': \"{n}\" is not an index of refraction"),
+                    )
+                })?;
+                dispersive();
+                v
+            }
+            Some(SpecVal::Sampled(p)) => {
+                dispersive();
+                sampled_at(&p, 550.0) as f32
+            }
             Some(SpecVal::Rgb(c)) => c.y,
             Some(SpecVal::Blackbody(_)) | None => 1.5,
         },
     };
     if !(eta.is_finite() && eta > 0.0) {
-        return Err(err_at(loc, format!("'eta' must be positive, found {eta}")));
+        return Err(err_at(
+            loc,
+            format!("'{name}' must be positive, found {eta}"),
+        ));
     }
     Ok(eta)
 }
@@ -171,19 +290,25 @@ pub fn parse_material(
             roughness: roughness(params, tex, 0.0, warn)?,
             remap: params.bool("remaproughness", true)?,
         },
-        "coateddiffuse" => {
-            for ignored in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
-                let _ = params.find(ignored);
-            }
-            MaterialDesc::CoatedDiffuse {
-                reflectance: tex
-                    .spectrum_param(params, "reflectance", Some(Rgb::splat(0.5)))?
-                    .unwrap_or(TextureDesc::Constant(Rgb::splat(0.5))),
-                roughness: roughness(params, tex, 0.0, warn)?,
-                eta: ior(params, loc)?,
-                remap: params.bool("remaproughness", true)?,
-            }
-        }
+        "coateddiffuse" => MaterialDesc::CoatedDiffuse {
+            reflectance: tex
+                .spectrum_param(params, "reflectance", Some(Rgb::splat(0.5)))?
+                .unwrap_or(TextureDesc::Constant(Rgb::splat(0.5))),
+            roughness: roughness(params, tex, 0.0, warn)?,
+            eta: ior(params, "eta", loc, warn)?,
+            remap: params.bool("remaproughness", true)?,
+            layer: layer_params(params, tex, loc, warn)?,
+        },
+        "coatedconductor" => MaterialDesc::CoatedConductor {
+            coat_eta: ior(params, "interface.eta", loc, warn)?,
+            coat_roughness: prefixed_roughness(params, tex, "interface.", 0.0, warn)?,
+            eta: metal(params, "conductor.eta", "metal-Cu-eta")?,
+            k: metal(params, "conductor.k", "metal-Cu-k")?,
+            reflectance: tex.spectrum_param(params, "reflectance", None)?,
+            roughness: prefixed_roughness(params, tex, "conductor.", 0.0, warn)?,
+            remap: params.bool("remaproughness", true)?,
+            layer: layer_params(params, tex, loc, warn)?,
+        },
         "dielectric" | "thindielectric" => {
             let thin = ty == "thindielectric";
             if thin {
@@ -194,7 +319,7 @@ pub fn parse_material(
                 );
             }
             MaterialDesc::Dielectric {
-                eta: ior(params, loc)?,
+                eta: ior(params, "eta", loc, warn)?,
                 roughness: roughness(params, tex, 0.0, warn)?,
                 remap: params.bool("remaproughness", true)?,
                 thin,
@@ -270,6 +395,19 @@ fn texture(t: &TextureDesc, images: &ImageCache) -> anyhow::Result<Texture> {
     })
 }
 
+/// RGB (η, k) of a conductor: both spectral → matched to the spectral Fresnel reflectance
+/// (`spectra::conductor_rgb`); otherwise each half on its own.
+pub fn conductor_pair(eta: &MetalSpectrum, k: &MetalSpectrum) -> (Rgb, Rgb) {
+    let one = |m: &MetalSpectrum| match m {
+        MetalSpectrum::Rgb(c) => *c,
+        MetalSpectrum::Spectral(p) => spectrum_to_rgb(|l| sampled_at(p, l)).max(Rgb::ZERO),
+    };
+    match (eta, k) {
+        (MetalSpectrum::Spectral(e), MetalSpectrum::Spectral(kk)) => conductor_rgb(e, kk),
+        _ => (one(eta), one(k)),
+    }
+}
+
 fn push_once(warnings: &mut Vec<String>, msg: String) {
     if !warnings.contains(&msg) {
         warnings.push(msg);
@@ -301,29 +439,7 @@ pub fn to_material(
             roughness,
             remap,
         } => {
-            let mut metal = |m: &MetalSpectrum, pick_k: bool| -> Rgb {
-                match m {
-                    MetalSpectrum::Rgb(c) => *c,
-                    MetalSpectrum::Named(name) => match named_metal(name) {
-                        Some((e, kk)) => {
-                            if pick_k {
-                                kk
-                            } else {
-                                e
-                            }
-                        }
-                        None => {
-                            push_once(
-                                warnings,
-                                format!("warning: unknown named spectrum \"{name}\"; using copper"),
-                            );
-                            let (e, kk) = named_metal("metal-Cu-eta").unwrap_or_default();
-                            if pick_k { kk } else { e }
-                        }
-                    },
-                }
-            };
-            let (eta, k) = (metal(eta, false), metal(k, true));
+            let (eta, k) = conductor_pair(eta, k);
             let reflectance = match reflectance {
                 Some(t) => Some(texture(t, images)?),
                 None => None,
@@ -340,11 +456,38 @@ pub fn to_material(
             roughness,
             eta,
             remap,
+            layer,
         } => Material::CoatedDiffuse {
             reflectance: texture(reflectance, images)?,
             alpha: alpha(*roughness, *remap),
             eta: *eta,
+            layer: Some(*layer),
         },
+        MaterialDesc::CoatedConductor {
+            coat_eta,
+            coat_roughness,
+            eta,
+            k,
+            reflectance,
+            roughness,
+            remap,
+            layer,
+        } => {
+            let (eta, k) = conductor_pair(eta, k);
+            let reflectance = match reflectance {
+                Some(t) => Some(texture(t, images)?),
+                None => None,
+            };
+            Material::CoatedConductor {
+                coat_eta: *coat_eta,
+                coat_alpha: alpha(*coat_roughness, *remap),
+                eta,
+                k,
+                alpha: alpha(*roughness, *remap),
+                reflectance,
+                layer: *layer,
+            }
+        }
         MaterialDesc::Dielectric {
             eta,
             roughness,

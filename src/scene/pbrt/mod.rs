@@ -7,8 +7,11 @@
 //! `file:line:column: expected X, found Y`; unsupported features are one warning per kind
 //! (`file:line: warning: …`) and the load continues.
 
+pub mod cie_data;
+pub mod film;
 pub mod lights;
 pub mod materials;
+pub mod named_spectra;
 pub mod params;
 pub mod parser;
 pub mod ply;
@@ -16,6 +19,7 @@ pub mod shapes;
 pub mod spectra;
 pub mod textures;
 pub mod tokenizer;
+pub mod upgrade;
 
 use crate::camera::Camera;
 use crate::scene::{AreaEmission, FilmSpec, Scene, SceneBuilder};

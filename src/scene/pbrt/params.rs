@@ -102,6 +102,21 @@ pub struct Param {
     used: Cell<bool>,
 }
 
+impl Param {
+    /// The value of a numeric parameter whose values are all equal (a grey `rgb`, a single
+    /// `float`), else `None`.
+    pub fn constant(&self) -> Option<f64> {
+        match (&self.ty, &self.values) {
+            (ParamType::Float | ParamType::Integer | ParamType::Rgb, Values::Nums(v))
+                if !v.is_empty() && v.iter().all(|x| *x == v[0]) =>
+            {
+                Some(v[0])
+            }
+            _ => None,
+        }
+    }
+}
+
 /// A spectrum-valued parameter before conversion to RGB (see `spectra`).
 #[derive(Clone, Debug, PartialEq)]
 pub enum SpecVal {
@@ -233,7 +248,7 @@ impl ParamSet {
                 _ => want_count(&p, 1, 0, true)?,
             },
             ParamType::Blackbody => {
-                // pbrt-v3 files give [T scale]; the scale is ignored as pbrt-v4 does.
+                // pbrt-v3 files give [T scale]; lights fold the scale in (`upgrade`).
                 if let Values::Nums(v) = &p.values {
                     if v.len() != 1 && v.len() != 2 {
                         want_count(&p, 1, 0, true)?;
@@ -310,6 +325,73 @@ impl ParamSet {
                 Ok(Values::Nums(v))
             }
         }
+    }
+
+    /// Replace every `"spectrum"` string that is not one of pbrt-v4's named spectra by the
+    /// (λ, value) pairs of the `.spd` file it names, relative to `dir` (pbrt's format: pairs of
+    /// numbers, `#` comments). A missing file is an error listing the named spectra; a bad file
+    /// an error at its own line.
+    pub fn resolve_spectrum_files(&mut self, dir: &std::path::Path) -> anyhow::Result<()> {
+        for p in &mut self.params {
+            if p.ty != ParamType::Spectrum {
+                continue;
+            }
+            let Values::Strs(names) = &p.values else {
+                continue;
+            };
+            let Some(name) = names.first().cloned() else {
+                continue;
+            };
+            if super::named_spectra::kind(&name).is_some() {
+                continue;
+            }
+            let path = super::textures::resolve(dir, &name);
+            let text = match std::fs::read_to_string(&path) {
+                Ok(t) => t,
+                Err(e) => {
+                    return Err(err_at(
+                        &p.loc,
+                        format!(
+                            "spectrum '{}': \"{name}\" is neither a named spectrum nor a readable file ({}: {e}); named spectra: {}",
+                            p.name,
+                            path.display(),
+                            super::named_spectra::all_names().join(", ")
+                        ),
+                    ));
+                }
+            };
+            p.values = Values::Nums(read_spd(&path, &text)?);
+        }
+        Ok(())
+    }
+
+    /// Rename every parameter called `from` (pbrt-v4's `--upgrade` renames).
+    pub fn rename(&mut self, from: &str, to: &str) {
+        for p in &mut self.params {
+            if p.name == from {
+                p.name = to.to_string();
+            }
+        }
+    }
+
+    /// Remove the parameters called `name`, returning the last one.
+    pub fn remove(&mut self, name: &str) -> Option<Param> {
+        let i = self.params.iter().rposition(|p| p.name == name)?;
+        let p = self.params.remove(i);
+        self.params.retain(|q| q.name != name);
+        Some(p)
+    }
+
+    /// Add a parameter (replacing any of the same name).
+    pub fn push(&mut self, ty: ParamType, name: &str, values: Values, loc: Loc) {
+        self.params.retain(|q| q.name != name);
+        self.params.push(Param {
+            ty,
+            name: name.to_string(),
+            values,
+            loc,
+            used: Cell::new(false),
+        });
     }
 
     /// The parameter called `name`, marking it used.
@@ -571,6 +653,47 @@ impl ParamSet {
             _ => return Ok(None),
         }))
     }
+}
+
+/// Parse a pbrt `.spd` file: whitespace-separated numbers in (λ, value) pairs with
+/// increasing λ; `#` starts a comment. Errors name `path:line`.
+pub fn read_spd(path: &std::path::Path, text: &str) -> anyhow::Result<Vec<f64>> {
+    let mut v = Vec::new();
+    let mut last_line = 1;
+    for (i, line) in text.lines().enumerate() {
+        let body = line.split('#').next().unwrap_or("");
+        for w in body.split_whitespace() {
+            let x: f64 = w.parse().map_err(|_| {
+                anyhow::anyhow!(
+                    "{}:{}: expected a number in the spectrum file, found \"{w}\"",
+                    path.display(),
+                    i + 1
+                )
+            })?;
+            if !x.is_finite() {
+                anyhow::bail!("{}:{}: non-finite value {w}", path.display(), i + 1);
+            }
+            if v.len() % 2 == 0 && v.len() >= 2 && x <= v[v.len() - 2] {
+                anyhow::bail!(
+                    "{}:{}: wavelengths must increase, found {x} after {}",
+                    path.display(),
+                    i + 1,
+                    v[v.len() - 2]
+                );
+            }
+            v.push(x);
+            last_line = i + 1;
+        }
+    }
+    if v.is_empty() || v.len() % 2 != 0 {
+        anyhow::bail!(
+            "{}:{}: expected (wavelength, value) pairs, found {} number(s)",
+            path.display(),
+            last_line,
+            v.len()
+        );
+    }
+    Ok(v)
 }
 
 #[cfg(test)]

@@ -5,8 +5,9 @@ use super::lights::{AreaLightDesc, parse_area_light, parse_light};
 use super::materials::{MaterialCtx, MaterialDesc, parse_material};
 use super::params::ParamSet;
 use super::shapes::{ShapeCtx, make_shape};
-use super::textures::TextureTable;
+use super::textures::{TextureTable, Warn};
 use super::tokenizer::{Loc, Tok, Token, Tokenizer, err_at};
+use super::upgrade;
 use super::{PbrtScene, ShapeCall};
 use crate::camera::{Camera, Lens, Projection, SphericalMapping};
 use crate::geometry::Transform;
@@ -53,6 +54,12 @@ pub struct Parser {
     world_seen: Option<Loc>,
     warned: HashSet<String>,
     camera: Option<Camera>,
+    /// Film sensor parameters and where the Film directive is.
+    sensor: (super::film::SensorParams, Option<Loc>),
+    /// `exposuretime` given on the Film (else the camera's shutter interval).
+    film_exposure: Option<f32>,
+    /// The camera's `shutterclose − shutteropen`.
+    camera_exposure: f32,
     out: PbrtScene,
 }
 
@@ -66,6 +73,7 @@ fn film_default() -> FilmSpec {
         },
         filename: None,
         spp: None,
+        sensor: Default::default(),
     }
 }
 
@@ -102,6 +110,9 @@ impl Parser {
             world_seen: None,
             warned: HashSet::new(),
             camera: None,
+            sensor: (Default::default(), None),
+            film_exposure: None,
+            camera_exposure: 1.0,
             out: PbrtScene {
                 camera: Camera {
                     camera_to_world: Transform::IDENTITY,
@@ -221,8 +232,21 @@ impl Parser {
         Ok(v)
     }
 
+    /// Run a pbrt-v3 rewrite (`upgrade`) and report its warnings.
+    fn upgrade<R>(&mut self, f: impl FnOnce(&mut Warn) -> R) -> R {
+        let mut pending = Vec::new();
+        let r = f(&mut |k: &str, l: &Loc, m: String| pending.push((k.to_string(), l.clone(), m)));
+        for (k, l, m) in pending {
+            self.warn(&k, &l, m);
+        }
+        r
+    }
+
     fn params(&mut self) -> anyhow::Result<ParamSet> {
-        ParamSet::parse(&mut self.top().tok)
+        let dir = self.dir();
+        let mut ps = ParamSet::parse(&mut self.top().tok)?;
+        ps.resolve_spectrum_files(&dir)?;
+        Ok(ps)
     }
 
     fn report_unused(&mut self, ps: &ParamSet, what: &str) {
@@ -297,6 +321,11 @@ impl Parser {
                 &loc,
                 format!("{kind} without matching End at end of file"),
             );
+        }
+        if let (mut params, Some(loc)) = self.sensor.clone() {
+            params.exposure_time = self.film_exposure.unwrap_or(self.camera_exposure);
+            let r = self.upgrade(|w| super::film::sensor_response(&params, &loc, w))?;
+            self.out.film.sensor = r;
         }
         self.out.images = std::mem::take(&mut self.textures.images);
         if let Some(cam) = self.camera.take() {
@@ -601,6 +630,11 @@ impl Parser {
                     }
                     (sw, _) => sw,
                 };
+                let (open, close) = (
+                    ps.float("shutteropen", 0.0)?,
+                    ps.float("shutterclose", 1.0)?,
+                );
+                self.camera_exposure = close - open;
                 self.report_unused(&ps, "Camera");
                 // The CTM here is camera-from-world.
                 let world_from_camera = self.gs.ctm.inverse();
@@ -616,7 +650,8 @@ impl Parser {
             "Film" => {
                 self.require_world(name, &loc, false)?;
                 let (ty, _) = self.expect_string("a film type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                let ty = self.upgrade(|w| upgrade::film(&ty, &mut ps, &loc, w));
                 if ty != "rgb" {
                     self.warn(
                         "film-type",
@@ -640,15 +675,17 @@ impl Parser {
                         self.warn(p, &loc, format!("Film '{p}' ignored"));
                     }
                 }
-                for p in [
-                    "iso",
-                    "exposuretime",
-                    "whitebalance",
-                    "sensor",
-                    "savefp16",
-                    "diagonal",
-                    "maxcomponentvalue",
-                ] {
+                self.sensor = (
+                    super::film::SensorParams {
+                        iso: ps.float("iso", 100.0)?,
+                        white_balance: ps.float("whitebalance", 0.0)?,
+                        sensor: ps.string("sensor")?.unwrap_or_else(|| "cie1931".into()),
+                        exposure_time: 1.0,
+                    },
+                    Some(loc.clone()),
+                );
+                self.film_exposure = ps.opt_float("exposuretime")?;
+                for p in ["savefp16", "diagonal", "maxcomponentvalue"] {
                     let _ = ps.find(p);
                 }
                 self.report_unused(&ps, "Film");
@@ -680,7 +717,8 @@ impl Parser {
             "PixelFilter" => {
                 self.require_world(name, &loc, false)?;
                 let (ty, tloc) = self.expect_string("a filter type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                upgrade::filter(&ty, &mut ps);
                 let default_r = match ty.as_str() {
                     "box" => 0.5,
                     "gaussian" => 1.5,
@@ -881,7 +919,8 @@ impl Parser {
             "LightSource" => {
                 self.require_world(name, &loc, true)?;
                 let (ty, _) = self.expect_string("a light type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                let ty = self.upgrade(|w| upgrade::light(&ty, &mut ps, &loc, w));
                 let dir = self.dir();
                 let mut pending = Vec::new();
                 let l = parse_light(
@@ -904,7 +943,8 @@ impl Parser {
             "AreaLightSource" => {
                 self.require_world(name, &loc, true)?;
                 let (ty, _) = self.expect_string("an area light type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                let ty = self.upgrade(|w| upgrade::area_light(&ty, &mut ps, &loc, w));
                 let mut pending = Vec::new();
                 let a = parse_area_light(&ty, &ps, &loc, &mut |k: &str, l: &Loc, m: String| {
                     pending.push((k.to_string(), l.clone(), m))
@@ -918,7 +958,8 @@ impl Parser {
             "Material" => {
                 self.require_world(name, &loc, true)?;
                 let (ty, _) = self.expect_string("a material type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                let ty = self.upgrade(|w| upgrade::material(&ty, &mut ps, &loc, w));
                 let d = self.parse_material_desc(&ty, &ps, &loc)?;
                 self.report_unused(&ps, &format!("Material \"{ty}\""));
                 self.descs.push(d);
@@ -928,13 +969,14 @@ impl Parser {
             "MakeNamedMaterial" => {
                 self.require_world(name, &loc, true)?;
                 let (n, _) = self.expect_string("a material name")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
                 let ty = ps.string("type")?.ok_or_else(|| {
                     err_at(
                         &loc,
                         format!("MakeNamedMaterial \"{n}\": expected \"string type\", found none"),
                     )
                 })?;
+                let ty = self.upgrade(|w| upgrade::material(&ty, &mut ps, &loc, w));
                 let d = self.parse_material_desc(&ty, &ps, &loc)?;
                 self.report_unused(&ps, &format!("Material \"{ty}\""));
                 if self.named_materials.contains_key(&n) {
@@ -961,7 +1003,8 @@ impl Parser {
                 let (n, _) = self.expect_string("a texture name")?;
                 let (ty, _) = self.expect_string("a texture type (\"spectrum\" or \"float\")")?;
                 let (class, _) = self.expect_string("a texture class")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                upgrade::texture(&class, &mut ps);
                 let dir = self.dir();
                 let mut pending = Vec::new();
                 self.textures.define(
@@ -981,7 +1024,8 @@ impl Parser {
             "Shape" => {
                 self.require_world(name, &loc, true)?;
                 let (ty, _) = self.expect_string("a shape type")?;
-                let ps = self.params()?;
+                let mut ps = self.params()?;
+                upgrade::shape(&ty, &mut ps);
                 self.shape(&ty, &ps, &loc)?;
                 self.report_unused(&ps, &format!("Shape \"{ty}\""));
             }
