@@ -13,7 +13,7 @@ use penumbra::sampling::Frame;
 use penumbra::sampling::chi2::{Chi2Config, Chi2Result, chi2_directions, chi2_points};
 
 /// Number of chi-square tests in this file (for the Šidák correction); keep in sync.
-const NUM_TESTS: usize = 43;
+const NUM_TESTS: usize = 54;
 
 fn cfg() -> Chi2Config {
     Chi2Config {
@@ -256,6 +256,75 @@ fn chi2_rough_dielectric() {
         sphere(
             &format!("rough glass α={alpha} entering={entering} {deg}°"),
             &b,
+            wo_at(deg),
+        );
+    }
+}
+
+fn glass(eta: f32, alpha: Vec2, entering: bool) -> Bsdf {
+    Bsdf::Dielectric(penumbra::bsdf::Dielectric {
+        eta,
+        alpha,
+        entering,
+    })
+}
+
+#[test]
+fn chi2_rough_dielectric_etas_roughnesses_and_sides() {
+    // Both lobes over the whole sphere; from inside both below the critical angle (41.8° for
+    // η = 1.5, 24.6° for η = 2.4) and beyond it, where microfacet TIR sends most samples back.
+    for (eta, alpha, entering, deg) in [
+        (1.5, Vec2::splat(0.1), false, 20.0),
+        (1.5, Vec2::splat(0.1), false, 60.0),
+        (1.33, Vec2::splat(0.7), true, 70.0),
+        (2.4, Vec2::splat(0.3), false, 40.0),
+        (1.5, Vec2::new(0.05, 0.3), false, 30.0),
+    ] {
+        let b = glass(eta, alpha, entering);
+        sphere(
+            &format!("rough glass η={eta} α={alpha} entering={entering} {deg}°"),
+            &b,
+            wo_at(deg),
+        );
+    }
+}
+
+#[test]
+fn chi2_rough_dielectric_sharp_transmission_zoomed() {
+    use penumbra::bsdf::dielectric::refract_z;
+    // α = 0.05: the transmitted lobe is a few degrees wide; look at it closely, from outside
+    // and from inside (the window's outside is the harness's "nowhere", so the mass there is
+    // tested too).
+    for (entering, deg) in [(true, 45.0), (false, 25.0)] {
+        let b = glass(1.5, Vec2::splat(0.05), entering);
+        let wo = wo_at(deg);
+        let eta = if entering { 1.5 } else { 1.0 / 1.5 };
+        let axis = refract_z(wo, eta).expect("below the critical angle");
+        let name = format!("rough glass α=0.05 entering={entering} {deg}° transmission");
+        zoomed(&name, &b, wo, axis, 0.4);
+    }
+}
+
+// ---------------------------------------------------------------- diffuse transmission
+
+#[test]
+fn chi2_diffuse_transmission() {
+    use penumbra::bsdf::DiffuseTransmission;
+    // The density does not depend on wo (beyond its side), so one angle per case suffices.
+    let dt = |r: f32, t: f32, s: LobeSampling| {
+        let mut b = DiffuseTransmission::new(Rgb::new(r, r * 0.5, r), Rgb::new(t, t, t * 0.2));
+        b.sampling = s;
+        Bsdf::DiffuseTransmission(b)
+    };
+    for (r, t, s, deg) in [
+        (0.3, 0.6, LobeSampling::Importance, 30.0),
+        (0.0, 0.5, LobeSampling::Importance, 45.0),
+        (0.5, 0.0, LobeSampling::Importance, 45.0),
+        (0.7, 0.2, LobeSampling::Uniform, 60.0),
+    ] {
+        sphere(
+            &format!("diffuse transmission R={r} T={t} {s:?} {deg}°"),
+            &dt(r, t, s),
             wo_at(deg),
         );
     }

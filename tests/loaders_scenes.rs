@@ -50,6 +50,7 @@ fn check_render(scene: &Scene, what: &str) {
         "{what}: non-finite pixel"
     );
     let mean: f32 = img.pixels.iter().map(|p| p.x + p.y + p.z).sum::<f32>() / (3.0 * 4096.0);
+    eprintln!("{what}: mean {mean}");
     assert!(mean > 1e-3, "{what}: image is black (mean {mean})");
     let (bx, by) = brightest_block(&img, 4);
     let light_px = scene
@@ -130,6 +131,20 @@ fn tinyobjloader_obj_with_ka_emission_loads_and_renders() {
         "Ka 20 20 20 on the light quad"
     );
     check_render(&loaded.scene, "tinyobjloader OBJ (--obj-ka-emission)");
+}
+
+#[test]
+fn tinyobjloader_box_auto_framing_looks_into_the_open_side() {
+    // No camera in the file and the box is open toward −z: automatic framing must look in.
+    let path = shared("cornell-box-tinyobjloader/cornell_box.obj");
+    let opts = LoadOptions {
+        obj_ka_emission: true,
+        ..Default::default()
+    };
+    let loaded = load(&path, &opts).expect("load");
+    check_render(&loaded.scene, "tinyobjloader OBJ (automatic framing)");
+    let eye = loaded.scene.camera.camera_to_world.point(Vec3::ZERO);
+    assert!(eye.z < 0.0, "the eye {eye} is not on the open (−z) side");
 }
 
 #[test]

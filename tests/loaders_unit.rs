@@ -702,3 +702,222 @@ fn gltf_base_color_texture_from_a_data_uri() {
         loaded.warnings
     );
 }
+
+// ---------------------------------------------------------------- camera flags and framing
+
+/// An open box (no wall on −z) with an emissive lamp under its ceiling, as OBJ.
+const OPEN_BOX_OBJ: &str = "mtllib m.mtl\n\
+v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+v 0.4 0.99 0.4\nv 0.6 0.99 0.4\nv 0.6 0.99 0.6\nv 0.4 0.99 0.6\n\
+usemtl wall\n\
+f 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n\
+usemtl lamp\nf 9 10 11 12\n";
+
+fn open_box(dir: &std::path::Path) -> PathBuf {
+    write(
+        dir,
+        "m.mtl",
+        b"newmtl wall\nKd 0.7 0.7 0.7\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n",
+    );
+    write(dir, "box.obj", OPEN_BOX_OBJ.as_bytes())
+}
+
+/// The `--look-from/--look-at/--up/--fov` values of a note.
+fn flags_of(note: &str) -> penumbra::scene::view::ViewOptions {
+    let words: Vec<&str> = note.split_whitespace().collect();
+    let get = |flag: &str| -> &str {
+        let i = words
+            .iter()
+            .position(|w| *w == flag)
+            .unwrap_or_else(|| panic!("{flag} missing in '{note}'"));
+        words[i + 1]
+    };
+    let v3 = |s: &str| {
+        let c: Vec<f32> = s.split(',').map(|x| x.parse().expect("number")).collect();
+        Vec3::new(c[0], c[1], c[2])
+    };
+    penumbra::scene::view::ViewOptions {
+        look_from: Some(v3(get("--look-from"))),
+        look_at: Some(v3(get("--look-at"))),
+        up: Some(v3(get("--up"))),
+        fov: Some(get("--fov").parse().expect("fov")),
+    }
+}
+
+#[test]
+fn automatic_framing_looks_into_the_open_side_and_prints_pasteable_flags() {
+    let d = scratch("open-box");
+    let p = open_box(&d);
+    let l = load_obj(&p, &LoadOptions::default()).expect("load");
+    // The box is open toward −z: the eye must be there, looking at the centre.
+    let eye = l.scene.camera.camera_to_world.point(Vec3::ZERO);
+    assert!(eye.z < 0.0 && (eye.x - 0.5).abs() < 1e-4, "eye {eye}");
+    assert_eq!(l.notes.len(), 1, "{:?}", l.notes);
+    let note = &l.notes[0];
+    assert!(note.contains("from -z"), "{note}");
+    // Pasting the printed flags gives the same camera.
+    let again = load_obj(
+        &p,
+        &LoadOptions {
+            view: flags_of(note),
+            ..Default::default()
+        },
+    )
+    .expect("load with the printed flags");
+    let (a, b) = (
+        l.scene.camera.camera_to_world.m,
+        again.scene.camera.camera_to_world.m,
+    );
+    assert!(
+        a.abs_diff_eq(b, 1e-3),
+        "printed flags give another camera:\n{a}\n{b}"
+    );
+    assert_eq!(l.scene.camera.fov_deg, again.scene.camera.fov_deg);
+}
+
+#[test]
+fn automatic_framing_with_nothing_lit_keeps_the_plus_z_view() {
+    let d = scratch("unlit");
+    write(
+        &d,
+        "m.mtl",
+        b"newmtl wall\nKd 0.7 0.7 0.7\nnewmtl lamp\nKd 0 0 0\n",
+    );
+    let p = write(&d, "box.obj", OPEN_BOX_OBJ.as_bytes());
+    let l = load_obj(&p, &LoadOptions::default()).expect("load");
+    let eye = l.scene.camera.camera_to_world.point(Vec3::ZERO);
+    assert!(eye.z > 1.0 && (eye.x - 0.5).abs() < 1e-4, "eye {eye}");
+    // The same scene twice gives the same camera (the probe is deterministic).
+    let again = load_obj(&p, &LoadOptions::default()).expect("load");
+    assert_eq!(
+        l.scene.camera.camera_to_world.m,
+        again.scene.camera.camera_to_world.m
+    );
+}
+
+#[test]
+fn camera_flags_refine_a_gltf_files_own_camera() {
+    use penumbra::scene::view::ViewOptions;
+    let d = scratch("gltf-flags");
+    write(&d, "t.bin", &triangle_bin([0, 1, 2]));
+    let p = write(
+        &d,
+        "s.gltf",
+        gltf_json(r#"{"byteLength": 44, "uri": "t.bin"}"#).as_bytes(),
+    );
+    let plain = load_gltf(&p, &LoadOptions::default()).expect("load");
+    assert!(plain.notes.is_empty(), "{:?}", plain.notes);
+    let fov = load_gltf(
+        &p,
+        &LoadOptions {
+            view: ViewOptions {
+                fov: Some(25.0),
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+    )
+    .expect("load");
+    // --fov alone keeps the file's eye and direction and changes the field of view.
+    assert_eq!(fov.scene.camera.fov_deg, 25.0);
+    assert_eq!(
+        fov.scene.camera.camera_to_world.m,
+        plain.scene.camera.camera_to_world.m
+    );
+    assert!(fov.notes[0].contains("--fov 25"), "{:?}", fov.notes);
+}
+
+#[test]
+fn scene_builder_repairs_meshes_and_notes_it() {
+    use penumbra::material::{Material, Texture};
+    use penumbra::scene::{SceneBuilder, TriangleMesh};
+    let mut b = SceneBuilder::new();
+    let m = b.add_material(Material::Diffuse {
+        reflectance: Texture::Constant(Vec3::splat(0.5)),
+    });
+    let tri = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+    b.add_mesh(
+        TriangleMesh {
+            positions: tri.clone(),
+            normals: Some(vec![Vec3::NAN, Vec3::Z, Vec3::Z]),
+            uvs: None,
+            indices: vec![0, 1, 2],
+            flip_normals: false,
+        },
+        m,
+        None,
+    )
+    .expect("a NaN normal is repaired");
+    b.add_mesh(TriangleMesh::default(), m, None)
+        .expect("an empty mesh is dropped");
+    assert_eq!(b.primitive_count(), 1);
+    assert_eq!(b.warnings.len(), 2, "{:?}", b.warnings);
+    assert!(b.warnings[0].starts_with("mesh #0: 1 of 3 vertex normals"));
+    assert!(b.warnings[1].starts_with("mesh #1: the mesh has no triangles"));
+    // Out-of-range indices cannot be repaired: still an error.
+    assert!(
+        b.add_mesh(
+            TriangleMesh {
+                positions: tri,
+                normals: None,
+                uvs: None,
+                indices: vec![0, 1, 5],
+                flip_normals: false,
+            },
+            m,
+            None,
+        )
+        .is_err()
+    );
+}
+
+#[test]
+fn builtin_knobs_warn_only_where_unused_and_camera_flags_apply() {
+    let with = |light_count: Option<u32>, fov: Option<f32>| LoadOptions {
+        builtin: penumbra::scene::builtin::BuiltinOptions {
+            light_count,
+            ..Default::default()
+        },
+        view: penumbra::scene::view::ViewOptions {
+            fov,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let l = load("many-open", &with(Some(50), None)).expect("load");
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let l = load("cornell", &with(Some(50), Some(30.0))).expect("load");
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("--light-count ignored")),
+        "{:?}",
+        l.warnings
+    );
+    assert_eq!(l.scene.camera.fov_deg, 30.0);
+    assert!(l.notes[0].contains("--fov 30"), "{:?}", l.notes);
+}
+
+#[test]
+fn warnings_carry_at_most_one_warning_marker() {
+    // The pbrt parser writes `file:line: warning: …`, the other loaders `location: …`; the CLI
+    // adds `warning:` only where there is none, so no warning may carry two.
+    let d = scratch("prefix");
+    let p = write(
+        &d,
+        "w.pbrt",
+        b"WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 2 0 0 0 1 0] \"integer indices\" [0 1 2 0 1 3]\n",
+    );
+    let l = load(p.to_str().expect("utf8"), &LoadOptions::default()).expect("load");
+    assert!(!l.warnings.is_empty());
+    for w in &l.warnings {
+        assert!(w.matches("warning:").count() <= 1, "{w}");
+    }
+    assert!(
+        l.warnings.iter().any(|w| w.ends_with(
+            "w.pbrt:2: warning: trianglemesh: 1 of 2 triangles have zero area and are dropped"
+        )),
+        "{:?}",
+        l.warnings
+    );
+}

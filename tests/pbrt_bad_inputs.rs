@@ -1,12 +1,19 @@
 //! The bad-input catalogue: every file under tests/data/pbrt/bad/ must fail with an error that
 //! names the file and line (`# expect-line:`) and says what went wrong (`# expect:`), never
-//! panic. Plus truncation and byte-mutation fuzzing of a real scene.
+//! panic; every file under tests/data/pbrt/repaired/ holds something a renderer can repair and
+//! must load with one warning naming the file and line (`# expect-warning-line:`) and saying
+//! what was repaired (`# expect-warning:`). Plus truncation and byte-mutation fuzzing of a real
+//! scene.
 
-use penumbra::scene::pbrt::{parse_pbrt, parse_pbrt_str};
+use penumbra::scene::pbrt::{load_pbrt, parse_pbrt, parse_pbrt_str};
 use std::path::{Path, PathBuf};
 
 fn catalogue() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/pbrt/bad");
+    files_in("tests/data/pbrt/bad")
+}
+
+fn files_in(rel: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
     let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
         .expect("catalogue dir")
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -42,6 +49,35 @@ fn catalogue_has_at_least_25_files_and_each_is_a_located_error() {
                 if !located || !msg.contains(&what) {
                     failures.push(format!(
                         "{name}: want '{name}:{line}:' and '{what}', got: {msg}"
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+}
+
+#[test]
+fn repaired_catalogue_loads_with_one_located_warning_each() {
+    let files = files_in("tests/data/pbrt/repaired");
+    assert!(files.len() >= 8, "only {} repaired files", files.len());
+    let mut failures = Vec::new();
+    for path in &files {
+        let src = std::fs::read_to_string(path).unwrap();
+        let line = header(&src, "expect-warning-line");
+        let what = header(&src, "expect-warning");
+        let name = path.file_name().unwrap().to_str().unwrap();
+        match load_pbrt(path) {
+            Err(e) => failures.push(format!("{name}: refused: {e:#}")),
+            Ok((_, warnings)) => {
+                let at = format!("{name}:{line}:");
+                let n = warnings
+                    .iter()
+                    .filter(|w| w.contains(&at) && w.contains(&what))
+                    .count();
+                if n != 1 {
+                    failures.push(format!(
+                        "{name}: want one warning with '{at}' and '{what}', got {warnings:?}"
                     ));
                 }
             }

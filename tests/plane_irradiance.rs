@@ -266,6 +266,7 @@ fn film() -> FilmSpec {
         },
         filename: None,
         spp: None,
+        sensor: Default::default(),
     }
 }
 

@@ -199,4 +199,8 @@ impl Bxdf for Dielectric {
     fn is_delta(&self) -> bool {
         is_smooth(self.alpha)
     }
+
+    fn transmits(&self) -> bool {
+        true
+    }
 }

@@ -11,11 +11,15 @@
 //! random walk's (intractable) density, and their samples carry the walk's weight.
 //! The integrator builds the frame with the shading normal flipped toward `wo`, so `wo.z ≥ 0`
 //! for every call; transmissive BSDFs are told which side they are entered from at construction.
+//! Only BSDFs whose [`Bxdf::transmits`] is true may return `f ≠ 0` or draw samples with
+//! `wi.z < 0`; which incident directions count at a surface whose geometric and shading normals
+//! differ is decided by one rule for every technique, [`gathers_from`].
 
 pub mod coated;
 pub mod coated_conductor;
 pub mod conductor;
 pub mod dielectric;
+pub mod diffuse_transmission;
 pub mod fresnel;
 pub mod ggx;
 pub mod lambert;
@@ -26,6 +30,7 @@ pub mod phong;
 pub use coated::CoatedDiffuse;
 pub use conductor::{Conductor, named_metal};
 pub use dielectric::Dielectric;
+pub use diffuse_transmission::DiffuseTransmission;
 pub use ggx::{TrowbridgeReitz, roughness_to_alpha};
 pub use lambert::Lambert;
 pub use layered::{LayerParams, Layered};
@@ -67,6 +72,30 @@ pub trait Bxdf {
     /// True if every lobe is a delta (mirror, smooth glass): light sampling cannot help.
     fn is_delta(&self) -> bool {
         false
+    }
+    /// True if light arriving from below the surface (`wi.z < 0`) can scatter toward `wo`
+    /// (glass, diffuse transmission): the integrator then gathers light from both sides.
+    fn transmits(&self) -> bool {
+        false
+    }
+}
+
+/// Whether an incident direction counts in the direct-lighting integral at a surface, given
+/// its cosines with the geometric normal (`cos_geometric`, normal flipped toward the viewer)
+/// and with the shading normal (`cos_shading`, the local `wi.z`). One rule for light sampling
+/// and BSDF sampling, so MIS combines two estimates of the same integrand:
+/// - a reflecting BSDF gathers only from above the geometric surface (its `f` is 0 below the
+///   shading surface anyway);
+/// - a transmitting BSDF gathers from both sides, but only where the two normals agree on
+///   the side: a direction above the shading surface but below the geometric one would
+///   "reflect" light that comes through the object, and the reverse would "transmit" light
+///   that never crossed the surface (both are light leaks), so they contribute 0.
+#[inline(always)]
+pub fn gathers_from(transmits: bool, cos_geometric: f32, cos_shading: f32) -> bool {
+    if transmits {
+        (cos_geometric > 0.0 && cos_shading > 0.0) || (cos_geometric < 0.0 && cos_shading < 0.0)
+    } else {
+        cos_geometric > 0.0
     }
 }
 
@@ -176,6 +205,8 @@ pub enum Bsdf {
     /// pbrt-v4's stochastic layered BSDF (coated diffuse / coated conductor); boxed so that
     /// its 80 bytes do not double the size of every other BSDF in the integrator's lanes.
     Layered(Box<Layered>),
+    /// Lambertian reflection and transmission (thin sheets).
+    DiffuseTransmission(DiffuseTransmission),
 }
 
 macro_rules! dispatch {
@@ -188,6 +219,7 @@ macro_rules! dispatch {
             Bsdf::CoatedDiffuse($b) => $e,
             Bsdf::Mirror($b) => $e,
             Bsdf::Layered($b) => $e,
+            Bsdf::DiffuseTransmission($b) => $e,
         }
     };
 }
@@ -209,6 +241,7 @@ impl Bsdf {
             Bsdf::Conductor(b) => b.sampling = s,
             Bsdf::CoatedDiffuse(b) => b.sampling = s,
             Bsdf::Layered(b) => b.sampling = s,
+            Bsdf::DiffuseTransmission(b) => b.sampling = s,
             Bsdf::Dielectric(_) | Bsdf::Mirror(_) => {}
         }
     }
@@ -236,5 +269,9 @@ impl Bxdf for Bsdf {
     #[inline]
     fn is_delta(&self) -> bool {
         dispatch!(self, b => b.is_delta())
+    }
+    #[inline]
+    fn transmits(&self) -> bool {
+        dispatch!(self, b => b.transmits())
     }
 }

@@ -76,16 +76,17 @@ pub struct Args {
     /// OBJ: treat the MTL ambient colour Ka as emitted radiance (Embree Cornell-box files).
     #[arg(long)]
     pub obj_ka_emission: bool,
-    /// OBJ/glTF camera eye X,Y,Z (overrides the file's camera / automatic framing).
+    /// Camera eye X,Y,Z (replaces the eye of the scene's camera or of automatic framing).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
     pub look_from: Option<glam::Vec3>,
-    /// OBJ/glTF camera target X,Y,Z.
+    /// Camera target X,Y,Z (default with --look-from: the scene's centre).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
     pub look_at: Option<glam::Vec3>,
-    /// OBJ/glTF camera up vector X,Y,Z (default 0,1,0).
+    /// Camera up vector X,Y,Z (default: the scene camera's, 0,1,0 for automatic framing).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true)]
     pub up: Option<glam::Vec3>,
-    /// OBJ/glTF field of view in degrees along the shorter image axis (default 40).
+    /// Field of view in degrees along the shorter image axis (default: the scene camera's, 40
+    /// for automatic framing).
     #[arg(long)]
     pub fov: Option<f32>,
 }
@@ -178,6 +179,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let load_time = load_start.elapsed();
     for w in &loaded.warnings {
         eprintln!("{}", messages::format_warning(w));
+    }
+    for n in &loaded.notes {
+        eprintln!("note: {n}");
     }
     let scene = loaded.scene;
     // The loaders build the BVHs (scene and emitters) as their last step and time them.

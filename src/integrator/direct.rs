@@ -2,14 +2,16 @@
 //! L(x, ωo) = Le + ∫ f(ωo, x, ωi) · Li · V · cosθx cosθy / ‖x − y‖² dA_y:
 //! BSDF (projected solid angle) sampling, light sampling (area or solid angle) and MIS.
 //!
-//! Both techniques estimate the same integrand restricted to directions above the geometric
-//! surface on the viewer's side (reflection only), so their MIS combination stays unbiased even
-//! where shading normals disagree with the geometry.
+//! Both techniques estimate the same integrand restricted by one hemisphere rule,
+//! [`gathers_from`]: above the geometric surface on the viewer's side for reflecting BSDFs;
+//! both sides for transmitting ones (rough glass, diffuse transmission), except directions on
+//! which the geometric and shading normals disagree. So their MIS combination stays unbiased
+//! even where shading normals disagree with the geometry.
 
 use super::lanes::{DiffuseBsdfLanes, Pending, Receivers, Sampled, TriangleLightLanes};
 use super::{MisHeuristic, Strategy};
 use crate::Rgb;
-use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling};
+use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeSampling, gathers_from};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::packet::bits;
 use crate::geometry::{PACKET, Ray, RayPacket, SurfaceHit};
@@ -251,11 +253,18 @@ struct Shading<'h> {
 
 impl Shading<'_> {
     /// The selector's view of this shading point, built only for selectors that read it.
+    /// A transmitting BSDF gathers from both sides, so the selector gets no normal (zero):
+    /// with one, importance-based selectors would give lights behind the surface (the bulb's
+    /// filament) probability 0.
     #[inline]
     fn shading_point(&self) -> ShadingPoint {
         ShadingPoint {
             p: self.ctx.p,
-            n: self.ctx.n,
+            n: if self.bsdf.transmits() {
+                Vec3::ZERO
+            } else {
+                self.ctx.n
+            },
             wo: self.wo,
         }
     }
@@ -557,11 +566,11 @@ impl<'a> DirectLighting<'a> {
     fn bsdf_ray(&self, sh: &Shading, lobe: f32, u: Vec2) -> Option<BsdfRay> {
         // Lambert inline: `Bsdf::sample` carries every BSDF and stays out of line, so the
         // common diffuse hit paid a call and a `BsdfSample` returned through memory.
-        let bs = match sh.bsdf {
-            Bsdf::Lambert(b) => b.sample(sh.wo_local, lobe, u),
-            other => other.sample(sh.wo_local, lobe, u),
-        }?;
-        bsdf_ray_of(&bs, &sh.frame, sh.ctx.n, sh.hit)
+        let (bs, transmits) = match sh.bsdf {
+            Bsdf::Lambert(b) => (b.sample(sh.wo_local, lobe, u), false),
+            other => (other.sample(sh.wo_local, lobe, u), other.transmits()),
+        };
+        bsdf_ray_through(&bs?, transmits, &sh.frame, sh.ctx.n, sh.hit)
     }
 
     /// The second half: given the nearest emitter `hit` along the sampled ray (a BVH of
@@ -639,10 +648,20 @@ pub(super) fn light_estimate(
     hit: &SurfaceHit,
     mis: Option<MisHeuristic>,
 ) -> Option<(Ray, Rgb)> {
-    if !(ls.pdf > 0.0) || pmf <= 0.0 || ls.li == Rgb::ZERO || ls.wi.dot(ctx.n) <= 0.0 {
+    // The hemisphere rule; a reflecting BSDF's needs no shading cosine, so it is decided
+    // before the frame change, as the lane kernels have always done it.
+    let transmits = bsdf.transmits();
+    if !(ls.pdf > 0.0)
+        || pmf <= 0.0
+        || ls.li == Rgb::ZERO
+        || (!transmits && !gathers_from(false, ls.wi.dot(ctx.n), 0.0))
+    {
         return None;
     }
     let wi_local = frame.to_local(ls.wi);
+    if transmits && !gathers_from(true, ls.wi.dot(ctx.n), wi_local.z) {
+        return None;
+    }
     // Under MIS the BSDF pdf is needed too: one dispatch evaluates both (for the few
     // occluded samples it is wasted, cheaper than a second call for all the others).
     let weigh = if ls.delta { None } else { mis };
@@ -663,12 +682,24 @@ pub(super) fn light_estimate(
     Some((shadow_ray(hit, ls.p_light), f * ls.li * (w / pdf)))
 }
 
-/// BSDF sample `bs` (local frame `frame`) at `hit`, whose geometric normal facing the viewer
-/// is `n`, as a ray with its weight f·cos / pdf; `None` when the estimate is zero without
-/// tracing it. Shared by the per-lane path and the lane kernels.
+/// BSDF sample `bs` of a reflecting BSDF (local frame `frame`) at `hit`, whose geometric
+/// normal facing the viewer is `n`, as a ray with its weight f·cos / pdf; `None` when the
+/// estimate is zero without tracing it. Shared by the per-lane path and the lane kernels.
 #[inline(always)]
 pub(super) fn bsdf_ray_of(
     bs: &BsdfSample,
+    frame: &Frame,
+    n: Vec3,
+    hit: &SurfaceHit,
+) -> Option<BsdfRay> {
+    bsdf_ray_through(bs, false, frame, n, hit)
+}
+
+/// [`bsdf_ray_of`] for a BSDF that transmits (`transmits`) or not.
+#[inline(always)]
+pub(super) fn bsdf_ray_through(
+    bs: &BsdfSample,
+    transmits: bool,
     frame: &Frame,
     n: Vec3,
     hit: &SurfaceHit,
@@ -677,9 +708,12 @@ pub(super) fn bsdf_ray_of(
         return None;
     }
     let wi = frame.to_world(bs.wi).normalize();
-    // Only specular transmission (smooth glass) may leave below the geometric surface;
-    // every other sample there is rejected exactly as light sampling rejects it.
-    if wi.dot(n) <= 0.0 && !bs.delta {
+    // The rule light sampling applies (`light_estimate`). Delta samples cannot meet light
+    // sampling, but a transmitting BSDF's obey it too (a refraction that leaves on the
+    // viewer's side of the geometry leaks light); a reflecting BSDF's delta samples (mirrors)
+    // keep their old exemption, so opaque images stay as they were.
+    let exempt = bs.delta && !transmits;
+    if !(exempt || gathers_from(transmits, wi.dot(n), bs.wi.z)) {
         return None;
     }
     let weight = bs.f * (bs.wi.z.abs() / bs.pdf);

@@ -5,7 +5,7 @@
 //! Every random number is a pure function of (seed, pass, pixel, draw), and results are
 //! gathered in pixel order, so the passes are deterministic under any thread schedule.
 
-use crate::bsdf::{Bsdf, Bxdf};
+use crate::bsdf::{Bsdf, Bxdf, gathers_from};
 use crate::geometry::{RayQuery, ShadingGeometry, SurfaceHit};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode};
 use crate::luminance;
@@ -26,6 +26,8 @@ pub struct EyeHit {
     bsdf: Bsdf,
     frame: Frame,
     wo_local: Vec3,
+    /// Geometric normal flipped toward the viewer (`sp.n` is zero for transmitting BSDFs).
+    n: Vec3,
 }
 
 /// Resolution of an estimation grid whose longer side is `max_side`, with the film's aspect.
@@ -53,15 +55,19 @@ pub fn eye_hit(scene: &Scene, res: UVec2, pixel: u32, rng: &mut Pcg32) -> Option
     let hit = scene.geometry.intersect(&ray)?;
     let material = scene.materials.get(hit.material as usize)?;
     let g = ShadingGeometry::new(ray.d, hit.ng, hit.ns);
+    let bsdf = material.bsdf(&hit, g.front);
+    // As the integrator's shading point: no normal where light comes from both sides.
+    let sp_n = if bsdf.transmits() { Vec3::ZERO } else { g.n };
     Some(EyeHit {
-        bsdf: material.bsdf(&hit, g.front),
+        bsdf,
         wo_local: g.wo_local,
         frame: g.frame,
         sp: ShadingPoint {
             p: hit.p,
-            n: g.n,
+            n: sp_n,
             wo: g.wo,
         },
+        n: g.n,
         hit,
     })
 }
@@ -74,15 +80,18 @@ pub fn contribution(scene: &Scene, eh: &EyeHit, light: u32, u: Vec2) -> f32 {
     };
     let ctx = LightSampleContext {
         p: eh.hit.p,
-        n: eh.sp.n,
+        n: eh.n,
     };
     let Some(ls) = l.sample_li(&ctx, u, SamplingMode::SolidAngle) else {
         return 0.0;
     };
-    if (ls.pdf.is_nan() || ls.pdf <= 0.0) || ls.wi.dot(eh.sp.n) <= 0.0 {
+    let wi_local = eh.frame.to_local(ls.wi);
+    // The integrator's hemisphere rule, so the estimate measures what it will gather.
+    if (ls.pdf.is_nan() || ls.pdf <= 0.0)
+        || !gathers_from(eh.bsdf.transmits(), ls.wi.dot(eh.n), wi_local.z)
+    {
         return 0.0;
     }
-    let wi_local = eh.frame.to_local(ls.wi);
     let v = luminance(eh.bsdf.f(eh.wo_local, wi_local) * ls.li) * wi_local.z.abs() / ls.pdf;
     if (v.is_nan() || v <= 0.0) || !v.is_finite() {
         return 0.0;

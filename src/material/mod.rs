@@ -10,7 +10,8 @@ use crate::bsdf::coated_conductor::{coated_conductor, layered_diffuse};
 use crate::bsdf::fresnel::k_from_reflectance;
 use crate::bsdf::ggx::is_smooth;
 use crate::bsdf::{
-    Bsdf, CoatedDiffuse, Conductor, Dielectric, Lambert, LayerParams, Mirror, Phong,
+    Bsdf, CoatedDiffuse, Conductor, Dielectric, DiffuseTransmission, Lambert, LayerParams, Mirror,
+    Phong,
 };
 use crate::geometry::SurfaceHit;
 use glam::Vec2;
@@ -81,6 +82,16 @@ pub enum Material {
     },
     /// Perfect mirror (reflectance 1).
     Mirror,
+    /// Lambertian reflection on the viewer's side and Lambertian transmission to the other
+    /// (pbrt-v4 `diffusetransmission`): both scaled by `scale`, then clamped to [0, 1].
+    DiffuseTransmission {
+        /// Reflectance.
+        reflectance: Texture,
+        /// Transmittance.
+        transmittance: Texture,
+        /// Factor on both.
+        scale: f32,
+    },
 }
 
 /// The Lambertian BSDF of a `diffuse` material (reflectance clamped to [0, 1]); inlined into the
@@ -176,6 +187,14 @@ impl Material {
                 entering: front,
             }),
             Material::Mirror => Bsdf::Mirror(Mirror { r: Rgb::ONE }),
+            Material::DiffuseTransmission {
+                reflectance,
+                transmittance,
+                scale,
+            } => Bsdf::DiffuseTransmission(DiffuseTransmission::new(
+                reflectance.eval(hit.uv) * *scale,
+                transmittance.eval(hit.uv) * *scale,
+            )),
         }
     }
 
@@ -192,9 +211,10 @@ impl Material {
                 layer,
                 ..
             } => is_smooth(*coat_alpha) && is_smooth(*alpha) && layer.albedo == Rgb::ZERO,
-            Material::Diffuse { .. } | Material::Phong { .. } | Material::CoatedDiffuse { .. } => {
-                false
-            }
+            Material::Diffuse { .. }
+            | Material::Phong { .. }
+            | Material::CoatedDiffuse { .. }
+            | Material::DiffuseTransmission { .. } => false,
         }
     }
 }

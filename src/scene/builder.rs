@@ -1,5 +1,6 @@
 //! [`SceneBuilder`]: what every loader and built-in scene calls to assemble a [`Scene`].
 
+use super::mesh_repair::{MeshRepair, repair_mesh};
 use super::{AreaEmission, FilmSpec, Scene, TriangleMesh};
 use crate::camera::Camera;
 use crate::geometry::{
@@ -21,8 +22,10 @@ pub struct SceneBuilder {
     prims: Vec<Primitive>,
     meshes: Vec<MeshShading>,
     quadrics: Vec<Quadric>,
-    /// Triangles skipped because their area is zero (loaders may warn about them).
-    pub degenerate_triangles: usize,
+    /// Meshes given to [`SceneBuilder::add_mesh`] so far (names them in warnings).
+    meshes_seen: usize,
+    /// What was repaired in meshes added with [`SceneBuilder::add_mesh`], one line per mesh.
+    pub warnings: Vec<String>,
 }
 
 impl SceneBuilder {
@@ -52,15 +55,65 @@ impl SceneBuilder {
     }
 
     /// Add a world-space triangle mesh. With `emission`, each triangle becomes its own
-    /// [`TriangleLight`]. Errors on out-of-range indices or non-finite data; zero-area triangles
-    /// are skipped (counted in `degenerate_triangles`).
+    /// [`TriangleLight`]. What can be repaired is ([`repair_mesh`]: bad normals, zero-area or
+    /// non-finite triangles; a mesh left empty is dropped) and noted in
+    /// [`SceneBuilder::warnings`]; loaders that know file and line call
+    /// [`SceneBuilder::add_mesh_repaired`] and word the warning themselves. Errors on
+    /// out-of-range indices and attribute arrays of the wrong length.
     pub fn add_mesh(
         &mut self,
         mesh: TriangleMesh,
         material: u32,
         emission: Option<AreaEmission>,
     ) -> anyhow::Result<()> {
+        let n = self.meshes_seen;
+        let r = self.add_mesh_repaired(mesh, material, emission)?;
+        if !r.is_clean() {
+            self.warnings.push(format!("mesh #{n}: {}", r.describe()));
+        }
+        Ok(())
+    }
+
+    /// [`SceneBuilder::add_mesh`] that leaves the warning to the caller: returns what was
+    /// repaired (nothing was added if `kept() == 0`).
+    pub fn add_mesh_repaired(
+        &mut self,
+        mut mesh: TriangleMesh,
+        material: u32,
+        emission: Option<AreaEmission>,
+    ) -> anyhow::Result<MeshRepair> {
+        self.meshes_seen += 1;
         self.check_material(material)?;
+        ensure!(
+            mesh.indices.len().is_multiple_of(3),
+            "mesh index count {} is not a multiple of 3",
+            mesh.indices.len()
+        );
+        let nv = mesh.positions.len();
+        if let Some(n) = &mesh.normals {
+            ensure!(
+                n.len() == nv,
+                "mesh has {} normals for {nv} vertices",
+                n.len()
+            );
+        }
+        if let Some(uv) = &mesh.uvs {
+            ensure!(
+                uv.len() == nv,
+                "mesh has {} uvs for {nv} vertices",
+                uv.len()
+            );
+        }
+        if let Some(&bad) = mesh.indices.iter().find(|&&i| i as usize >= nv) {
+            bail!("mesh index {bad} out of range ({nv} vertices)");
+        }
+        if let Some(e) = &emission {
+            check_emission(e)?;
+        }
+        let repair = repair_mesh(&mut mesh);
+        if repair.kept() == 0 {
+            return Ok(repair);
+        }
         let TriangleMesh {
             positions,
             normals,
@@ -68,51 +121,12 @@ impl SceneBuilder {
             indices,
             flip_normals,
         } = mesh;
-        ensure!(!indices.is_empty(), "mesh has no triangles");
-        ensure!(
-            indices.len().is_multiple_of(3),
-            "mesh index count {} is not a multiple of 3",
-            indices.len()
-        );
-        let nv = positions.len();
-        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            bail!(
-                "mesh vertex {i} has a non-finite position {:?}",
-                positions[i]
-            );
-        }
-        let normals = match normals {
-            Some(n) => {
-                ensure!(
-                    n.len() == nv,
-                    "mesh has {} normals for {nv} vertices",
-                    n.len()
-                );
-                if let Some(i) = n.iter().position(|v| !v.is_finite()) {
-                    bail!("mesh normal {i} is not finite");
-                }
-                // Normalised here, once, so every loader and built-in scene agrees bit for bit.
-                Some(
-                    n.into_iter()
-                        .map(|v| v.normalize_or_zero())
-                        .collect::<Vec<_>>(),
-                )
-            }
-            None => None,
-        };
-        if let Some(uv) = &uvs {
-            ensure!(
-                uv.len() == nv,
-                "mesh has {} uvs for {nv} vertices",
-                uv.len()
-            );
-        }
-        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= nv) {
-            bail!("mesh index {bad} out of range ({nv} vertices)");
-        }
-        if let Some(e) = &emission {
-            check_emission(e)?;
-        }
+        // Normalised here, once, so every loader and built-in scene agrees bit for bit.
+        let normals = normals.map(|n| {
+            n.into_iter()
+                .map(|v| v.normalize_or_zero())
+                .collect::<Vec<_>>()
+        });
         let mesh_id = self.meshes.len() as u32;
         for tri in indices.chunks_exact(3) {
             let v = [tri[0], tri[1], tri[2]];
@@ -123,10 +137,6 @@ impl SceneBuilder {
             ];
             let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
             let cross = e1.cross(e2);
-            if !(cross.length_squared() > 0.0) {
-                self.degenerate_triangles += 1;
-                continue;
-            }
             let light = match &emission {
                 Some(e) => {
                     // The emitting side is the hit record's geometric normal (pbrt-v4): the
@@ -167,7 +177,7 @@ impl SceneBuilder {
             uvs,
             flip: flip_normals,
         });
-        Ok(())
+        Ok(repair)
     }
 
     /// Add a parallelogram corner + s·e1 + t·e2 (s, t ∈ [0,1]) as two triangles, normal

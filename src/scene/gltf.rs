@@ -12,9 +12,10 @@
 //! efficacy at 555 nm, the same factor glTF viewers and exporters (e.g. Blender) use to map
 //! between watts and lumens; so 683 cd → 1 W/sr and 683 lux → 1 W/m².
 
-use super::load::{LoadOptions, Loaded};
-use super::view::{bounds_of, default_film, flag_or_auto_camera};
-use super::{AreaEmission, SceneBuilder, TriangleMesh};
+use super::gltf_check::{Role, check_accessor, parse_document};
+use super::load::{LoadOptions, Loaded, warn_if_unlit};
+use super::view::{DEFAULT_FOV_DEG, apply_view_flags, auto_frame, default_film, place_auto_camera};
+use super::{AreaEmission, SceneBuilder, TriangleMesh, guard};
 use crate::Rgb;
 use crate::camera::Camera;
 use crate::geometry::Transform;
@@ -37,15 +38,16 @@ const MAX_DEPTH: usize = 256;
 /// Load a `.gltf` or `.glb` file.
 pub fn load_gltf(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     let file = path.display().to_string();
-    // The gltf crate and our accessor reads run on untrusted data: a panic becomes an error.
-    std::panic::catch_unwind(|| load_inner(path, opts))
+    // The gltf crate and our accessor reads run on untrusted data: a panic becomes an error,
+    // and its text stays out of the user's terminal.
+    guard::catch(|| load_inner(path, opts))
         .map_err(|_| anyhow!("{file}: the glTF reader crashed on this file"))?
 }
 
 fn load_inner(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).with_context(|| format!("{file}: cannot read"))?;
-    let doc = ::gltf::Gltf::from_slice(&bytes).map_err(|e| anyhow!("{file}: invalid glTF: {e}"))?;
+    let doc = parse_document(&bytes, &file)?;
     let dir = path.parent().unwrap_or(Path::new(""));
     let buffers = load_buffers(&doc, dir, &file)?;
     let mut warnings = Vec::new();
@@ -73,37 +75,51 @@ fn load_inner(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
         warnings: &mut warnings,
         file: &file,
         camera: None,
-        all_points: Vec::new(),
+        triangles: 0,
     };
     for node in scene.nodes() {
         ctx.visit(&node, Mat4::IDENTITY, 0)?;
     }
     let Walk {
-        camera, all_points, ..
+        camera, triangles, ..
     } = ctx;
     if b.primitive_count() == 0 {
+        if triangles > 0 {
+            bail!("{file}: no triangle is left: every one has zero area or a non-finite vertex");
+        }
         bail!("{file}: the scene has no triangles");
     }
-    if b.degenerate_triangles > 0 {
-        warnings.push(format!(
-            "{file}: skipped {} zero-area triangles",
-            b.degenerate_triangles
-        ));
-    }
-    let (lo, hi) = bounds_of(&all_points).ok_or_else(|| anyhow!("{file}: no vertices"))?;
     let mut film = default_film();
-    let camera = match camera {
-        Some((m, persp)) if !opts.view.places_camera() => {
-            let (cam, res) = gltf_camera(m, persp.yfov, persp.aspect)?;
+    let file_camera = match camera {
+        Some((m, persp)) => {
+            let (cam, res) = gltf_camera(m, persp.yfov, persp.aspect)
+                .with_context(|| format!("{file}: camera"))?;
             film.resolution = res;
-            cam
+            Some(cam)
         }
-        _ => flag_or_auto_camera(&opts.view, lo, hi).with_context(|| format!("{file}: camera"))?,
+        None => None,
     };
-    let scene = b
+    let has_camera = file_camera.is_some();
+    // Without a camera in the file, a placeholder until the scene exists to be probed.
+    let camera = match file_camera {
+        Some(c) => c,
+        None => auto_frame(Vec3::ZERO, Vec3::ONE, DEFAULT_FOV_DEG)?,
+    };
+    let mut scene = b
         .build(camera, film)
         .with_context(|| format!("{file}: building the scene"))?;
-    Ok(Loaded { scene, warnings })
+    let note = if has_camera {
+        apply_view_flags(&mut scene, &opts.view)
+    } else {
+        place_auto_camera(&mut scene, &opts.view).map(Some)
+    }
+    .with_context(|| format!("{file}: camera"))?;
+    warn_if_unlit(&scene, &file, "", &mut warnings);
+    Ok(Loaded {
+        scene,
+        warnings,
+        notes: note.map(|n| format!("{file}: {n}")).into_iter().collect(),
+    })
 }
 
 /// The parts of a glTF perspective camera we use.
@@ -156,7 +172,8 @@ struct Walk<'a> {
     warnings: &'a mut Vec<String>,
     file: &'a str,
     camera: Option<(Mat4, Perspective)>,
-    all_points: Vec<Vec3>,
+    /// Triangles found, before repair (tells "all dropped" from "none there").
+    triangles: usize,
 }
 
 impl Walk<'_> {
@@ -200,6 +217,21 @@ impl Walk<'_> {
                 ));
             }
             let color = Rgb::from_array(light.color());
+            let (i, at) = (
+                light.intensity(),
+                format!("{file}: KHR_lights_punctual lights[{}]", light.index()),
+            );
+            if !(i.is_finite() && i >= 0.0) {
+                self.warnings.push(format!(
+                    "{at}: intensity {i} is not a finite non-negative number; the light is black"
+                ));
+            }
+            if !(color.is_finite() && color.min_element() >= 0.0) {
+                self.warnings.push(format!(
+                    "{at}: color [{} {} {}] is not finite and non-negative; negative or non-finite components taken as 0",
+                    color.x, color.y, color.z
+                ));
+            }
             self.b.add_light(punctual_light(
                 light.kind(),
                 color,
@@ -209,7 +241,7 @@ impl Walk<'_> {
         }
         if let Some(mesh) = node.mesh() {
             self.add_mesh(&mesh, world)
-                .with_context(|| format!("{file}: node {} mesh {}", node.index(), mesh.index()))?;
+                .with_context(|| format!("{file}: nodes[{}]", node.index()))?;
         }
         for child in node.children() {
             self.visit(&child, world, depth + 1)?;
@@ -219,25 +251,60 @@ impl Walk<'_> {
 
     fn add_mesh(&mut self, mesh: &::gltf::Mesh, world: Mat4) -> anyhow::Result<()> {
         let xf = Transform::new(world).ok_or_else(|| anyhow!("singular node transform"))?;
+        let mesh_name = match mesh.name() {
+            Some(n) => format!("meshes[{}] '{n}'", mesh.index()),
+            None => format!("meshes[{}]", mesh.index()),
+        };
         for prim in mesh.primitives() {
+            let at = format!("{}: {mesh_name} primitives[{}]", self.file, prim.index());
             if prim.mode() != ::gltf::mesh::Mode::Triangles {
                 self.warnings.push(format!(
-                    "{}: mesh {} primitive {}: mode {:?} skipped (triangles only)",
-                    self.file,
-                    mesh.index(),
-                    prim.index(),
+                    "{at}: mode {:?} skipped (triangles only)",
                     prim.mode()
                 ));
                 continue;
             }
+            let pos_acc = prim.get(&::gltf::Semantic::Positions).ok_or_else(|| {
+                anyhow!(
+                    "{mesh_name} primitives[{}]: no POSITION attribute",
+                    prim.index()
+                )
+            })?;
+            check_accessor(&pos_acc, Role::Position)
+                .map_err(|e| anyhow!("{mesh_name} primitives[{}]: POSITION {e}", prim.index()))?;
+            if let Some(ix) = prim.indices() {
+                check_accessor(&ix, Role::Indices).map_err(|e| {
+                    anyhow!("{mesh_name} primitives[{}]: indices {e}", prim.index())
+                })?;
+            }
+            // Attributes a renderer can do without are dropped with a warning when misdeclared.
+            let normals_ok = match prim.get(&::gltf::Semantic::Normals) {
+                Some(acc) => check_accessor(&acc, Role::Normal)
+                    .map_err(|e| {
+                        self.warnings
+                            .push(format!("{at}: NORMAL {e}; geometric normals used"))
+                    })
+                    .is_ok(),
+                None => false,
+            };
+            let uvs_ok = match prim.get(&::gltf::Semantic::TexCoords(0)) {
+                Some(acc) => check_accessor(&acc, Role::TexCoord)
+                    .map_err(|e| {
+                        self.warnings
+                            .push(format!("{at}: TEXCOORD_0 {e}; texture coordinates ignored"))
+                    })
+                    .is_ok(),
+                None => false,
+            };
             let buffers = self.buffers;
             let reader = prim.reader(|buf| buffers.get(buf.index()).map(|v| v.as_slice()));
             let positions: Vec<Vec3> = reader
                 .read_positions()
                 .ok_or_else(|| {
                     anyhow!(
-                        "primitive {}: POSITION missing or out of range",
-                        prim.index()
+                        "{mesh_name} primitives[{}]: POSITION accessor {} lies outside its buffer",
+                        prim.index(),
+                        pos_acc.index()
                     )
                 })?
                 .map(|p| xf.point(Vec3::from_array(p)))
@@ -245,20 +312,46 @@ impl Walk<'_> {
             let nv = positions.len();
             let indices: Vec<u32> = match reader.read_indices() {
                 Some(ix) => ix.into_u32().collect(),
+                None if prim.indices().is_some() => bail!(
+                    "{mesh_name} primitives[{}]: the indices accessor lies outside its buffer",
+                    prim.index()
+                ),
                 None => (0..nv as u32).collect(),
             };
-            let normals = reader.read_normals().map(|ns| {
-                ns.map(|n| xf.normal(Vec3::from_array(n)).normalize_or_zero())
-                    .collect::<Vec<_>>()
-            });
+            let mut normals = None;
+            if normals_ok {
+                normals = reader.read_normals().map(|ns| {
+                    ns.map(|n| xf.normal(Vec3::from_array(n)))
+                        .collect::<Vec<_>>()
+                });
+                match &normals {
+                    Some(n) if n.len() == nv => {}
+                    _ => {
+                        self.warnings.push(format!(
+                            "{at}: NORMAL does not match POSITION (missing data or another count); geometric normals used"
+                        ));
+                        normals = None;
+                    }
+                }
+            }
             // glTF's uv origin is the image's top-left, ours (pbrt) the bottom-left.
-            let uvs = reader.read_tex_coords(0).map(|t| {
-                t.into_f32()
-                    .map(|[u, v]| Vec2::new(u, 1.0 - v))
-                    .collect::<Vec<_>>()
-            });
-            let normals = normals.filter(|n| n.len() == nv);
-            let uvs = uvs.filter(|u| u.len() == nv);
+            let mut uvs = None;
+            if uvs_ok {
+                uvs = reader.read_tex_coords(0).map(|t| {
+                    t.into_f32()
+                        .map(|[u, v]| Vec2::new(u, 1.0 - v))
+                        .collect::<Vec<_>>()
+                });
+                match &uvs {
+                    Some(u) if u.len() == nv => {}
+                    _ => {
+                        self.warnings.push(format!(
+                            "{at}: TEXCOORD_0 does not match POSITION (missing data or another count); texture coordinates ignored"
+                        ));
+                        uvs = None;
+                    }
+                }
+            }
             let (mat, emission) = match prim.material().index() {
                 Some(i) => *self
                     .mats
@@ -281,7 +374,7 @@ impl Walk<'_> {
                     }
                 },
             };
-            self.all_points.extend(positions.iter().copied());
+            self.triangles += indices.len() / 3;
             let mesh = TriangleMesh {
                 positions,
                 normals,
@@ -289,9 +382,13 @@ impl Walk<'_> {
                 indices,
                 flip_normals: xf.swaps_handedness(),
             };
-            self.b
-                .add_mesh(mesh, mat, emission)
-                .with_context(|| format!("primitive {}", prim.index()))?;
+            let repair = self
+                .b
+                .add_mesh_repaired(mesh, mat, emission)
+                .with_context(|| format!("{mesh_name} primitives[{}]", prim.index()))?;
+            if !repair.is_clean() {
+                self.warnings.push(format!("{at}: {}", repair.describe()));
+            }
         }
         Ok(())
     }
@@ -305,7 +402,12 @@ pub fn punctual_light(kind: Kind, color: Rgb, intensity: f32, world: Mat4) -> Li
     } else {
         0.0
     };
-    let radiometric = color.max(Rgb::ZERO) * intensity / LUMENS_PER_WATT;
+    let color = Rgb::from_array(
+        color
+            .to_array()
+            .map(|c| if c.is_finite() { c.max(0.0) } else { 0.0 }),
+    );
+    let radiometric = color * intensity / LUMENS_PER_WATT;
     let p = world.transform_point3(Vec3::ZERO);
     let dir = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
     match kind {
@@ -392,13 +494,44 @@ fn gltf_material(
         }
         None => Texture::Constant(factor),
     };
-    let strength = m
-        .emissive_strength()
-        .filter(|s| s.is_finite())
-        .unwrap_or(1.0);
-    let le = Rgb::from_array(m.emissive_factor()) * strength;
-    let emission = (le.is_finite() && le.max_element() > 0.0).then(|| AreaEmission {
-        l: le.max(Rgb::ZERO),
+    let at = match m.index() {
+        Some(i) => format!("{file}: materials[{i}] '{name}'"),
+        None => format!("{file}: default material"),
+    };
+    let strength = match m.emissive_strength() {
+        Some(s) if !(s.is_finite() && s >= 0.0) => {
+            warnings.push(format!(
+                "{at}: KHR_materials_emissive_strength {s} is not a finite non-negative number; 1 used"
+            ));
+            1.0
+        }
+        Some(s) => s,
+        None => 1.0,
+    };
+    let factor_e = Rgb::from_array(m.emissive_factor());
+    let le = factor_e * strength;
+    let le = if !factor_e.is_finite() {
+        warnings.push(format!(
+            "{at}: emissiveFactor [{} {} {}] is not finite (beyond f32); the material does not emit",
+            factor_e.x, factor_e.y, factor_e.z
+        ));
+        Rgb::ZERO
+    } else if !le.is_finite() {
+        warnings.push(format!(
+            "{at}: emissiveFactor × emissive strength {strength} overflows f32; the material does not emit"
+        ));
+        Rgb::ZERO
+    } else {
+        if le.min_element() < 0.0 {
+            warnings.push(format!(
+                "{at}: emissiveFactor [{} {} {}] has a negative component, taken as 0",
+                factor_e.x, factor_e.y, factor_e.z
+            ));
+        }
+        le.max(Rgb::ZERO)
+    };
+    let emission = (le.max_element() > 0.0).then(|| AreaEmission {
+        l: le,
         two_sided: m.double_sided(),
     });
     let finite01 = |x: f32, d: f32| if x.is_finite() { x.clamp(0.0, 1.0) } else { d };

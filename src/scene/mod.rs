@@ -7,9 +7,14 @@ pub mod builder;
 pub mod builtin;
 pub mod film;
 pub mod gltf;
+pub mod gltf_check;
+pub mod guard;
 pub mod load;
+pub mod mesh_repair;
 pub mod obj;
+pub mod obj_text;
 pub mod pbrt;
+pub mod polygon;
 pub mod view;
 
 pub use builder::SceneBuilder;

@@ -29,6 +29,8 @@ pub struct Builtin {
     pub description: &'static str,
     /// Build it.
     pub build: fn(&BuiltinOptions) -> anyhow::Result<Scene>,
+    /// The [`BuiltinOptions`] it reads, by flag name (`light-count`, `rooms`, `triangles`).
+    pub knobs: &'static [&'static str],
 }
 
 /// Every built-in scene, default first.
@@ -37,31 +39,37 @@ pub const BUILTINS: &[Builtin] = &[
         name: "cornell",
         description: "Cornell box of ../shared/scenes/cornell-box-bitterli/scene-v4.pbrt (default), 512x512",
         build: cornell::cornell,
+        knobs: &[],
     },
     Builtin {
         name: "cornell-phong",
         description: "Cornell box with Phong (n = 10, 100, 1000) and GGX conductor spheres",
         build: cornell::cornell_phong,
+        knobs: &[],
     },
     Builtin {
         name: "dense",
         description: "Cornell box around a displaced sphere of ~1.05M triangles (--triangles)",
         build: dense::dense,
+        knobs: &["triangles"],
     },
     Builtin {
         name: "many-open",
         description: "10k small area lights over an open floor with occluders (--light-count up to 1M)",
         build: many_open::many_open,
+        knobs: &["light-count"],
     },
     Builtin {
         name: "many-rooms",
         description: "8x8 rooms with doorways, 4 ceiling lights each (--rooms, --light-count)",
         build: many_rooms::many_rooms,
+        knobs: &["rooms", "light-count"],
     },
     Builtin {
         name: "many-mesh",
         description: "emissive torus of 8192 triangle lights plus strip lights (--light-count)",
         build: many_mesh::many_mesh,
+        knobs: &["light-count", "triangles"],
     },
 ];
 

@@ -5,7 +5,7 @@
 //! area) and `illuminance` (distant, uniform infinite) then rescale it so the emitted power or
 //! the irradiance at normal incidence equals the given value.
 
-use super::params::ParamSet;
+use super::params::{ParamSet, SpecVal};
 use super::spectra::{SpectrumUse, to_rgb};
 use super::textures::{ImageCache, Warn, load_image, resolve};
 use super::tokenizer::{Loc, err_at};
@@ -90,9 +90,20 @@ impl AreaLightDesc {
 }
 
 fn spectrum(params: &ParamSet, name: &str) -> anyhow::Result<Rgb> {
-    Ok(params
-        .spectrum(name)?
-        .and_then(|v| to_rgb(&v, SpectrumUse::Illuminant))
+    let v = params.spectrum(name)?;
+    // Emission cannot be negative; pbrt-v4 refuses such an RGB too, rather than rendering black.
+    if let (Some(SpecVal::Rgb(c)), Some(at)) = (&v, params.loc_of(name))
+        && c.min_element() < 0.0
+    {
+        return Err(err_at(
+            &at,
+            format!(
+                "RGB parameter \"{name}\" [{} {} {}] has a negative component: emitted radiance cannot be negative",
+                c.x, c.y, c.z
+            ),
+        ));
+    }
+    Ok(v.and_then(|v| to_rgb(&v, SpectrumUse::Illuminant))
         .unwrap_or(Rgb::ONE))
 }
 
@@ -217,6 +228,27 @@ pub fn parse_light(
                     }
                     let floc = params.loc_of("filename").unwrap_or(loc.clone());
                     let img = load_image(images, &path, &floc)?;
+                    let negative = img.pixels.iter().filter(|p| p.min_element() < 0.0).count();
+                    if img.pixels.iter().all(|p| !(p.max_element() > 0.0)) {
+                        warn(
+                            &format!("envmap-black@{}", floc.file_line()),
+                            &floc,
+                            format!(
+                                "environment map {} has no pixel with positive radiance: the light is black",
+                                path.display()
+                            ),
+                        );
+                    } else if negative > 0 {
+                        warn(
+                            &format!("envmap-negative@{}", floc.file_line()),
+                            &floc,
+                            format!(
+                                "environment map {}: {negative} of {} pixels have negative values, taken as 0",
+                                path.display(),
+                                img.pixels.len()
+                            ),
+                        );
+                    }
                     let layout = if img.width == img.height {
                         EnvLayout::EqualArea
                     } else {

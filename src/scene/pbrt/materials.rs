@@ -25,10 +25,19 @@ pub enum MetalSpectrum {
 /// A material as the scene file describes it.
 #[derive(Clone, Debug, PartialEq)]
 pub enum MaterialDesc {
-    /// `diffuse` (also the approximation of `diffusetransmission`).
+    /// `diffuse`.
     Diffuse {
         /// Albedo.
         reflectance: TextureDesc,
+    },
+    /// `diffusetransmission`.
+    DiffuseTransmission {
+        /// Reflectance (pbrt default 0.25).
+        reflectance: TextureDesc,
+        /// Transmittance (pbrt default 0.25).
+        transmittance: TextureDesc,
+        /// Factor on both (pbrt default 1).
+        scale: f32,
     },
     /// `conductor`.
     Conductor {
@@ -270,17 +279,19 @@ pub fn parse_material(
                 .unwrap_or(TextureDesc::Constant(Rgb::splat(0.5))),
         },
         "diffusetransmission" => {
-            warn(
-                "diffusetransmission",
-                loc,
-                "material \"diffusetransmission\" approximated by diffuse reflection (transmission dropped)".into(),
-            );
-            let _ = params.find("transmittance");
-            let _ = params.find("scale");
-            MaterialDesc::Diffuse {
+            let quarter = || TextureDesc::Constant(Rgb::splat(0.25));
+            let scale = params.float("scale", 1.0)?;
+            if !(scale.is_finite() && scale >= 0.0) {
+                return Err(err_at(loc, format!("'scale' must be ≥ 0, found {scale}")));
+            }
+            MaterialDesc::DiffuseTransmission {
                 reflectance: tex
                     .spectrum_param(params, "reflectance", Some(Rgb::splat(0.25)))?
-                    .unwrap_or(TextureDesc::Constant(Rgb::splat(0.25))),
+                    .unwrap_or_else(quarter),
+                transmittance: tex
+                    .spectrum_param(params, "transmittance", Some(Rgb::splat(0.25)))?
+                    .unwrap_or_else(quarter),
+                scale,
             }
         }
         "conductor" => MaterialDesc::Conductor {
@@ -431,6 +442,15 @@ pub fn to_material(
     Ok(match desc {
         MaterialDesc::Diffuse { reflectance } => Material::Diffuse {
             reflectance: texture(reflectance, images)?,
+        },
+        MaterialDesc::DiffuseTransmission {
+            reflectance,
+            transmittance,
+            scale,
+        } => Material::DiffuseTransmission {
+            reflectance: texture(reflectance, images)?,
+            transmittance: texture(transmittance, images)?,
+            scale: *scale,
         },
         MaterialDesc::Conductor {
             eta,

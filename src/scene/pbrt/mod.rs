@@ -102,12 +102,26 @@ impl PbrtScene {
     pub fn into_builder(self) -> anyhow::Result<(SceneBuilder, Camera, FilmSpec, Vec<String>)> {
         let mut warnings = self.warnings;
         let mut b = SceneBuilder::new();
+        let mut warned_at = std::collections::HashSet::new();
         for m in &self.materials {
             b.add_material(materials::to_material(m, &self.images, &mut warnings)?);
         }
         for s in self.shapes {
             let r = match s.geom {
-                ShapeGeom::Mesh(mesh) => b.add_mesh(mesh, s.material, s.emission),
+                // Meshes were repaired when read; an instance's transform can still overflow.
+                ShapeGeom::Mesh(mesh) => {
+                    b.add_mesh_repaired(mesh, s.material, s.emission)
+                        .map(|rep| {
+                            // One warning per ObjectInstance line, however many shapes.
+                            if !rep.is_clean() && warned_at.insert(s.loc.file_line()) {
+                                warnings.push(format!(
+                                    "{}: warning: instanced mesh: {}",
+                                    s.loc.file_line(),
+                                    rep.describe()
+                                ));
+                            }
+                        })
+                }
                 ShapeGeom::Sphere { to_world, radius } => b.add_sphere(
                     to_world,
                     radius,

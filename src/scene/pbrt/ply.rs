@@ -1,6 +1,8 @@
 //! PLY meshes (ASCII and binary, either endianness) via `ply-rs-bw`: positions, optional
-//! normals and uvs, triangle and quad faces (larger polygons are fan-triangulated).
+//! normals and uvs, triangle and quad faces (larger polygons are triangulated by
+//! [`crate::scene::polygon`]).
 
+use crate::scene::polygon::triangulate;
 use anyhow::{Context, anyhow};
 use glam::{Vec2, Vec3};
 use ply_rs_bw::parser::{Parser, Reader};
@@ -18,7 +20,7 @@ pub struct PlyMesh {
     pub uvs: Option<Vec<Vec2>>,
     /// Triangle indices.
     pub indices: Vec<u32>,
-    /// Faces with more than four vertices (fan-triangulated).
+    /// Faces with more than four vertices (triangulated).
     pub big_polygons: usize,
 }
 
@@ -181,10 +183,8 @@ pub fn read_ply(path: &Path) -> anyhow::Result<PlyMesh> {
                     if ix.len() > 4 {
                         mesh.big_polygons += 1;
                     }
-                    // Fan: (0,1,2), (0,2,3), … — for quads the same split as pbrt.
-                    for k in 1..ix.len() - 1 {
-                        mesh.indices.extend_from_slice(&[ix[0], ix[k], ix[k + 1]]);
-                    }
+                    // Quads split along (0, 2) as pbrt does; larger polygons as OBJ faces are.
+                    triangulate(ix, &mesh.positions, &mut mesh.indices);
                 }
             }
             _ => {

@@ -8,6 +8,7 @@ use super::textures::{Warn, resolve};
 use super::tokenizer::{Loc, err_at};
 use crate::geometry::Transform;
 use crate::scene::TriangleMesh;
+use crate::scene::mesh_repair::repair_mesh;
 use glam::{Mat4, Vec2, Vec3};
 use std::f32::consts::PI;
 use std::path::Path;
@@ -119,18 +120,18 @@ pub struct RawMesh {
     pub indices: Vec<u32>,
 }
 
-/// Validate an object-space mesh and take it to world space. Errors: empty mesh, non-finite
-/// data, index out of range, attribute count mismatch, all triangles degenerate. Zero-area
-/// triangles are dropped with a warning.
-pub fn finish_mesh(raw: RawMesh, ctx: &ShapeCtx, warn: &mut Warn) -> anyhow::Result<TriangleMesh> {
+/// Validate an object-space mesh and take it to world space. Errors: indices out of range or
+/// not triples, attribute count mismatch. What a renderer can repair ([`repair_mesh`]: bad
+/// normals, zero-area or non-finite triangles) is repaired with one warning for the shape; a
+/// mesh that is empty, or left empty, is dropped with that warning (`Ok(None)`).
+pub fn finish_mesh(
+    raw: RawMesh,
+    ctx: &ShapeCtx,
+    what: &str,
+    warn: &mut Warn,
+) -> anyhow::Result<Option<TriangleMesh>> {
     let loc = ctx.loc;
     let n = raw.positions.len();
-    if n == 0 || raw.indices.is_empty() {
-        return Err(err_at(
-            loc,
-            "empty mesh: expected vertices and triangles, found none",
-        ));
-    }
     if !raw.indices.len().is_multiple_of(3) {
         return Err(err_at(
             loc,
@@ -139,9 +140,6 @@ pub fn finish_mesh(raw: RawMesh, ctx: &ShapeCtx, warn: &mut Warn) -> anyhow::Res
                 raw.indices.len()
             ),
         ));
-    }
-    if let Some(i) = raw.positions.iter().position(|p| !p.is_finite()) {
-        return Err(err_at(loc, format!("non-finite position at vertex {i}")));
     }
     if let Some((k, &i)) = raw
         .indices
@@ -154,24 +152,18 @@ pub fn finish_mesh(raw: RawMesh, ctx: &ShapeCtx, warn: &mut Warn) -> anyhow::Res
             format!("index {i} (entry {k}) out of range: mesh has {n} vertices"),
         ));
     }
-    if let Some(ns) = &raw.normals {
-        if ns.len() != n {
-            return Err(err_at(
-                loc,
-                format!("expected {n} normals, found {}", ns.len()),
-            ));
-        }
-        if let Some(i) = ns.iter().position(|p| !p.is_finite()) {
-            return Err(err_at(loc, format!("non-finite normal at vertex {i}")));
-        }
+    if let Some(ns) = &raw.normals
+        && ns.len() != n
+    {
+        return Err(err_at(
+            loc,
+            format!("expected {n} normals, found {}", ns.len()),
+        ));
     }
-    if let Some(uv) = &raw.uvs {
-        if uv.len() != n {
-            return Err(err_at(loc, format!("expected {n} uvs, found {}", uv.len())));
-        }
-        if let Some(i) = uv.iter().position(|p| !p.is_finite()) {
-            return Err(err_at(loc, format!("non-finite uv at vertex {i}")));
-        }
+    if let Some(uv) = &raw.uvs
+        && uv.len() != n
+    {
+        return Err(err_at(loc, format!("expected {n} uvs, found {}", uv.len())));
     }
     // The identity (the common case after WorldBegin) is skipped entirely: no rounding, so a
     // scene loaded from file matches the same data given to the builder bit for bit (the
@@ -186,12 +178,6 @@ pub fn finish_mesh(raw: RawMesh, ctx: &ShapeCtx, warn: &mut Warn) -> anyhow::Res
             .map(|&p| m.transform_point3(p))
             .collect()
     };
-    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-        return Err(err_at(
-            loc,
-            format!("position of vertex {i} is not finite in world space"),
-        ));
-    }
     let nt = ctx.ctm.m_inv.transpose();
     let normals = raw.normals.map(|ns| {
         if identity {
@@ -201,42 +187,22 @@ pub fn finish_mesh(raw: RawMesh, ctx: &ShapeCtx, warn: &mut Warn) -> anyhow::Res
             .map(|v| nt.transform_vector3(v).normalize_or_zero())
             .collect()
     });
-    let before = raw.indices.len() / 3;
-    let mut indices = raw.indices;
-    let mut w = 0;
-    for t in 0..before {
-        let (a, b, c) = (indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]);
-        let (pa, pb, pc) = (
-            positions[a as usize],
-            positions[b as usize],
-            positions[c as usize],
-        );
-        if (pb - pa).cross(pc - pa).length_squared() > 0.0 {
-            indices.copy_within(3 * t..3 * t + 3, 3 * w);
-            w += 1;
-        }
-    }
-    indices.truncate(3 * w);
-    if w == 0 {
-        return Err(err_at(
-            loc,
-            format!("all {before} triangles have zero area"),
-        ));
-    }
-    if w < before {
-        warn(
-            &format!("zero-area@{}", loc.file_line()),
-            loc,
-            format!("{} zero-area triangle(s) skipped", before - w),
-        );
-    }
-    Ok(TriangleMesh {
+    let mut mesh = TriangleMesh {
         positions,
         normals,
         uvs: raw.uvs,
-        indices,
+        indices: raw.indices,
         flip_normals: ctx.reverse ^ ctx.ctm.swaps_handedness(),
-    })
+    };
+    let repair = repair_mesh(&mut mesh);
+    if !repair.is_clean() {
+        warn(
+            &format!("mesh-repair@{}", loc.file_line()),
+            loc,
+            format!("{what}: {}", repair.describe()),
+        );
+    }
+    Ok((repair.kept() > 0).then_some(mesh))
 }
 
 fn indices_param(
@@ -310,16 +276,16 @@ pub fn make_shape(
         "trianglemesh" => {
             let (p, n, uv) = mesh_attrs(params, loc)?;
             let indices = indices_param(params, "indices", p.len(), 3, loc)?;
-            ShapeGeom::Mesh(finish_mesh(
-                RawMesh {
-                    positions: p,
-                    normals: n,
-                    uvs: uv,
-                    indices,
-                },
-                ctx,
-                warn,
-            )?)
+            let raw = RawMesh {
+                positions: p,
+                normals: n,
+                uvs: uv,
+                indices,
+            };
+            match finish_mesh(raw, ctx, "trianglemesh", warn)? {
+                Some(m) => ShapeGeom::Mesh(m),
+                None => return Ok(None),
+            }
         }
         "bilinearmesh" => {
             let (p, n, uv) = mesh_attrs(params, loc)?;
@@ -344,16 +310,16 @@ pub fn make_shape(
                 loc,
                 "bilinear patches approximated by two triangles each".into(),
             );
-            ShapeGeom::Mesh(finish_mesh(
-                RawMesh {
-                    positions: p,
-                    normals: n,
-                    uvs: uv,
-                    indices,
-                },
-                ctx,
-                warn,
-            )?)
+            let raw = RawMesh {
+                positions: p,
+                normals: n,
+                uvs: uv,
+                indices,
+            };
+            match finish_mesh(raw, ctx, "bilinearmesh", warn)? {
+                Some(m) => ShapeGeom::Mesh(m),
+                None => return Ok(None),
+            }
         }
         "plymesh" => {
             let file = params
@@ -375,21 +341,21 @@ pub fn make_shape(
                     "ply-polygons",
                     loc,
                     format!(
-                        "{} PLY polygons with more than 4 vertices fan-triangulated",
+                        "{} PLY polygons with more than 4 vertices triangulated (pbrt-v4 reads triangles and quads only)",
                         ply.big_polygons
                     ),
                 );
             }
-            ShapeGeom::Mesh(finish_mesh(
-                RawMesh {
-                    positions: ply.positions,
-                    normals: ply.normals,
-                    uvs: ply.uvs,
-                    indices: ply.indices,
-                },
-                ctx,
-                warn,
-            )?)
+            let raw = RawMesh {
+                positions: ply.positions,
+                normals: ply.normals,
+                uvs: ply.uvs,
+                indices: ply.indices,
+            };
+            match finish_mesh(raw, ctx, &format!("plymesh \"{file}\""), warn)? {
+                Some(m) => ShapeGeom::Mesh(m),
+                None => return Ok(None),
+            }
         }
         "sphere" => {
             let radius = params.float("radius", 1.0)?;
