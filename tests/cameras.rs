@@ -345,3 +345,73 @@ fn pbrt_cameras_parse() {
     .unwrap();
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
 }
+
+/// Render a small emissive square (a quarter of a pixel's footprint wide) on the plane z = 10,
+/// centred on the chief ray of raster point (40.825, 10.825) of a 64×32 image, so its sharp
+/// image spans [40.7, 40.95]² (0.05 pixel from the pixel's edges), through a thin lens of
+/// radius 0.5 focused at `focal`; box filter, so a sample only reaches the pixel it is drawn in.
+fn render_point(focal: f32, spp: u32) -> Vec<f64> {
+    let head = format!(
+        "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 30 \
+         \"float lensradius\" 0.5 \"float focaldistance\" {focal}\nPixelFilter \"box\"\n\
+         Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 32\nWorldBegin\n"
+    );
+    let res = UVec2::new(64, 32);
+    let cam = parse_pbrt_str("p.pbrt", &head, Path::new("."))
+        .unwrap()
+        .camera;
+    let mut pin = cam.clone();
+    pin.lens = Lens::PINHOLE;
+    let chief = pin.rays(res).generate(Vec2::new(40.825, 10.825));
+    let c = chief.o + chief.d * ((10.0 - chief.o.z) / chief.d.z);
+    // Pixel footprint at depth 10: 2·tan 15°·10 / 32 ≈ 0.167; the square is 0.042 wide.
+    let h = 0.25 * 2.0 * 15f32.to_radians().tan() * 10.0 / 32.0 / 2.0;
+    let src = format!(
+        "{head}AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n\
+         Shape \"trianglemesh\" \"point3 P\" [{x0} {y0} 10  {x1} {y0} 10  {x1} {y1} 10  {x0} {y1} 10] \
+         \"integer indices\" [0 2 1 0 3 2]\n",
+        x0 = c.x - h,
+        x1 = c.x + h,
+        y0 = c.y - h,
+        y1 = c.y + h,
+    );
+    let (b, cam, film, _) = parse_pbrt_str("p.pbrt", &src, Path::new("."))
+        .unwrap()
+        .into_builder()
+        .unwrap();
+    let scene = b.build(cam, film).unwrap();
+    let opts = RenderOptions {
+        spp,
+        ..Default::default()
+    };
+    let (img, _) = render(&scene, res, &opts).unwrap();
+    img.pixels.iter().map(|p| p.x as f64).collect()
+}
+
+#[test]
+fn thin_lens_focuses_a_point_on_the_plane_of_focus_to_one_pixel() {
+    let spp = 1024;
+    let sharp = render_point(10.0, spp);
+    let lit: Vec<usize> = (0..sharp.len()).filter(|&i| sharp[i] > 0.0).collect();
+    assert_eq!(
+        lit,
+        vec![10 * 64 + 40],
+        "in focus, only pixel (40, 10) sees the square"
+    );
+    // It covers 1/16 of the pixel's footprint, whatever the lens point.
+    let v = sharp[10 * 64 + 40];
+    let sigma = (0.0625 * (1.0 - 0.0625) / spp as f64).sqrt();
+    assert!((v - 0.0625).abs() < 5.0 * sigma, "{v}");
+    // A blur of radius 0.27 pixel (focused at 11: 0.5·|1/10 − 1/11|·16/tan 15°) already leaks
+    // past the 0.05-pixel margin.
+    let near = render_point(11.0, spp);
+    let leak: f64 = near.iter().sum::<f64>() - near[10 * 64 + 40];
+    assert!(leak > 0.0, "focused at 11, nothing left pixel (40, 10)");
+    // Focused at 5 the same square spreads over a disk of radius ≈ 3 pixels, conserving the
+    // image's total.
+    let blurred = render_point(5.0, spp);
+    let lit = blurred.iter().filter(|&&v| v > 0.0).count();
+    assert!(lit >= 20, "{lit} pixels lit out of focus");
+    let total: f64 = blurred.iter().sum();
+    assert!((total - 0.0625).abs() < 0.01, "total {total}");
+}
