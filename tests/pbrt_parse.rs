@@ -520,7 +520,8 @@ Material "conductor" "texture roughness" "r"
         TextureDesc::Image {
             path: d.join("wood.png"),
             scale: Rgb::splat(0.5),
-            invert: false
+            invert: false,
+            encoding: penumbra::scene::pbrt::textures::Encoding::SRgb,
         }
     );
     assert!(

@@ -21,7 +21,7 @@ pub const WRITE_EXTENSIONS: &[&str] = &["exr", "pfm", "png"];
 pub const READ_EXTENSIONS: &[&str] = &["exr", "pfm", "png", "tga", "jpg", "jpeg", "hdr"];
 
 /// Lower-cased extension of `path`, or "" when it has none.
-fn extension(path: &Path) -> String {
+pub fn extension(path: &Path) -> String {
     path.extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")

@@ -1,5 +1,6 @@
 //! RGB textures over (u, v).
 
+use super::float_texture::FloatTexture;
 use crate::Rgb;
 use glam::Vec2;
 use std::sync::Arc;
@@ -36,6 +37,10 @@ pub enum Texture {
         /// Squares per unit uv (u, v).
         freq: Vec2,
     },
+    /// The product of two textures (pbrt's spectrum `scale` texture with a varying factor).
+    Product(Box<Texture>, Box<Texture>),
+    /// A scalar texture as a grey colour.
+    Float(FloatTexture),
 }
 
 impl Texture {
@@ -53,6 +58,8 @@ impl Texture {
                     *b
                 }
             }
+            Texture::Product(a, b) => a.eval(uv) * b.eval(uv),
+            Texture::Float(f) => Rgb::splat(f.eval(uv)),
         }
     }
 }
