@@ -10,6 +10,7 @@ pub mod gltf;
 pub mod gltf_check;
 pub mod guard;
 pub mod load;
+pub mod loop_subdiv;
 pub mod mesh_repair;
 pub mod obj;
 pub mod obj_text;
