@@ -345,6 +345,8 @@ impl<'a> DirectLighting<'a> {
         scene
             .geometry
             .intersect_packet_cols(&cam.rays, cam.active(), hits, &mut rx.cols);
+        // Normal and bump maps replace the shading normals before the frames are built.
+        crate::scene::shading_normals::perturb_hits(scene, &mut hits[..], &mut rx.cols);
         let mut rays = n as u64;
         let isa = scene.geometry.isa();
         // The hits' shading geometry for all lanes at once, then each lane's emission and

@@ -7,7 +7,7 @@ pub mod varying;
 
 pub use float_texture::FloatTexture;
 pub use texture::Texture;
-pub use varying::{AlphaOverride, RoughnessTextures, VaryingMaterial};
+pub use varying::{AlphaOverride, NormalPerturbation, RoughnessTextures, VaryingMaterial};
 
 use crate::Rgb;
 use crate::bsdf::coated_conductor::{coated_conductor, layered_diffuse};
@@ -127,6 +127,11 @@ impl Material {
     pub fn lambert(&self, hit: &SurfaceHit) -> Option<Lambert> {
         match self {
             Material::Diffuse { reflectance } => Some(diffuse(reflectance, hit)),
+            // Only the normal varies (the hit already carries it): still Lambertian, so the
+            // lane kernels shade it as they shade the plain material.
+            Material::Varying(v) if v.roughness.is_none() && v.coat_roughness.is_none() => {
+                v.base.lambert(hit)
+            }
             _ => None,
         }
     }
@@ -218,6 +223,15 @@ impl Material {
                 reflectance.eval(hit.uv) * *scale,
                 transmittance.eval(hit.uv) * *scale,
             )),
+        }
+    }
+
+    /// The material's normal or bump map, if it has one.
+    #[inline]
+    pub fn normal_perturbation(&self) -> Option<&NormalPerturbation> {
+        match self {
+            Material::Varying(v) => v.normal.as_ref(),
+            _ => None,
         }
     }
 

@@ -81,9 +81,13 @@ impl ImageRgb {
             self.pixels[j * self.width as usize + i]
         };
         let (xi, yi) = (x0 as i64, y0 as i64);
-        at(xi, yi) * (1.0 - fx) * (1.0 - fy)
-            + at(xi + 1, yi) * fx * (1.0 - fy)
-            + at(xi, yi + 1) * (1.0 - fx) * fy
-            + at(xi + 1, yi + 1) * fx * fy
+        // Lerps rather than four weights: a region of equal texels returns exactly their
+        // value (the weights' products do not sum to exactly 1), so a flat normal map or a
+        // constant texture changes nothing.
+        let (a, b) = (at(xi, yi), at(xi + 1, yi));
+        let (c, d) = (at(xi, yi + 1), at(xi + 1, yi + 1));
+        let top = a + (b - a) * fx;
+        let bottom = c + (d - c) * fx;
+        top + (bottom - top) * fy
     }
 }

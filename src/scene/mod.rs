@@ -16,6 +16,7 @@ pub mod obj;
 pub mod obj_text;
 pub mod pbrt;
 pub mod polygon;
+pub mod shading_normals;
 pub mod view;
 
 pub use builder::SceneBuilder;

@@ -10,7 +10,9 @@ use super::textures::{FloatTexDesc, ImageCache, TextureDesc, TextureTable, Warn}
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
 use crate::bsdf::{LayerParams, roughness_to_alpha};
-use crate::material::{FloatTexture, Material, RoughnessTextures, Texture, VaryingMaterial};
+use crate::material::{
+    FloatTexture, Material, NormalPerturbation, RoughnessTextures, Texture, VaryingMaterial,
+};
 use glam::Vec2;
 
 /// A metal's eta or k: RGB, or a spectrum (named `metal-*`, inline or from a `.spd` file).
@@ -106,7 +108,18 @@ pub enum MaterialDesc {
         roughness: Option<[FloatTexDesc; 2]>,
         /// (u, v) roughness of a coated conductor's interface, when textured.
         coat_roughness: Option<[FloatTexDesc; 2]>,
+        /// Normal or bump map.
+        normal: Option<NormalDesc>,
     },
+}
+
+/// A material's normal map (resolved path, loaded while parsing) or bump displacement.
+#[derive(Clone, Debug, PartialEq)]
+pub enum NormalDesc {
+    /// `"string normalmap"`.
+    Map(std::path::PathBuf),
+    /// `"texture displacement"` (varying; a constant displacement changes nothing).
+    Bump(FloatTexDesc),
 }
 
 impl MaterialDesc {
@@ -161,21 +174,79 @@ fn prefixed_roughness(
     })
 }
 
-/// Wrap `base` when a roughness is textured.
+/// Wrap `base` when a roughness is textured or the normal is perturbed.
 fn varying(
     base: MaterialDesc,
     roughness: Option<[FloatTexDesc; 2]>,
     coat_roughness: Option<[FloatTexDesc; 2]>,
+    normal: Option<NormalDesc>,
 ) -> MaterialDesc {
-    if roughness.is_none() && coat_roughness.is_none() {
-        base
-    } else {
-        MaterialDesc::Varying {
-            base: Box::new(base),
-            roughness,
-            coat_roughness,
-        }
+    if roughness.is_none() && coat_roughness.is_none() && normal.is_none() {
+        return base;
     }
+    // A material that is already varying (a `mix` component) keeps its own maps.
+    if let MaterialDesc::Varying {
+        base,
+        roughness: r0,
+        coat_roughness: c0,
+        normal: n0,
+    } = base
+    {
+        return MaterialDesc::Varying {
+            base,
+            roughness: roughness.or(r0),
+            coat_roughness: coat_roughness.or(c0),
+            normal: normal.or(n0),
+        };
+    }
+    MaterialDesc::Varying {
+        base: Box::new(base),
+        roughness,
+        coat_roughness,
+        normal,
+    }
+}
+
+/// pbrt-v4's `"string normalmap"` / `"texture displacement"` of a material.
+fn normal_desc(
+    params: &ParamSet,
+    ctx: &MaterialCtx,
+    loc: &Loc,
+    warn: &mut Warn,
+) -> anyhow::Result<Option<NormalDesc>> {
+    let map = match params.string("normalmap")? {
+        Some(f) if !f.is_empty() => Some(NormalDesc::Map(super::textures::resolve(ctx.dir, &f))),
+        _ => None,
+    };
+    let bump = if params.has("displacement") {
+        match ctx
+            .textures
+            .float_texture_param(params, "displacement", 0.0, warn)?
+        {
+            FloatTexDesc::Constant(_) => None,
+            t => Some(NormalDesc::Bump(t)),
+        }
+    } else {
+        None
+    };
+    if map.is_some() && bump.is_some() {
+        warn(
+            "normalmap-and-bump",
+            loc,
+            "material has both 'normalmap' and 'displacement': the normal map is used".into(),
+        );
+    }
+    if map.is_none() && bump.is_some() {
+        warn(
+            "bump-approx",
+            loc,
+            format!(
+                "bump mapping: finite differences of {} in uv (no ray differentials) and without the displacement·∂n/∂u term of curved shading normals",
+                crate::material::varying::BUMP_DELTA
+            ),
+        );
+    }
+    Ok(map.or(bump))
 }
 
 /// pbrt-v4's layered-material parameters (`thickness`, `albedo`, `g`, `maxdepth`,
@@ -289,6 +360,8 @@ pub struct MaterialCtx<'a> {
     pub textures: &'a TextureTable,
     /// Looks up a named material's description (for `mix`).
     pub named: &'a dyn Fn(&str) -> Option<MaterialDesc>,
+    /// Directory of the file being parsed (normal maps are relative to it).
+    pub dir: &'a std::path::Path,
 }
 
 /// Parse a material of pbrt type `ty`.
@@ -299,13 +372,22 @@ pub fn parse_material(
     loc: &Loc,
     warn: &mut Warn,
 ) -> anyhow::Result<MaterialDesc> {
+    let normal = normal_desc(params, ctx, loc, warn)?;
+    let desc = material_body(ty, params, ctx, loc, warn)?;
+    Ok(match desc {
+        MaterialDesc::Interface => MaterialDesc::Interface,
+        d => varying(d, None, None, normal),
+    })
+}
+
+fn material_body(
+    ty: &str,
+    params: &ParamSet,
+    ctx: &MaterialCtx,
+    loc: &Loc,
+    warn: &mut Warn,
+) -> anyhow::Result<MaterialDesc> {
     let tex = ctx.textures;
-    for ignored in ["displacement", "normalmap"] {
-        if params.has(ignored) {
-            let _ = params.find(ignored);
-            warn(ignored, loc, format!("material '{ignored}' is ignored"));
-        }
-    }
     Ok(match ty {
         "diffuse" => MaterialDesc::Diffuse {
             reflectance: tex
@@ -337,7 +419,7 @@ pub fn parse_material(
                 roughness: r,
                 remap: params.bool("remaproughness", true)?,
             };
-            varying(base, rt, None)
+            varying(base, rt, None, None)
         }
         "coateddiffuse" => {
             let (r, rt) = roughness(params, tex, 0.0, warn)?;
@@ -350,7 +432,7 @@ pub fn parse_material(
                 remap: params.bool("remaproughness", true)?,
                 layer: layer_params(params, tex, loc, warn)?,
             };
-            varying(base, rt, None)
+            varying(base, rt, None, None)
         }
         "coatedconductor" => {
             let (cr, crt) = prefixed_roughness(params, tex, "interface.", 0.0, warn)?;
@@ -365,7 +447,7 @@ pub fn parse_material(
                 remap: params.bool("remaproughness", true)?,
                 layer: layer_params(params, tex, loc, warn)?,
             };
-            varying(base, rt, crt)
+            varying(base, rt, crt, None)
         }
         "dielectric" | "thindielectric" => {
             let thin = ty == "thindielectric";
@@ -383,7 +465,7 @@ pub fn parse_material(
                 remap: params.bool("remaproughness", true)?,
                 thin,
             };
-            varying(base, rt, None)
+            varying(base, rt, None, None)
         }
         "mix" => {
             let names = params.strings("materials")?.ok_or_else(|| {
@@ -615,6 +697,7 @@ pub fn to_material(
             base,
             roughness,
             coat_roughness,
+            normal,
         } => {
             let remap = match **base {
                 MaterialDesc::Conductor { remap, .. }
@@ -632,10 +715,21 @@ pub fn to_material(
                     None => None,
                 })
             };
+            let normal = match normal {
+                // pbrt-v4 reads normal maps with the linear encoding.
+                Some(NormalDesc::Map(path)) => Some(NormalPerturbation::NormalMap(image(
+                    path,
+                    super::textures::Encoding::Linear,
+                    images,
+                )?)),
+                Some(NormalDesc::Bump(t)) => Some(NormalPerturbation::Bump(float_texture(t, images)?)),
+                None => None,
+            };
             Material::Varying(Box::new(VaryingMaterial {
                 base: to_material(base, images, warnings)?,
                 roughness: textures(roughness)?,
                 coat_roughness: textures(coat_roughness)?,
+                normal,
             }))
         }
         MaterialDesc::Interface => {

@@ -387,9 +387,36 @@ impl Parser {
             .map(|(k, &i)| (k.clone(), self.descs[i].clone()))
             .collect();
         let lookup = |n: &str| named.get(n).cloned();
+        let dir = self.dir();
+        // A normal map is loaded (cached with the textures' images) before the material
+        // refers to it.
+        if let Some(f) = ps.string("normalmap")?
+            && !f.is_empty()
+        {
+            let path = super::textures::resolve(&dir, &f);
+            let floc = ps.loc_of("normalmap").unwrap_or(loc.clone());
+            if let Some(why) = crate::image::io::not_a_file(&path) {
+                return Err(err_at(&floc, format!("normalmap: {why}: {}", path.display())));
+            }
+            // pbrt-v4 reads the three channels as a direction: a grey image is an error
+            // there too, not a normal map of (g, g, g).
+            let color = crate::image::io::has_color_channels(&path)
+                .map_err(|e| err_at(&floc, format!("normalmap: {e:#}")))?;
+            if !color {
+                return Err(err_at(
+                    &floc,
+                    format!(
+                        "normalmap: {} has one (grey) channel; a normal map needs R, G and B",
+                        path.display()
+                    ),
+                ));
+            }
+            super::textures::load_image(&mut self.textures.images, &path, &floc)?;
+        }
         let ctx = MaterialCtx {
             textures: &self.textures,
             named: &lookup,
+            dir: &dir,
         };
         let mut pending = Vec::new();
         let d = parse_material(ty, ps, &ctx, loc, &mut |k: &str, l: &Loc, m: String| {
@@ -1061,6 +1088,21 @@ impl Parser {
             );
             return Ok(());
         };
+        if !matches!(geom, super::shapes::ShapeGeom::Mesh(_))
+            && matches!(
+                self.out.materials.get(material as usize),
+                Some(MaterialDesc::Varying {
+                    normal: Some(_),
+                    ..
+                })
+            )
+        {
+            self.warn(
+                "normalmap-quadric",
+                loc,
+                format!("normal and bump maps on a \"{ty}\" are ignored (triangle meshes only)"),
+            );
+        }
         let emission = self.gs.area.as_ref().map(|a| AreaEmission {
             l: a.radiance_for_area(geom.area()),
             two_sided: a.two_sided,
