@@ -252,7 +252,7 @@ fn bump_map_of_a_linear_ramp_renders_as_the_tilted_normal() {
     // A constant displacement is no bump at all: the material stays plain.
     let s = parse_pbrt_str(
         "t.pbrt",
-        "WorldBegin\nMaterial \"diffuse\" \"float displacement\" 0.3\n",
+        "WorldBegin\nMaterial \"diffuse\" \"float displacement\" 0.3\nShape \"sphere\"\n",
         &d,
     )
     .unwrap();
