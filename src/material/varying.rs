@@ -49,9 +49,18 @@ pub struct VaryingMaterial {
 /// pbrt-v4's two ways of changing the shading normal.
 #[derive(Clone, Debug)]
 pub enum NormalPerturbation {
-    /// `"string normalmap"`: a tangent-space normal (x along ∂p/∂u, z along the shading
-    /// normal) encoded as RGB = (n + 1)/2, linear, bilinearly filtered.
-    NormalMap(Arc<ImageRgb>),
+    /// `"string normalmap"` (and glTF's `normalTexture`): a tangent-space normal (x along
+    /// ∂p/∂u, z along the shading normal) encoded as RGB = (n + 1)/2, linear, bilinearly
+    /// filtered.
+    NormalMap {
+        /// The encoded normals.
+        image: Arc<ImageRgb>,
+        /// glTF's `normalTexture.scale` on the tangent-space x and y (1 for pbrt).
+        scale: f32,
+        /// y of the frame along ∂p/∂v's side of n × ∂p/∂u, as MikkTSpace tangents (glTF) make
+        /// it on mirrored uvs; pbrt-v4 always takes n × ∂p/∂u.
+        uv_handed: bool,
+    },
     /// `"texture displacement"`: the surface moved along its normal by a float texture.
     Bump(FloatTexture),
 }
@@ -66,16 +75,27 @@ impl NormalPerturbation {
     /// Bump mapping leaves out pbrt-v4's displacement·∂n/∂u term (zero on flat triangles).
     pub fn shading_normal(&self, uv: Vec2, ns: Vec3, ng: Vec3, dpdu: Vec3, dpdv: Vec3) -> Vec3 {
         let n = match self {
-            NormalPerturbation::NormalMap(img) => {
-                let c = img.bilinear(uv);
-                let local = (2.0 * c - Vec3::ONE).normalize_or_zero();
+            NormalPerturbation::NormalMap {
+                image,
+                scale,
+                uv_handed,
+            } => {
+                let c = image.bilinear(uv);
+                let mut local = 2.0 * c - Vec3::ONE;
+                if *scale != 1.0 {
+                    local *= Vec3::new(*scale, *scale, 1.0);
+                }
+                let local = local.normalize_or_zero();
                 // pbrt-v4's Frame::FromXZ: x = ∂p/∂u (made perpendicular to the shading
                 // normal, as pbrt's shading ∂p/∂u already is), z = ns, y = z × x.
                 let x = (dpdu - ns * ns.dot(dpdu)).normalize_or_zero();
                 if local == Vec3::ZERO || x == Vec3::ZERO {
                     return ns;
                 }
-                let y = ns.cross(x);
+                let mut y = ns.cross(x);
+                if *uv_handed && y.dot(dpdv) < 0.0 {
+                    y = -y;
+                }
                 // Unit to rounding (an orthonormal frame times a unit vector), and left
                 // unnormalised so that a flat texel, local = +z exactly, gives back ns bit
                 // for bit.

@@ -717,11 +717,11 @@ pub fn to_material(
             };
             let normal = match normal {
                 // pbrt-v4 reads normal maps with the linear encoding.
-                Some(NormalDesc::Map(path)) => Some(NormalPerturbation::NormalMap(image(
-                    path,
-                    super::textures::Encoding::Linear,
-                    images,
-                )?)),
+                Some(NormalDesc::Map(path)) => Some(NormalPerturbation::NormalMap {
+                    image: image(path, super::textures::Encoding::Linear, images)?,
+                    scale: 1.0,
+                    uv_handed: false,
+                }),
                 Some(NormalDesc::Bump(t)) => Some(NormalPerturbation::Bump(float_texture(t, images)?)),
                 None => None,
             };
