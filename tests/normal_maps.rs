@@ -299,3 +299,83 @@ fn bad_normal_maps_are_errors_at_their_line() {
     assert_eq!(w.len(), 1, "{:?}", s.warnings);
     assert!(w[0].contains("t.pbrt:3") && w[0].contains("sphere"), "{w:?}");
 }
+
+/// The (u, v) each pixel centre of `render_square`'s 32×16 view sees (UV layout), found by
+/// projecting a fine grid of points of the square.
+fn pixel_uvs(dir: &Path) -> Vec<glam::Vec2> {
+    let s = parse_pbrt_str(
+        "t.pbrt",
+        "LookAt 0.5 0.5 2  0.5 0.5 0  0 1 0\nCamera \"orthographic\" \"float screenwindow\" [-0.5 0.5 -0.25 0.25]\n\
+         Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 16\nWorldBegin\n",
+        dir,
+    )
+    .unwrap();
+    let res = UVec2::new(32, 16);
+    let mut best = vec![(f32::INFINITY, glam::Vec2::ZERO); 32 * 16];
+    for i in 0..=400 {
+        for j in 0..=400 {
+            let uv = glam::Vec2::new(i as f32 / 400.0, j as f32 / 400.0);
+            let Some(p) = s.camera.project(Vec3::new(uv.x, uv.y, 0.0), res) else {
+                continue;
+            };
+            let (x, y) = (p.x.floor() as i64, p.y.floor() as i64);
+            if !(0..32).contains(&x) || !(0..16).contains(&y) {
+                continue;
+            }
+            let k = y as usize * 32 + x as usize;
+            let d = (p - (glam::Vec2::new(x as f32, y as f32) + 0.5)).length();
+            if d < best[k].0 {
+                best[k] = (d, uv);
+            }
+        }
+    }
+    best.into_iter().map(|b| b.1).collect()
+}
+
+#[test]
+fn normal_map_texels_land_where_their_uv_is() {
+    // Four quadrants of different tilts: the lookup's u and v orientation (an image row 0 is
+    // v = 1) must put each where its uv is, as a constant map cannot tell.
+    let d = tmpdir("quad");
+    let t = 0.3f32;
+    let tilt = |x: f32, y: f32| Vec3::new(x * t.sin(), y * t.sin(), 1.0).normalize();
+    // (u < ½ or not, v < ½ or not) → tangent-space normal.
+    let quadrant = |u_hi: bool, v_hi: bool| match (u_hi, v_hi) {
+        (false, false) => tilt(1.0, 0.0),
+        (true, false) => tilt(0.0, 1.0),
+        (false, true) => tilt(-1.0, 0.0),
+        (true, true) => tilt(0.0, -1.0),
+    };
+    let mut img = Image::new(8, 8);
+    for (k, p) in img.pixels.iter_mut().enumerate() {
+        let (i, j) = (k % 8, k / 8);
+        // Row j = 0 is the top, v = 1.
+        *p = (quadrant(i >= 4, j < 4) + Vec3::ONE) * 0.5;
+    }
+    write_image(&img, &d.join("q.exr"), 0.0).unwrap();
+    let r = render_square(
+        &d,
+        "",
+        &format!("Material \"diffuse\" {MAT} \"string normalmap\" \"q.exr\""),
+        UV,
+        "",
+    );
+    let uvs = pixel_uvs(&d);
+    let mut checked = [0usize; 4];
+    for (k, uv) in uvs.iter().enumerate() {
+        // Pure texels only: more than one texel (1/8) from the quadrant borders and the wrap.
+        let inner = |c: f32| (0.07..0.43).contains(&c) || (0.57..0.93).contains(&c);
+        if !inner(uv.x) || !inner(uv.y) {
+            continue;
+        }
+        let (u_hi, v_hi) = (uv.x > 0.5, uv.y > 0.5);
+        let want = analytic(quadrant(u_hi, v_hi));
+        let got = r.pixels[k].x as f64;
+        assert!(
+            (got - want).abs() <= 2e-5 * want,
+            "pixel {k} at uv {uv}: {got} vs {want}"
+        );
+        checked[u_hi as usize + 2 * v_hi as usize] += 1;
+    }
+    assert!(checked.iter().all(|&c| c >= 8), "{checked:?}");
+}
