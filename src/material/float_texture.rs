@@ -1,7 +1,7 @@
 //! Scalar textures over (u, v): pbrt-v4's float `constant`, `imagemap` and `scale` textures
 //! (roughness, bump displacement, the factor of a spectrum `scale` texture).
 
-use super::texture::ImageRgb;
+use super::texture::{ImageRgb, UvMap};
 use glam::Vec2;
 use std::sync::Arc;
 
@@ -22,6 +22,8 @@ pub enum FloatTexture {
     },
     /// Product of two float textures (pbrt's float `scale` texture).
     Product(Box<FloatTexture>, Box<FloatTexture>),
+    /// A texture looked up through a uv mapping.
+    Mapped(UvMap, Box<FloatTexture>),
 }
 
 impl FloatTexture {
@@ -39,6 +41,7 @@ impl FloatTexture {
                 if *invert { (1.0 - v).max(0.0) } else { v }
             }
             FloatTexture::Product(a, b) => a.eval(uv) * b.eval(uv),
+            FloatTexture::Mapped(m, t) => t.eval(m.apply(uv)),
         }
     }
 
@@ -47,6 +50,7 @@ impl FloatTexture {
         match self {
             FloatTexture::Constant(v) => Some(*v),
             FloatTexture::Product(a, b) => Some(a.constant()? * b.constant()?),
+            FloatTexture::Mapped(_, t) => t.constant(),
             FloatTexture::Image { .. } => None,
         }
     }

@@ -16,6 +16,30 @@ pub struct ImageRgb {
     pub pixels: Vec<Rgb>,
 }
 
+/// pbrt-v4's `UVMapping`: the texture is looked up at (su·u + du, sv·v + dv) (`uscale`,
+/// `vscale`, `udelta`, `vdelta`), so one image can tile a floor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvMap {
+    /// (uscale, vscale).
+    pub scale: Vec2,
+    /// (udelta, vdelta).
+    pub delta: Vec2,
+}
+
+impl UvMap {
+    /// The identity mapping.
+    pub const IDENTITY: UvMap = UvMap {
+        scale: Vec2::ONE,
+        delta: Vec2::ZERO,
+    };
+
+    /// Texture-space coordinates of surface coordinates `uv`.
+    #[inline]
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        uv * self.scale + self.delta
+    }
+}
+
 /// A colour that can vary over the surface.
 #[derive(Clone, Debug)]
 pub enum Texture {
@@ -41,6 +65,8 @@ pub enum Texture {
     Product(Box<Texture>, Box<Texture>),
     /// A scalar texture as a grey colour.
     Float(FloatTexture),
+    /// A texture looked up through a uv mapping.
+    Mapped(UvMap, Box<Texture>),
 }
 
 impl Texture {
@@ -60,6 +86,7 @@ impl Texture {
             }
             Texture::Product(a, b) => a.eval(uv) * b.eval(uv),
             Texture::Float(f) => Rgb::splat(f.eval(uv)),
+            Texture::Mapped(m, t) => t.eval(m.apply(uv)),
         }
     }
 }

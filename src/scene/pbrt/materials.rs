@@ -532,6 +532,9 @@ pub fn float_texture(t: &FloatTexDesc, images: &ImageCache) -> anyhow::Result<Fl
             Box::new(float_texture(a, images)?),
             Box::new(float_texture(b, images)?),
         ),
+        FloatTexDesc::Mapped(m, t) => {
+            FloatTexture::Mapped(*m, Box::new(float_texture(t, images)?))
+        }
     })
 }
 
@@ -571,6 +574,7 @@ fn texture(t: &TextureDesc, images: &ImageCache) -> anyhow::Result<Texture> {
             Texture::Product(Box::new(texture(a, images)?), Box::new(texture(b, images)?))
         }
         TextureDesc::Float(f) => Texture::Float(float_texture(f, images)?),
+        TextureDesc::Mapped(m, t) => Texture::Mapped(*m, Box::new(texture(t, images)?)),
     })
 }
 

@@ -5,7 +5,7 @@ use super::params::{ParamSet, ParamType};
 use super::spectra::{SpectrumUse, to_rgb};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
-use crate::material::texture::ImageRgb;
+use crate::material::texture::{ImageRgb, UvMap};
 use glam::Vec2;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -108,6 +108,8 @@ pub enum FloatTexDesc {
     },
     /// Product (pbrt's float `scale` texture with a varying factor).
     Product(Box<FloatTexDesc>, Box<FloatTexDesc>),
+    /// Looked up through a uv mapping.
+    Mapped(UvMap, Box<FloatTexDesc>),
 }
 
 impl FloatTexDesc {
@@ -117,6 +119,7 @@ impl FloatTexDesc {
             Self::Constant(v) => Some(*v),
             Self::Product(a, b) => Some(a.constant()? * b.constant()?),
             Self::Image { .. } => None,
+            Self::Mapped(_, t) => t.constant(),
         }
     }
 
@@ -158,6 +161,8 @@ pub enum TextureDesc {
         /// (uscale, vscale)
         freq: Vec2,
     },
+    /// Looked up through a uv mapping.
+    Mapped(UvMap, Box<TextureDesc>),
 }
 
 impl TextureDesc {
@@ -186,6 +191,7 @@ impl TextureDesc {
                 b: b * s,
                 freq,
             },
+            Self::Mapped(m, t) => Self::Mapped(m, Box::new(t.scaled(s))),
         }
     }
 }
@@ -363,12 +369,37 @@ impl TextureTable {
                 format!("texture mapping \"{m}\" approximated by uv"),
             );
         }
-        for ignored in ["maxanisotropy", "udelta", "vdelta", "dimension"] {
+        for ignored in ["maxanisotropy", "dimension"] {
             let _ = params.find(ignored);
         }
+        // pbrt-v4's uv mapping of the classes that have one (checkerboard's scale is its
+        // square frequency below; its offset is mapped here).
+        let mapped = matches!(class, "imagemap" | "checkerboard");
+        let map = if mapped {
+            let scale = Vec2::new(params.float("uscale", 1.0)?, params.float("vscale", 1.0)?);
+            let delta = Vec2::new(params.float("udelta", 0.0)?, params.float("vdelta", 0.0)?);
+            if class == "checkerboard" {
+                // floor(s·u + d) = floor(s·(u + d/s)): the offset goes before the squares'
+                // frequency (a zero frequency makes one square whatever the offset).
+                let d = |d: f32, s: f32| if s == 0.0 { 0.0 } else { d / s };
+                UvMap {
+                    scale: Vec2::ONE,
+                    delta: Vec2::new(d(delta.x, scale.x), d(delta.y, scale.y)),
+                }
+            } else {
+                UvMap { scale, delta }
+            }
+        } else {
+            UvMap::IDENTITY
+        };
         match ty {
             "spectrum" | "color" => {
                 let d = self.spectrum_texture(class, params, dir, loc, warn)?;
+                let d = if map == UvMap::IDENTITY {
+                    d
+                } else {
+                    TextureDesc::Mapped(map, Box::new(d))
+                };
                 self.spectrum.insert(name.to_string(), d);
             }
             "float" => {
@@ -396,6 +427,12 @@ impl TextureTable {
                         );
                         None
                     }
+                };
+                let v = match v {
+                    Some(t) if map != UvMap::IDENTITY => {
+                        Some(FloatTexDesc::Mapped(map, Box::new(t)))
+                    }
+                    v => v,
                 };
                 self.float.insert(name.to_string(), v);
             }
