@@ -3,8 +3,10 @@
 //! image is bit-identical for any thread count and schedule.
 
 use super::RenderOptions;
-use super::direct::{CameraPacket, DIM_FILTER, DIM_LENS, DirectLighting, PacketScratch};
+use super::dims::{DIM_FILTER, DIM_LENS};
 use super::film::{FilterSampler, filter_sample};
+use super::queues::CameraPacket;
+use super::stages::{Integrator, Queues};
 use crate::Rgb;
 use crate::camera::CameraRays;
 use crate::geometry::{PACKET, Ray, RayPacket};
@@ -56,7 +58,7 @@ pub fn render(
     anyhow::ensure!(opts.spp > 0, "--spp must be at least 1");
     let selector = make_selector(&opts.light_selection, scene, opts.seed)?;
     let pattern = make_pattern(opts.pattern, opts.seed);
-    let est = DirectLighting {
+    let est = Integrator {
         scene,
         selector: selector.as_ref(),
         pattern: pattern.as_ref(),
@@ -110,13 +112,13 @@ pub fn render(
                 let mut next = 0;
                 let mut cam = CameraPacket::new();
                 let mut radiance = [Rgb::ZERO; PACKET];
-                let mut scratch = PacketScratch::new();
+                let mut queues = Queues::new();
                 let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
                 let mut flush = |cam: &mut CameraPacket,
                                  pxs: &[PixelSamples],
                                  owner: &[usize; PACKET],
                                  weight: &[f32; PACKET]| {
-                    tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut scratch);
+                    tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut queues);
                     for k in 0..cam.n {
                         // Filters with negative lobes weight their samples (mean weight 1);
                         // box, tent and gaussian samples all weigh exactly 1.
