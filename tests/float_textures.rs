@@ -304,17 +304,29 @@ fn uv_mapping_scales_and_offsets_image_and_checkerboard_lookups() {
         m => panic!("{m:?}"),
     };
     let (c, k) = (tex(1), tex(2));
-    for uv in [Vec2::new(0.1, 0.2), Vec2::new(0.37, 0.8), Vec2::new(0.9, 0.55)] {
+    for uv in [
+        Vec2::new(0.1, 0.2),
+        Vec2::new(0.37, 0.8),
+        Vec2::new(0.9, 0.55),
+    ] {
         let st = Vec2::new(3.0 * uv.x + 0.3, 2.0 * uv.y - 0.2);
         let want = raw.eval(st);
-        assert!((f.eval(uv) - want).abs() < 1e-6, "float at {uv}: {} vs {want}", f.eval(uv));
+        assert!(
+            (f.eval(uv) - want).abs() < 1e-6,
+            "float at {uv}: {} vs {want}",
+            f.eval(uv)
+        );
         assert!((c.eval(uv).x - want).abs() < 1e-6, "spectrum at {uv}");
         // The mapped lookup differs from the unmapped one here (the test can tell).
         assert!((raw.eval(uv) - want).abs() > 0.02, "{uv}");
     }
     // Checkerboard: squares of 1/4, shifted by udelta 0.5 (an eighth of a square pair).
     let even = |u: f32, v: f32| ((4.0 * u + 0.5).floor() + (4.0 * v).floor()) as i64 % 2 == 0;
-    for uv in [Vec2::new(0.05, 0.1), Vec2::new(0.2, 0.1), Vec2::new(0.6, 0.3)] {
+    for uv in [
+        Vec2::new(0.05, 0.1),
+        Vec2::new(0.2, 0.1),
+        Vec2::new(0.6, 0.3),
+    ] {
         let want = if even(uv.x, uv.y) { 1.0 } else { 0.0 };
         assert_eq!(k.eval(uv).x, want, "checkerboard at {uv}");
     }

@@ -143,7 +143,10 @@ fn constant_tilt_normal_map_renders_as_the_tilted_normal() {
         assert_analytic(what, &img, 0, 32, world);
         // The tilt is visible: far outside the bound of the flat plane's value.
         let (m, _) = mean_sigma(&img, 0, 32);
-        assert!((m - flat_mean).abs() > 0.02 * flat_mean, "{what}: {m} vs flat {flat_mean}");
+        assert!(
+            (m - flat_mean).abs() > 0.02 * flat_mean,
+            "{what}: {m} vs flat {flat_mean}"
+        );
     }
 }
 
@@ -297,7 +300,10 @@ fn bad_normal_maps_are_errors_at_their_line() {
     .unwrap();
     let w: Vec<_> = s.warnings.iter().filter(|w| w.contains("normal")).collect();
     assert_eq!(w.len(), 1, "{:?}", s.warnings);
-    assert!(w[0].contains("t.pbrt:3") && w[0].contains("sphere"), "{w:?}");
+    assert!(
+        w[0].contains("t.pbrt:3") && w[0].contains("sphere"),
+        "{w:?}"
+    );
 }
 
 /// The (u, v) each pixel centre of `render_square`'s 32×16 view sees (UV layout), found by

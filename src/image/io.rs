@@ -402,12 +402,9 @@ pub fn has_color_channels(path: &Path) -> anyhow::Result<bool> {
                     .headers
                     .first()
                     .ok_or_else(|| anyhow::anyhow!("no layers"))?;
-                ["R", "G", "B"].iter().all(|c| {
-                    h.channels
-                        .list
-                        .iter()
-                        .any(|ch| ch.name.to_string() == *c)
-                })
+                ["R", "G", "B"]
+                    .iter()
+                    .all(|c| h.channels.list.iter().any(|ch| ch.name.to_string() == *c))
             }
             "pfm" => {
                 let mut magic = [0u8; 2];

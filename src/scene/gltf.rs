@@ -460,30 +460,32 @@ fn gltf_material(
         Rgb::ONE
     };
     // Image `img` decoded (sRGB-linearised for colours, as stored for data), once per use.
-    let mut decoded_image = |img: ::gltf::Image,
-                             srgb: bool,
-                             instead: &str,
-                             warnings: &mut Vec<String>| {
-        let idx = img.index();
-        match images.get_mut(idx) {
-            Some(slot) => slot[srgb as usize]
-                .get_or_insert_with(|| match decode_image(&img, buffers, dir, srgb) {
-                    Ok(i) => Some(Arc::new(i)),
-                    Err(e) => {
-                        warnings.push(format!(
-                            "{file}: image {idx}: {e:#}; material '{name}' {instead}"
-                        ));
-                        None
-                    }
-                })
-                .clone(),
-            None => None,
-        }
-    };
+    let mut decoded_image =
+        |img: ::gltf::Image, srgb: bool, instead: &str, warnings: &mut Vec<String>| {
+            let idx = img.index();
+            match images.get_mut(idx) {
+                Some(slot) => slot[srgb as usize]
+                    .get_or_insert_with(|| match decode_image(&img, buffers, dir, srgb) {
+                        Ok(i) => Some(Arc::new(i)),
+                        Err(e) => {
+                            warnings.push(format!(
+                                "{file}: image {idx}: {e:#}; material '{name}' {instead}"
+                            ));
+                            None
+                        }
+                    })
+                    .clone(),
+                None => None,
+            }
+        };
     let base = match pbr.base_color_texture() {
         Some(info) => {
-            let decoded =
-                decoded_image(info.texture().source(), true, "uses its base colour factor", warnings);
+            let decoded = decoded_image(
+                info.texture().source(),
+                true,
+                "uses its base colour factor",
+                warnings,
+            );
             if info.tex_coord() != 0 {
                 warnings.push(format!(
                     "{file}: material '{name}': texture uses TEXCOORD_{}, only TEXCOORD_0 is read",
@@ -578,7 +580,12 @@ fn gltf_material(
     // bitangent sign MikkTSpace stores in TANGENT.w), scaled in x and y by `scale`.
     let material = match m.normal_texture() {
         Some(info) => {
-            let decoded = decoded_image(info.texture().source(), false, "has no normal map", warnings);
+            let decoded = decoded_image(
+                info.texture().source(),
+                false,
+                "has no normal map",
+                warnings,
+            );
             if info.tex_coord() != 0 {
                 warnings.push(format!(
                     "{file}: material '{name}': normalTexture uses TEXCOORD_{}, only TEXCOORD_0 is read",
@@ -590,7 +597,11 @@ fn gltf_material(
                     warnings.push(format!(
                         "{file}: material '{name}': normalTexture tangents are each triangle's ∂p/∂u (TANGENT attributes and MikkTSpace's per-vertex smoothing are not used)"
                     ));
-                    let scale = if info.scale().is_finite() { info.scale() } else { 1.0 };
+                    let scale = if info.scale().is_finite() {
+                        info.scale()
+                    } else {
+                        1.0
+                    };
                     Material::Varying(Box::new(VaryingMaterial {
                         base: material,
                         roughness: None,

@@ -9,7 +9,12 @@ use glam::{Vec2, Vec3};
 /// ∂p/∂u and ∂p/∂v of triangle `p` with texture coordinates `uv` (pbrt-v4's triangle
 /// derivatives, made perpendicular to the shading normal `ns` when the mesh has vertex
 /// normals); `None` when the uvs are degenerate.
-fn triangle_derivatives(p: [Vec3; 3], uv: [Vec2; 3], ns: Vec3, smooth: bool) -> Option<(Vec3, Vec3)> {
+fn triangle_derivatives(
+    p: [Vec3; 3],
+    uv: [Vec2; 3],
+    ns: Vec3,
+    smooth: bool,
+) -> Option<(Vec3, Vec3)> {
     let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
     let (dp02, dp12) = (p[0] - p[2], p[1] - p[2]);
     let det = duv02.x * duv12.y - duv02.y * duv12.x;

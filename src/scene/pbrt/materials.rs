@@ -532,9 +532,7 @@ pub fn float_texture(t: &FloatTexDesc, images: &ImageCache) -> anyhow::Result<Fl
             Box::new(float_texture(a, images)?),
             Box::new(float_texture(b, images)?),
         ),
-        FloatTexDesc::Mapped(m, t) => {
-            FloatTexture::Mapped(*m, Box::new(float_texture(t, images)?))
-        }
+        FloatTexDesc::Mapped(m, t) => FloatTexture::Mapped(*m, Box::new(float_texture(t, images)?)),
     })
 }
 
@@ -726,7 +724,9 @@ pub fn to_material(
                     scale: 1.0,
                     uv_handed: false,
                 }),
-                Some(NormalDesc::Bump(t)) => Some(NormalPerturbation::Bump(float_texture(t, images)?)),
+                Some(NormalDesc::Bump(t)) => {
+                    Some(NormalPerturbation::Bump(float_texture(t, images)?))
+                }
                 None => None,
             };
             Material::Varying(Box::new(VaryingMaterial {

@@ -396,7 +396,10 @@ impl Parser {
             let path = super::textures::resolve(&dir, &f);
             let floc = ps.loc_of("normalmap").unwrap_or(loc.clone());
             if let Some(why) = crate::image::io::not_a_file(&path) {
-                return Err(err_at(&floc, format!("normalmap: {why}: {}", path.display())));
+                return Err(err_at(
+                    &floc,
+                    format!("normalmap: {why}: {}", path.display()),
+                ));
             }
             // pbrt-v4 reads the three channels as a direction: a grey image is an error
             // there too, not a normal map of (g, g, g).
