@@ -288,9 +288,27 @@ pub fn write_image_with(
     exposure_stops: f32,
     ctl: &WriteControl,
 ) -> anyhow::Result<()> {
+    write_image_tagged(img, path, exposure_stops, &[], ctl)
+}
+
+/// [`write_image_with`] that also stores text `attributes` (name, value) in the header; only
+/// EXR has one, so other formats with attributes are an error.
+pub fn write_image_tagged(
+    img: &Image,
+    path: &Path,
+    exposure_stops: f32,
+    attributes: &[(&str, String)],
+    ctl: &WriteControl,
+) -> anyhow::Result<()> {
     let ext = extension(path);
     if !WRITE_EXTENSIONS.contains(&ext.as_str()) {
         check_output_path(path)?;
+    }
+    if !attributes.is_empty() && ext != "exr" {
+        bail!(
+            "cannot write {}: only .exr files carry the header this image needs",
+            path.display()
+        );
     }
     let expected = img.width as usize * img.height as usize;
     if img.pixels.len() != expected {
@@ -322,7 +340,7 @@ pub fn write_image_with(
         img
     };
     let bytes = match ext.as_str() {
-        "exr" => encode_exr(img),
+        "exr" => encode_exr(img, attributes),
         "pfm" => Ok(encode_pfm(img)),
         _ => encode_png(&to_rgb8(img, exposure_stops)),
     }
@@ -330,15 +348,26 @@ pub fn write_image_with(
     write_bytes_atomic_with(path, &bytes, ctl)
 }
 
-/// OpenEXR, three f32 channels, default (lossless) compression.
-fn encode_exr(img: &Image) -> anyhow::Result<Vec<u8>> {
-    use exr::prelude::{SpecificChannels, Vec2, WritableImage};
+/// OpenEXR, three f32 channels, default (lossless) compression, text `attributes` in the
+/// layer header.
+fn encode_exr(img: &Image, attributes: &[(&str, String)]) -> anyhow::Result<Vec<u8>> {
+    use exr::prelude::{AttributeValue, SpecificChannels, Text, Vec2, WritableImage};
     let w = img.width as usize;
     let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
         let p = img.pixels[y * w + x];
         (p.x, p.y, p.z)
     });
-    let image = exr::image::Image::from_channels((w, img.height as usize), channels);
+    let mut image = exr::image::Image::from_channels((w, img.height as usize), channels);
+    for (name, value) in attributes {
+        let text = |s: &str| {
+            Text::new_or_none(s).ok_or_else(|| anyhow::anyhow!("EXR attribute {s:?} is not text"))
+        };
+        image
+            .layer_data
+            .attributes
+            .other
+            .insert(text(name)?, AttributeValue::Text(text(value)?));
+    }
     let mut buf = Cursor::new(Vec::new());
     image.write().to_buffered(&mut buf)?;
     Ok(buf.into_inner())
@@ -495,6 +524,27 @@ fn read_exr(path: &Path) -> anyhow::Result<Image> {
         // exr's errors print their io cause in their own message: keep that one only.
         Err(rgba_err) => read_exr_grey(path).map_err(|_| anyhow::anyhow!("{rgba_err}")),
     }
+}
+
+/// The text attributes of an EXR's first layer header (name, value), sorted by name.
+pub fn read_exr_attributes(path: &Path) -> anyhow::Result<Vec<(String, String)>> {
+    if let Some(why) = not_a_file(path) {
+        bail!("cannot read {}: {why}", path.display());
+    }
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .map_err(|e| anyhow::anyhow!("reading {}: {e}", path.display()))?;
+    let mut out: Vec<(String, String)> = meta
+        .headers
+        .first()
+        .into_iter()
+        .flat_map(|h| h.own_attributes.other.iter())
+        .filter_map(|(k, v)| match v {
+            exr::meta::attribute::AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
+            _ => None,
+        })
+        .collect();
+    out.sort();
+    Ok(out)
 }
 
 /// An EXR whose first layer has a "Y" channel, replicated to RGB.

@@ -1,5 +1,6 @@
 //! Images: the linear-RGB [`Image`], EXR/PFM/PNG I/O with atomic writes, error metrics,
-//! false-colour error maps, labelled montages and convergence plots.
+//! false-colour error maps, labelled montages and convergence plots, and the sample-range
+//! parts of a distributed render (`parts`).
 //!
 //! Everything here works on linear radiance; the sRGB transfer is applied only when an 8-bit
 //! file or montage is produced, so metrics never see tonemapped values.
@@ -9,6 +10,7 @@ pub mod font;
 pub mod io;
 pub mod metrics;
 pub mod montage;
+pub mod parts;
 pub mod plot;
 
 pub use io::{read_image, save_png_atomic, write_image};

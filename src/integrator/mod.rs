@@ -20,7 +20,10 @@ pub use render::{RenderStats, render};
 use crate::bsdf::LobeSampling;
 use crate::sampling::{PatternKind, balance_heuristic, power_heuristic};
 use std::fmt;
+use std::ops::Range;
 use std::str::FromStr;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The estimator selected by `--strategy`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -130,7 +133,42 @@ pub struct RenderOptions {
     pub bsdf_sampling: LobeSampling,
     /// Show a progress bar.
     pub progress: bool,
+    /// Render only sample indices `[start, end)` of the `spp` of every pixel (a part of a
+    /// distributed render, see `image::parts`); `None` renders all of `0..spp`. Each index draws
+    /// the very numbers it draws in the whole render, so parts add up to it.
+    pub sample_range: Option<Range<u32>>,
+    /// Set from another thread to stop the render early; it then returns [`Cancelled`].
+    pub cancel: Option<Arc<AtomicBool>>,
 }
+
+impl RenderOptions {
+    /// The sample indices to render: `sample_range`, checked against `spp`, or `0..spp`.
+    pub fn samples(&self) -> anyhow::Result<Range<u32>> {
+        match &self.sample_range {
+            None => Ok(0..self.spp),
+            Some(r) if r.start < r.end && r.end <= self.spp => Ok(r.clone()),
+            Some(r) => anyhow::bail!(
+                "sample range {}..{} must be non-empty and within 0..{} (the spp)",
+                r.start,
+                r.end,
+                self.spp
+            ),
+        }
+    }
+
+    /// Whether the cancellation flag has been set.
+    #[inline]
+    pub fn is_cancelled(&self) -> bool {
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+}
+
+/// The render was stopped through [`RenderOptions::cancel`]; no image was produced.
+#[derive(Debug, thiserror::Error)]
+#[error("render cancelled")]
+pub struct Cancelled;
 
 impl Default for RenderOptions {
     fn default() -> Self {
@@ -145,6 +183,8 @@ impl Default for RenderOptions {
             bsdf_sampling: LobeSampling::Importance,
             mis_light: crate::lights::SamplingMode::SolidAngle,
             progress: false,
+            sample_range: None,
+            cancel: None,
         }
     }
 }

@@ -56,6 +56,7 @@ pub fn render(
         res.y
     );
     anyhow::ensure!(opts.spp > 0, "--spp must be at least 1");
+    let samples = opts.samples()?;
     let selector = make_selector(&opts.light_selection, scene, opts.seed)?;
     let pattern = make_pattern(opts.pattern, opts.seed);
     let est = Integrator {
@@ -140,12 +141,15 @@ pub fn render(
                 let mut lanes = CameraLanes::new();
                 for y in y0..y1 {
                     for x in x0..x1 {
+                        if opts.is_cancelled() {
+                            break;
+                        }
                         let pixel = UVec2::new(x, y);
                         let slot = next;
                         next = (next + 1) % PACKET;
                         pattern.pixel_into(pixel, &mut pxs[slot]);
                         owner[slot] = ((y - y0) * w + (x - x0)) as usize;
-                        for i in 0..opts.spp {
+                        for i in samples.clone() {
                             let k = cam.n;
                             lanes.pixel[k] = pixel;
                             lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
@@ -166,7 +170,7 @@ pub fn render(
                     lanes.rays(isa, &camera, &filter, &mut cam.rays);
                     flush(&mut cam, pxs, &owner, &lanes.weight);
                 }
-                let out: Vec<Rgb> = sums.iter().map(|&s| s / opts.spp as f32).collect();
+                let out: Vec<Rgb> = sums.iter().map(|&s| s / samples.len() as f32).collect();
                 rays.fetch_add(tile_rays, Ordering::Relaxed);
                 bad.fetch_add(tile_bad, Ordering::Relaxed);
                 bar.inc(1);
@@ -175,6 +179,9 @@ pub fn render(
         )
         .collect();
     bar.finish_and_clear();
+    if opts.is_cancelled() {
+        return Err(super::Cancelled.into());
+    }
     let time = start.elapsed();
     let mut img = Image::new(res.x, res.y);
     for (t, tile) in tiles.iter().enumerate() {
