@@ -284,6 +284,8 @@ impl<'a> Integrator<'a> {
         self.scene
             .geometry
             .intersect_packet_cols(rays, active, &mut q.hits, &mut q.rx.cols);
+        // Normal and bump maps replace the shading normals before the frames are built.
+        crate::scene::shading_normals::perturb_hits(self.scene, &mut q.hits[..], &mut q.rx.cols);
         u64::from(active.count_ones())
     }
 

@@ -110,8 +110,7 @@ fn look_at_with(
         .ok_or_else(|| anyhow::anyhow!("mirror transform is singular"))?;
     Ok(Camera {
         camera_to_world: lh.camera_to_world.then_apply_to(&m),
-        fov_deg,
-        screen_window: None,
+        ..lh
     })
 }
 
