@@ -11,7 +11,7 @@ use penumbra::camera::Camera;
 use penumbra::geometry::{Ray, Transform};
 use penumbra::integrator::MisHeuristic;
 use penumbra::integrator::Strategy;
-use penumbra::integrator::direct::DirectLighting;
+use penumbra::integrator::stages::Integrator;
 use penumbra::light_selection::make_selector;
 use penumbra::lights::{Light, UniformInfiniteLight};
 use penumbra::material::{Material, Texture};
@@ -61,7 +61,7 @@ fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> 
     let selector = make_selector("uniform", scene, 7).unwrap();
     let pattern = make_pattern(pattern, 7);
     let spp = 16;
-    let est = DirectLighting {
+    let est = Integrator {
         scene,
         selector: selector.as_ref(),
         pattern: pattern.as_ref(),

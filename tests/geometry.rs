@@ -6,7 +6,7 @@ use penumbra::Rgb;
 use penumbra::camera::Camera;
 use penumbra::geometry::triangle::intersect_triangle;
 use penumbra::geometry::{Ray, RayQuery, Transform};
-use penumbra::integrator::direct::shadow_ray;
+use penumbra::integrator::estimator::shadow_ray;
 use penumbra::integrator::{RenderOptions, Strategy, render};
 use penumbra::material::{Material, Texture};
 use penumbra::sampling::hash::{next_f32, pcg_from_keys};

@@ -1,12 +1,14 @@
-//! `DirectLighting::li_packet` against `li`: every lane of a full packet (lanes from several
+//! `Integrator::li_packet` against `li`: every lane of a full packet (lanes from several
 //! pixels, several shadow rays, every strategy, scenes with Phong/GGX, many lights and an
 //! environment) gives exactly the single-sample radiance and the same ray count.
 
 use glam::UVec2;
 use penumbra::Rgb;
 use penumbra::geometry::PACKET;
-use penumbra::integrator::direct::{CameraPacket, DIM_FILTER, DirectLighting, PacketScratch};
+use penumbra::integrator::dims::DIM_FILTER;
 use penumbra::integrator::film::filter_sample;
+use penumbra::integrator::queues::CameraPacket;
+use penumbra::integrator::stages::{Integrator, Queues};
 use penumbra::integrator::{MisHeuristic, Strategy};
 use penumbra::light_selection::make_selector;
 use penumbra::lights::SamplingMode;
@@ -18,7 +20,7 @@ use penumbra::scene::load::{LoadOptions, load};
 fn check(scene: &Scene, strategy: Strategy, selection: &str, spp: u32, m: u32) -> (u32, u32) {
     let selector = make_selector(selection, scene, 3).unwrap();
     let pattern = make_pattern(PatternKind::Stratified, 3);
-    let est = DirectLighting {
+    let est = Integrator {
         scene,
         selector: selector.as_ref(),
         pattern: pattern.as_ref(),
@@ -35,8 +37,8 @@ fn check(scene: &Scene, strategy: Strategy, selection: &str, spp: u32, m: u32) -
     // packet when spp < PACKET.
     let mut pxs: Vec<PixelSamples> = Vec::new();
     let mut cam = CameraPacket::new();
-    // One scratch for every packet, as a render reuses it.
-    let mut scratch = PacketScratch::new();
+    // One set of queues for every packet, as a render thread reuses them.
+    let mut queues = Queues::new();
     let (mut lanes_checked, mut lit) = (0, 0);
     for p in 0..48u32 {
         let pixel = UVec2::new(p % 24, (p * 7) % 24);
@@ -51,7 +53,7 @@ fn check(scene: &Scene, strategy: Strategy, selection: &str, spp: u32, m: u32) -
             cam.push(slot as u8, i, ray);
             if cam.is_full() || (i + 1 == spp && pxs.len() == PACKET) {
                 let mut out = [Rgb::ZERO; PACKET];
-                let rays = est.li_packet(&pxs, &cam, &mut out, &mut scratch);
+                let rays = est.li_packet(&pxs, &cam, &mut out, &mut queues);
                 let mut rays_single = 0;
                 for k in 0..cam.n {
                     let (l, r) = est.li(&pxs[cam.pixel[k] as usize], cam.eye[k], &cam.rays.ray(k));

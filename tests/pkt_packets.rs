@@ -17,7 +17,7 @@ use penumbra::geometry::{
     Backend, Geometry, MeshShading, PACKET, PrimKind, Primitive, QuadricKind, Ray, RayQuery,
     SurfaceHit,
 };
-use penumbra::integrator::direct::shadow_ray;
+use penumbra::integrator::estimator::shadow_ray;
 use penumbra::isa::Isa;
 use penumbra::sampling::{
     PatternKind, concentric_disk, make_pattern, uniform_sphere, uniform_triangle_point,

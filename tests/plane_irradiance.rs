@@ -17,7 +17,8 @@ use penumbra::bsdf::LobeSampling;
 use penumbra::camera::Camera;
 use penumbra::geometry::interaction::NO_LIGHT;
 use penumbra::geometry::{Backend, PACKET, PrimKind, Ray, RayQuery, SurfaceHit, Transform};
-use penumbra::integrator::direct::{CameraPacket, DirectLighting, PacketScratch};
+use penumbra::integrator::queues::CameraPacket;
+use penumbra::integrator::stages::{Integrator, Queues};
 use penumbra::integrator::{MisHeuristic, Strategy};
 use penumbra::light_selection::make_selector;
 use penumbra::lights::{
@@ -610,7 +611,7 @@ fn measure(b: &Built, c: &Case, cfg: &Config, seed: u64) -> Vec<(f64, f64)> {
     let scene = &b.scene;
     let selector = make_selector("uniform", scene, seed).unwrap();
     let pattern = make_pattern(PatternKind::Random, seed);
-    let est = DirectLighting {
+    let est = Integrator {
         scene,
         selector: selector.as_ref(),
         pattern: pattern.as_ref(),
@@ -635,7 +636,7 @@ fn measure(b: &Built, c: &Case, cfg: &Config, seed: u64) -> Vec<(f64, f64)> {
     let side = -along + (c.u * r.range(-0.3, 0.3) + c.v * r.range(-0.3, 0.3));
     let side = side.try_normalize().unwrap_or(c.u);
     let cam = c.center + (c.n * tilt.cos() + side * tilt.sin()) * (s * r.range(2.0, 4.0));
-    let mut scratch = PacketScratch::new();
+    let mut queues = Queues::new();
     let mut out = Vec::new();
     for round in 0..ROUNDS {
         // Mostly full packets (the 16-lane kernels); every fourth round three rays, whose
@@ -651,7 +652,7 @@ fn measure(b: &Built, c: &Case, cfg: &Config, seed: u64) -> Vec<(f64, f64)> {
             want.push(x);
         }
         let mut radiance = [Rgb::ZERO; PACKET];
-        est.li_packet(&pxs, &packet, &mut radiance, &mut scratch);
+        est.li_packet(&pxs, &packet, &mut radiance, &mut queues);
         for k in 0..lanes {
             out.push((radiance[k].x as f64, want[k]));
         }

@@ -15,7 +15,7 @@ use penumbra::Rgb;
 use penumbra::bsdf::{Bxdf, Dielectric};
 use penumbra::camera::Camera;
 use penumbra::geometry::{Ray, Transform};
-use penumbra::integrator::direct::DirectLighting;
+use penumbra::integrator::stages::Integrator;
 use penumbra::integrator::{MisHeuristic, Strategy};
 use penumbra::light_selection::make_selector;
 use penumbra::lights::{Light, UniformInfiniteLight};
@@ -84,7 +84,7 @@ fn estimate(scene: &Scene, strategy: Strategy, selector: &str, ray: &Ray, m: u32
     let selector = make_selector(selector, scene, 7).unwrap();
     let pattern = make_pattern(PatternKind::Stratified, 7);
     let spp = 16;
-    let est = DirectLighting {
+    let est = Integrator {
         scene,
         selector: selector.as_ref(),
         pattern: pattern.as_ref(),

@@ -224,7 +224,24 @@ macro_rules! dispatch {
     };
 }
 
+/// A BSDF as the integrator's vector kernels (`integrator/lanes.rs`) take it: which kernel
+/// evaluates and samples it exactly as its own [`Bxdf`] methods do, with the data it reads.
+#[derive(Clone, Copy, Debug)]
+pub enum LaneBsdf {
+    /// Lambertian with cosine-weighted sampling (importance and cosine coincide): its albedo.
+    Lambert(Rgb),
+}
+
 impl Bsdf {
+    /// The vector kernel for this BSDF, if one exists (`None`: one sample at a time).
+    #[inline(always)]
+    pub fn lane_kind(&self) -> Option<LaneBsdf> {
+        match self {
+            Bsdf::Lambert(b) if b.sampling != LobeSampling::Uniform => Some(LaneBsdf::Lambert(b.r)),
+            _ => None,
+        }
+    }
+
     /// `(f(wo, wi), pdf(wo, wi))` in one dispatch: MIS light sampling needs both for the same
     /// pair, and one call instead of two saves a call and a match per light sample.
     #[inline]

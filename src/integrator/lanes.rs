@@ -1,98 +1,33 @@
-//! Structure-of-arrays kernels for the packet estimator's commonest case: a Lambertian
-//! receiver lit by a triangle light (sampled by area or by solid angle), and its
+//! The vector kernels of the commonest work items: a Lambertian receiver's shading geometry,
+//! its light samples of triangle lights (by area or by solid angle, with MIS) and its
 //! cosine-sampled BSDF rays.
 //!
-//! Lane by lane these run the very functions the per-lane path runs (the triangle's
-//! `sample_li`, [`light_estimate`], the Lambertian `sample`, [`bsdf_ray_of`]), so each lane's
-//! bits are the per-lane path's. What changes is the layout: each input and output is an array
-//! over the packet's lanes, so the loop over lanes compiles to 16-wide (AVX-512), 8-wide (AVX2)
-//! or 4-wide (SSE2) vector code instead of one lane at a time, whose chains of square roots
-//! and divisions left the CPU waiting.
+//! Lane by lane these run the very functions of the per-lane path (`ShadingGeometry::new`, the
+//! triangle's `sample_li`, [`light_estimate`], the Lambertian `sample`, [`bsdf_ray_of`]), so
+//! each lane's bits are the per-lane path's; they hold no maths of their own. What changes is
+//! the layout: each input and output is an array over the packet's lanes, so the loop over
+//! lanes compiles to 16-wide (AVX-512), 8-wide (AVX2) or 4-wide (SSE2) vector code instead of
+//! one lane at a time, whose chains of square roots and divisions left the CPU waiting.
+//!
+//! Which work item goes to a kernel is decided by the light ([`Light::lane_kind`]) and the BSDF
+//! ([`Bsdf::lane_kind`]); the kernels' input queues ([`TriangleLightLanes`],
+//! [`DiffuseBsdfLanes`]) live here, their outputs are the stages' queues.
+//!
+//! [`Light::lane_kind`]: crate::lights::Light::lane_kind
+//! [`Bsdf::lane_kind`]: crate::bsdf::Bsdf::lane_kind
 
 use super::MisHeuristic;
-use super::direct::{BsdfRay, bsdf_ray_of, light_estimate};
+use super::estimator::{BsdfRay, bsdf_ray_of, light_estimate};
+use super::queues::{BsdfRays, Lanes, Receivers, ShadowRays, V3, col};
 use crate::Rgb;
-use crate::bsdf::{Bxdf, Lambert, LobeSampling};
-use crate::geometry::{Geometry, HitColumns, PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
+use crate::bsdf::{Bxdf, Lambert};
+use crate::geometry::{PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
 use crate::isa::Isa;
 use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
 use crate::sampling::Frame;
 use glam::{Vec2, Vec3};
 
-/// One f32 per lane.
-type Lanes = [f32; PACKET];
-
-/// One `Vec3` per lane, as three coordinate arrays (contiguous across lanes).
-#[derive(Clone, Copy)]
-struct V3 {
-    x: Lanes,
-    y: Lanes,
-    z: Lanes,
-}
-
-impl V3 {
-    const ZERO: V3 = V3 {
-        x: [0.0; PACKET],
-        y: [0.0; PACKET],
-        z: [0.0; PACKET],
-    };
-
-    #[inline(always)]
-    fn get(&self, k: usize) -> Vec3 {
-        Vec3::new(self.x[k], self.y[k], self.z[k])
-    }
-
-    #[inline(always)]
-    fn set(&mut self, k: usize, v: Vec3) {
-        self.x[k] = v.x;
-        self.y[k] = v.y;
-        self.z[k] = v.z;
-    }
-}
-
-/// Lane k of a column triple.
-#[inline(always)]
-fn col(c: &[Lanes; 3], k: usize) -> Vec3 {
-    Vec3::new(c[0][k], c[1][k], c[2][k])
-}
-
-/// The receivers of a packet: each hit's shading geometry (computed for all lanes at once by
-/// [`Self::shade`]) and, for the Lambertian ones, what the kernels read. Bit k of `diffuse`
-/// marks lane k as a Lambertian receiver.
-#[derive(Clone, Copy)]
-pub(super) struct Receivers {
-    /// Lanes whose receiver is Lambertian with cosine sampling.
-    pub(super) diffuse: u32,
-    /// The hits' points, normals and error bounds, written by the camera-ray query itself.
-    pub(super) cols: HitColumns,
-    wo: V3,
-    front: [bool; PACKET],
-    /// Geometric normal facing the viewer (the light-sample context's).
-    n: V3,
-    s: V3,
-    t: V3,
-    sn: V3,
-    wo_local: V3,
-    albedo: V3,
-}
-
 impl Receivers {
-    /// No lanes loaded.
-    pub(super) fn new() -> Self {
-        Self {
-            diffuse: 0,
-            cols: HitColumns::new(),
-            wo: V3::ZERO,
-            front: [false; PACKET],
-            n: V3::ZERO,
-            s: V3::ZERO,
-            t: V3::ZERO,
-            sn: V3::ZERO,
-            wo_local: V3::ZERO,
-            albedo: V3::ZERO,
-        }
-    }
-
     /// Every lane's [`ShadingGeometry`] seen along `rays` (lanes without a hit too: theirs
     /// are ignored), on `isa`.
     pub(super) fn shade(&mut self, rays: &RayPacket, isa: Isa) {
@@ -157,16 +92,6 @@ impl Receivers {
         }
     }
 
-    /// Mark lane k as diffuse if its BSDF `b` is one the kernels evaluate (Lambertian, not
-    /// sampled uniformly).
-    #[inline]
-    pub(super) fn set_diffuse(&mut self, k: usize, b: &Lambert) {
-        if b.sampling != LobeSampling::Uniform {
-            self.diffuse |= 1 << k;
-            self.albedo.set(k, b.r);
-        }
-    }
-
     /// Lane k's hit, context, frame, local wo and BSDF as the per-lane path has them (fields
     /// the estimators do not read are left zero).
     #[inline(always)]
@@ -191,12 +116,7 @@ impl Receivers {
             t: self.t.get(k),
             n: self.sn.get(k),
         };
-        // Importance and cosine sampling coincide for a Lambertian BSDF.
-        let lambert = Lambert {
-            r: self.albedo.get(k),
-            sampling: LobeSampling::Importance,
-        };
-        (hit, ctx, frame, self.wo_local.get(k), lambert)
+        (hit, ctx, frame, self.wo_local.get(k), self.lambert(k))
     }
 }
 
@@ -205,7 +125,6 @@ impl Receivers {
 pub(super) struct TriangleLightLanes {
     /// Loaded lanes.
     pub(super) active: u32,
-    u: [Lanes; 2],
     pmf: Lanes,
     v: [V3; 3],
     n: V3,
@@ -220,7 +139,6 @@ impl TriangleLightLanes {
     pub(super) fn new() -> Self {
         Self {
             active: 0,
-            u: [[0.0; PACKET]; 2],
             pmf: [0.0; PACKET],
             v: [V3::ZERO; 3],
             n: V3::ZERO,
@@ -231,12 +149,10 @@ impl TriangleLightLanes {
         }
     }
 
-    /// Load lane k: light `tri` picked with probability `pmf`, sampled with `u`.
+    /// Load lane k: light `tri` picked with probability `pmf`.
     #[inline]
-    pub(super) fn load(&mut self, k: usize, tri: &TriangleLight, pmf: f32, u: Vec2) {
+    pub(super) fn load(&mut self, k: usize, tri: &TriangleLight, pmf: f32) {
         self.active |= 1 << k;
-        self.u[0][k] = u.x;
-        self.u[1][k] = u.y;
         self.pmf[k] = pmf;
         for (v, p) in self.v.iter_mut().zip(tri.p) {
             v.set(k, p);
@@ -247,29 +163,32 @@ impl TriangleLightLanes {
         self.two_sided[k] = tri.two_sided;
     }
 
-    /// Every lane's estimate (loaded or not) sampled in `mode`, MIS-weighted by `mis` when
-    /// given, on instruction set `isa`, written to all the lanes of `out` (so before any lane's
-    /// own); the loaded lanes with an estimate become active there. Returns their number.
+    /// Every lane's estimate (loaded or not) sampled in `mode` with the draws `u` (lane k:
+    /// `(u[0][k], u[1][k])`), MIS-weighted by `mis` when given, on instruction set `isa`,
+    /// written to all the lanes of `out` (so before any lane's own); the loaded lanes with an
+    /// estimate become active there. Returns their number.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn run(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
         isa: Isa,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) -> u32 {
         match isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx512 => {
                 // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx, mis, mode, out) }
+                unsafe { self.run_avx512(rx, u, mis, mode, out) }
             }
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => {
                 // SAFETY: as above.
-                unsafe { self.run_avx2(rx, mis, mode, out) }
+                unsafe { self.run_avx2(rx, u, mis, mode, out) }
             }
-            _ => self.dispatch(rx, mis, mode, out),
+            _ => self.dispatch(rx, u, mis, mode, out),
         }
         let ok = mask_of(&self.ok) & self.active;
         out.active |= ok;
@@ -281,11 +200,12 @@ impl TriangleLightLanes {
     unsafe fn run_avx512(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) {
-        self.dispatch(rx, mis, mode, out)
+        self.dispatch(rx, u, mis, mode, out)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -293,11 +213,12 @@ impl TriangleLightLanes {
     unsafe fn run_avx2(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) {
-        self.dispatch(rx, mis, mode, out)
+        self.dispatch(rx, u, mis, mode, out)
     }
 
     /// One copy of the lane loop per (`mis`, `mode`), each with both constant, so each loop
@@ -306,25 +227,26 @@ impl TriangleLightLanes {
     fn dispatch(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) {
         use SamplingMode::{Area, SolidAngle};
         match (mis, mode) {
-            (None, Area) => self.body(rx, None, Area, out),
-            (None, SolidAngle) => self.body(rx, None, SolidAngle, out),
+            (None, Area) => self.body(rx, u, None, Area, out),
+            (None, SolidAngle) => self.body(rx, u, None, SolidAngle, out),
             (Some(MisHeuristic::Power), Area) => {
-                self.body(rx, Some(MisHeuristic::Power), Area, out)
+                self.body(rx, u, Some(MisHeuristic::Power), Area, out)
             }
             (Some(MisHeuristic::Power), SolidAngle) => {
-                self.body(rx, Some(MisHeuristic::Power), SolidAngle, out)
+                self.body(rx, u, Some(MisHeuristic::Power), SolidAngle, out)
             }
             (Some(MisHeuristic::Balance), Area) => {
-                self.body(rx, Some(MisHeuristic::Balance), Area, out)
+                self.body(rx, u, Some(MisHeuristic::Balance), Area, out)
             }
             (Some(MisHeuristic::Balance), SolidAngle) => {
-                self.body(rx, Some(MisHeuristic::Balance), SolidAngle, out)
+                self.body(rx, u, Some(MisHeuristic::Balance), SolidAngle, out)
             }
         }
     }
@@ -334,9 +256,10 @@ impl TriangleLightLanes {
     fn body(
         &mut self,
         rx: &Receivers,
+        u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
-        out: &mut Pending,
+        out: &mut ShadowRays,
     ) {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
@@ -347,7 +270,7 @@ impl TriangleLightLanes {
                 l: self.l.get(k),
                 two_sided: self.two_sided[k],
             };
-            let u = Vec2::new(self.u[0][k], self.u[1][k]);
+            let u = Vec2::new(u[0][k], u[1][k]);
             // A match, not `and_then`: the closure is not always inlined, and one call in
             // the loop keeps it from vectorising.
             let est = match tri.sample_li(&ctx, u, mode) {
@@ -378,7 +301,6 @@ impl TriangleLightLanes {
 pub(super) struct DiffuseBsdfLanes {
     /// Loaded lanes.
     pub(super) active: u32,
-    u: [Lanes; 2],
     ok: [bool; PACKET],
 }
 
@@ -387,35 +309,32 @@ impl DiffuseBsdfLanes {
     pub(super) fn new() -> Self {
         Self {
             active: 0,
-            u: [[0.0; PACKET]; 2],
             ok: [false; PACKET],
         }
     }
 
-    /// Load lane k with direction draw `u`.
-    #[inline]
-    pub(super) fn load(&mut self, k: usize, u: Vec2) {
-        self.active |= 1 << k;
-        self.u[0][k] = u.x;
-        self.u[1][k] = u.y;
-    }
-
-    /// Every lane's ray (loaded or not) on instruction set `isa`, written to all the lanes of
-    /// `out` (so before any lane's own); the loaded lanes with a ray become active there.
-    /// Returns their number.
-    pub(super) fn run(&mut self, rx: &Receivers, isa: Isa, out: &mut Sampled) -> u32 {
+    /// Every lane's ray (loaded or not) with direction draws `u` (lane k: `(u[0][k],
+    /// u[1][k])`) on instruction set `isa`, written to all the lanes of `out` (so before any
+    /// lane's own); the lanes of `active` with a ray become active there. Returns their number.
+    pub(super) fn run(
+        &mut self,
+        rx: &Receivers,
+        u: &[Lanes; 2],
+        isa: Isa,
+        out: &mut BsdfRays,
+    ) -> u32 {
         match isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx512 => {
                 // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx, out) }
+                unsafe { self.run_avx512(rx, u, out) }
             }
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => {
                 // SAFETY: as above.
-                unsafe { self.run_avx2(rx, out) }
+                unsafe { self.run_avx2(rx, u, out) }
             }
-            _ => self.body(rx, out),
+            _ => self.body(rx, u, out),
         }
         let ok = mask_of(&self.ok) & self.active;
         out.active |= ok;
@@ -424,22 +343,22 @@ impl DiffuseBsdfLanes {
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn run_avx512(&mut self, rx: &Receivers, out: &mut Sampled) {
-        self.body(rx, out)
+    unsafe fn run_avx512(&mut self, rx: &Receivers, u: &[Lanes; 2], out: &mut BsdfRays) {
+        self.body(rx, u, out)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&mut self, rx: &Receivers, out: &mut Sampled) {
-        self.body(rx, out)
+    unsafe fn run_avx2(&mut self, rx: &Receivers, u: &[Lanes; 2], out: &mut BsdfRays) {
+        self.body(rx, u, out)
     }
 
     /// The lane loop.
     #[inline(always)]
-    fn body(&mut self, rx: &Receivers, out: &mut Sampled) {
+    fn body(&mut self, rx: &Receivers, u: &[Lanes; 2], out: &mut BsdfRays) {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
-            let u = Vec2::new(self.u[0][k], self.u[1][k]);
+            let u = Vec2::new(u[0][k], u[1][k]);
             // A match, not `and_then`, as in the light kernel: the closure may be outlined.
             let b = match lambert.sample(wo_local, 0.0, u) {
                 Some(bs) => bsdf_ray_of(&bs, &frame, ctx.n, &hit),
@@ -463,129 +382,10 @@ fn mask_of(b: &[bool; PACKET]) -> u32 {
         .fold(0, |m, (k, &on)| m | (on as u32) << k)
 }
 
-/// One value per lane that counts unless its ray is blocked: the rays go to the geometry as
-/// one packet query, in the lanes the kernels write them to.
-pub(super) struct Pending {
-    /// Lanes with a ray.
-    pub(super) active: u32,
-    rays: RayPacket,
-    value: V3,
-    /// After [`Self::resolve`]: the active lanes whose rays are clear.
-    clear: u32,
-}
-
-impl Pending {
-    /// No lanes active.
-    pub(super) fn new() -> Self {
-        Self {
-            active: 0,
-            rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
-            value: V3::ZERO,
-            clear: 0,
-        }
-    }
-
-    /// Lane k's ray and value, not (yet) active.
-    #[inline(always)]
-    fn put(&mut self, k: usize, ray: &Ray, value: Rgb) {
-        self.rays.set(k, ray);
-        self.value.set(k, value);
-    }
-
-    /// Make lane k active with `ray` and `value`.
-    #[inline]
-    pub(super) fn set(&mut self, k: usize, ray: &Ray, value: Rgb) {
-        self.active |= 1 << k;
-        self.put(k, ray, value);
-    }
-
-    /// Trace the active rays: afterwards [`Self::value`] is the value where the ray is clear.
-    pub(super) fn resolve(&mut self, geometry: &Geometry) {
-        let blocked = if self.active != 0 {
-            geometry.occluded_packet(&self.rays, self.active)
-        } else {
-            0
-        };
-        self.clear = self.active & !blocked;
-    }
-
-    /// Add to `sums` each lane's value where its ray is clear, zero elsewhere, for the lanes
-    /// `on` (valid after [`Self::resolve`]).
-    #[inline]
-    pub(super) fn add_to(&self, on: u32, sums: &mut [Rgb; PACKET]) {
-        for (k, s) in sums.iter_mut().enumerate() {
-            if on >> k & 1 != 0 {
-                let clear = self.clear >> k & 1 != 0;
-                *s += if clear { self.value.get(k) } else { Rgb::ZERO };
-            }
-        }
-    }
-}
-
-/// The BSDF rays of a packet's lanes (bit k of `active`: lane k has one), field by field: the
-/// rays go to the emitter query as they are, and the rest is read only for lanes that reach
-/// an emitter.
-pub(super) struct Sampled {
-    /// Lanes with a ray.
-    pub(super) active: u32,
-    /// The rays.
-    pub(super) rays: RayPacket,
-    weight: V3,
-    pdf: Lanes,
-    /// Bit k: lane k's sample is from a delta lobe.
-    delta: u32,
-}
-
-impl Sampled {
-    /// No lanes active.
-    pub(super) fn new() -> Self {
-        Self {
-            active: 0,
-            rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
-            weight: V3::ZERO,
-            pdf: [0.0; PACKET],
-            delta: 0,
-        }
-    }
-
-    /// Start a new round: no lanes active.
-    #[inline]
-    pub(super) fn clear(&mut self) {
-        self.active = 0;
-        self.delta = 0;
-    }
-
-    /// Lane k's ray, not (yet) active (and not from a delta lobe).
-    #[inline(always)]
-    fn put(&mut self, k: usize, b: &BsdfRay) {
-        self.rays.set(k, &b.ray);
-        self.weight.set(k, b.weight);
-        self.pdf[k] = b.pdf;
-    }
-
-    /// Make lane k active with ray `b`.
-    #[inline]
-    pub(super) fn set(&mut self, k: usize, b: &BsdfRay) {
-        self.active |= 1 << k;
-        self.put(k, b);
-        self.delta |= (b.delta as u32) << k;
-    }
-
-    /// Lane k's ray.
-    #[inline]
-    pub(super) fn get(&self, k: usize) -> BsdfRay {
-        BsdfRay {
-            ray: self.rays.ray(k),
-            weight: self.weight.get(k),
-            pdf: self.pdf[k],
-            delta: self.delta >> k & 1 != 0,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::LobeSampling;
     use crate::sampling::hash::{next_f32, pcg_from_keys};
     use rand_pcg::Pcg32;
 
@@ -615,7 +415,7 @@ mod tests {
             rx.cols.p_error[k] = 1e-6 * next_f32(rng);
             rays.set(k, &Ray::new(Vec3::new(0.0, 0.0, -5.0), p - unit(rng) * 3.0));
             let albedo = Vec3::new(next_f32(rng), next_f32(rng), next_f32(rng));
-            rx.set_diffuse(k, &Lambert::new(albedo));
+            rx.set_diffuse(k, albedo);
         }
         rx.shade(&rays, isa);
         (rx, rays)
@@ -648,6 +448,35 @@ mod tests {
     }
 
     #[test]
+    fn kernels_take_exactly_the_bsdfs_and_lights_they_reproduce() {
+        use crate::bsdf::{Bsdf, LaneBsdf, Mirror};
+        use crate::lights::{LaneLight, Light, PointLight};
+        // The BSDF kernel draws cosine-weighted directions: importance and cosine sampling of a
+        // Lambertian BSDF are that density, uniform sampling is not.
+        let r = Vec3::new(0.2, 0.5, 0.7);
+        for (s, kernel) in [
+            (LobeSampling::Importance, true),
+            (LobeSampling::Cosine, true),
+            (LobeSampling::Uniform, false),
+        ] {
+            let b = Bsdf::Lambert(Lambert { r, sampling: s });
+            match b.lane_kind() {
+                Some(LaneBsdf::Lambert(a)) => assert!(kernel && a == r, "{s:?}"),
+                None => assert!(!kernel, "{s:?}"),
+            }
+        }
+        assert!(Bsdf::Mirror(Mirror { r: Vec3::ONE }).lane_kind().is_none());
+        let v = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let tri = TriangleLight::new(v, Vec3::Z, Vec3::ONE, false).expect("has an area");
+        assert!(matches!(
+            Light::Triangle(tri).lane_kind(),
+            Some(LaneLight::Triangle(_))
+        ));
+        let point = Light::Point(PointLight::new(Vec3::ZERO, Vec3::ONE));
+        assert!(point.lane_kind().is_none());
+    }
+
+    #[test]
     fn light_kernel_lanes_equal_the_per_lane_functions_on_every_isa() {
         // The kernel's loop must compile to exactly the per-lane functions' float operations
         // on every instruction set (no contraction, no reassociation, nothing dropped).
@@ -664,14 +493,15 @@ mod tests {
                     let tri = TriangleLight::new(v, unit(&mut rng), Vec3::splat(4.0), k % 3 == 0)
                         .expect("a random triangle has an area");
                     let (pmf, u) = (0.5, Vec2::new(next_f32(&mut rng), next_f32(&mut rng)));
-                    lanes.load(k, &tri, pmf, u);
+                    lanes.load(k, &tri, pmf);
                     tris.push((tri, pmf, u));
                 }
+                let draws = [0, 1].map(|a| std::array::from_fn(|k| tris[k].2[a]));
                 let mode = [SamplingMode::Area, SamplingMode::SolidAngle][round as usize % 2];
                 let mis = [None, Some(MisHeuristic::Power), Some(MisHeuristic::Balance)]
                     [round as usize % 3];
-                let mut out = Pending::new();
-                let n = lanes.run(&rx, mis, mode, isa, &mut out);
+                let mut out = ShadowRays::new();
+                let n = lanes.run(&rx, &draws, mis, mode, isa, &mut out);
                 assert_eq!(n, out.active.count_ones());
                 for (k, (tri, pmf, u)) in tris.iter().enumerate() {
                     let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
@@ -685,7 +515,7 @@ mod tests {
                         assert_eq!(bits(got.o), bits(ray.o), "{what}");
                         assert_eq!(bits(got.d), bits(ray.d), "{what}");
                         assert_eq!(got.t_max.to_bits(), ray.t_max.to_bits(), "{what}");
-                        assert_eq!(bits(out.value.get(k)), bits(value), "{what}");
+                        assert_eq!(bits(out.value(k)), bits(value), "{what}");
                         checked += 1;
                     }
                 }
@@ -706,11 +536,10 @@ mod tests {
                 let u: Vec<Vec2> = (0..PACKET)
                     .map(|_| Vec2::new(next_f32(&mut rng), next_f32(&mut rng)))
                     .collect();
-                for (k, &u) in u.iter().enumerate() {
-                    lanes.load(k, u);
-                }
-                let mut out = Sampled::new();
-                lanes.run(&rx, isa, &mut out);
+                lanes.active = u32::MAX >> (32 - PACKET);
+                let draws = [0, 1].map(|a| std::array::from_fn(|k| u[k][a]));
+                let mut out = BsdfRays::new();
+                lanes.run(&rx, &draws, isa, &mut out);
                 for (k, &u) in u.iter().enumerate() {
                     let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
                     let want = lambert

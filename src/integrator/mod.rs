@@ -1,13 +1,19 @@
-//! Direct-lighting estimators and the render loop.
+//! The integrator and the render loop.
 //!
-//! `direct` holds the lecture's estimators (BSDF sampling, light-area sampling, solid-angle
-//! sampling, MIS); `render` drives them over tiles in parallel; `film` turns pixel samples into
-//! raster positions by filter importance sampling.
+//! Read `estimator` first: the per-sample maths of the lecture's estimators (light sampling by
+//! area or solid angle, BSDF sampling, MIS). `stages` runs them as named stages over the work
+//! queues of `queues`, a packet of 16 paths at a time; `lanes` holds the vector kernels of the
+//! common case, which lay the same maths over 16 lanes; `dims` says which pattern dimension
+//! each decision reads; `render` drives the stages over tiles in parallel; `film` turns pixel
+//! samples into raster positions by filter importance sampling.
 
-pub mod direct;
+pub mod dims;
+pub mod estimator;
 pub mod film;
 mod lanes;
+pub mod queues;
 pub mod render;
+pub mod stages;
 
 pub use render::{RenderStats, render};
 

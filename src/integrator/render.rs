@@ -3,8 +3,10 @@
 //! image is bit-identical for any thread count and schedule.
 
 use super::RenderOptions;
-use super::direct::{CameraPacket, DIM_FILTER, DirectLighting, PacketScratch};
+use super::dims::DIM_FILTER;
 use super::film::filter_sample;
+use super::queues::CameraPacket;
+use super::stages::{Integrator, Queues};
 use crate::Rgb;
 use crate::camera::CameraRays;
 use crate::geometry::{PACKET, Ray, RayPacket};
@@ -57,7 +59,7 @@ pub fn render(
     let samples = opts.samples()?;
     let selector = make_selector(&opts.light_selection, scene, opts.seed)?;
     let pattern = make_pattern(opts.pattern, opts.seed);
-    let est = DirectLighting {
+    let est = Integrator {
         scene,
         selector: selector.as_ref(),
         pattern: pattern.as_ref(),
@@ -110,11 +112,11 @@ pub fn render(
                 let mut next = 0;
                 let mut cam = CameraPacket::new();
                 let mut radiance = [Rgb::ZERO; PACKET];
-                let mut scratch = PacketScratch::new();
+                let mut queues = Queues::new();
                 let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
                 let mut flush =
                     |cam: &mut CameraPacket, pxs: &[PixelSamples], owner: &[usize; PACKET]| {
-                        tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut scratch);
+                        tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut queues);
                         for k in 0..cam.n {
                             let l = radiance[k];
                             if l.is_finite() {

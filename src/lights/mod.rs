@@ -185,7 +185,24 @@ macro_rules! dispatch {
     };
 }
 
+/// A light as the integrator's vector kernels (`integrator/lanes.rs`) take it: which kernel
+/// samples it exactly as its own `sample_li` does, with the data that kernel reads.
+#[derive(Clone, Copy, Debug)]
+pub enum LaneLight<'a> {
+    /// A triangle: sampled by area or by solid angle, 16 receivers at a time.
+    Triangle(&'a TriangleLight),
+}
+
 impl Light {
+    /// The vector kernel for this light's samples, if one exists (`None`: one sample at a time).
+    #[inline(always)]
+    pub fn lane_kind(&self) -> Option<LaneLight<'_>> {
+        match self {
+            Light::Triangle(t) => Some(LaneLight::Triangle(t)),
+            _ => None,
+        }
+    }
+
     /// True for lights at infinity (environment, uniform sky), hit by rays that escape.
     pub fn is_infinite(&self) -> bool {
         matches!(self, Light::UniformInfinite(_) | Light::EnvMap(_))

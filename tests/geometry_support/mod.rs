@@ -3,7 +3,7 @@
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::triangle::intersect_triangle;
 use penumbra::geometry::{Geometry, PrimKind, Primitive, Ray, RayQuery};
-use penumbra::integrator::direct::shadow_ray;
+use penumbra::integrator::estimator::shadow_ray;
 use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere, uniform_triangle_point};
 use penumbra::scene::Scene;
 

@@ -1,0 +1,618 @@
+//! The integrator as named stages over work queues, in the spirit of pbrt-v4's wavefront
+//! integrator on the CPU: a packet of [`PACKET`] paths (one per lane) goes through one small
+//! function per stage, each reading and writing structure-of-arrays queues ([`Queues`]); the
+//! maths of one sample is in `estimator.rs`, the vector kernels of the common case in
+//! `lanes.rs`.
+//!
+//! ```text
+//!  camera rays ─▶ draw ─▶ intersect ─▶ shade ─┬─▶ round j = 0 .. M: draw ─▶ sample_lights
+//!  (render.rs)           closest hits  Le·w·β, │     ─▶ sample_bsdfs ─▶ gather_emitters
+//!                                      BSDFs   │     ─▶ trace_shadows ─▶ accumulate
+//!                                              └─▶ finish: L += β·Σ/M, continue or terminate
+//! ```
+//!
+//! Direct lighting is the path with one vertex: its BSDF rays are the last of the path, so
+//! `gather_emitters` finds what they reach with a query of the emitters alone (most BSDF rays
+//! reach no light: no closest-hit query of the whole scene for them) and tests the visibility
+//! of the emitters found; `finish` terminates every path. Every value is a pure function of
+//! the path's pixel, sample index and pattern dimension, and each lane's value is what the
+//! one-lane packet ([`Integrator::li`]) computes, so neither packets nor threads change a bit.
+
+use super::dims::{VertexDims, rounds_at, sample_index};
+use super::estimator::{
+    BsdfRay, Techniques, bsdf_ray_through, emission_weight, emitter_hit_value, escaped_radiance,
+    light_estimate, nee_pdf,
+};
+use super::lanes::{DiffuseBsdfLanes, TriangleLightLanes};
+use super::queues::{BsdfRays, CameraPacket, Draws, LaneShading, PathLanes, Receivers, ShadowRays};
+use super::{MisHeuristic, Strategy};
+use crate::Rgb;
+use crate::bsdf::{Bsdf, Bxdf, LaneBsdf, LobeSampling};
+use crate::geometry::interaction::NO_LIGHT;
+use crate::geometry::packet::bits;
+use crate::geometry::{PACKET, Ray, RayPacket, SurfaceHit};
+use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
+use crate::lights::{Emitter, LaneLight, LightSampleContext, LightSource, SamplingMode};
+use crate::sampling::{Frame, PixelSamples, SamplePattern};
+use crate::scene::Scene;
+use glam::{Vec2, Vec3};
+
+/// The integrator configured for one render.
+pub struct Integrator<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// Light selection.
+    pub selector: &'a dyn LightSelector,
+    /// Sample pattern.
+    pub pattern: &'a dyn SamplePattern,
+    /// Estimator.
+    pub strategy: Strategy,
+    /// MIS heuristic.
+    pub mis: MisHeuristic,
+    /// Eye rays per pixel (N).
+    pub eye_rays: u32,
+    /// Light / BSDF samples per eye ray (M).
+    pub shadow_rays: u32,
+    /// How BSDF lobes are sampled.
+    pub bsdf_sampling: LobeSampling,
+    /// Light sampling technique of `mis`.
+    pub mis_light: SamplingMode,
+}
+
+/// The work queues of one render thread (made once per tile, not per packet: every lane a
+/// stage reads was written first by an earlier stage of the same packet).
+pub struct Queues {
+    /// The paths' state.
+    paths: PathLanes,
+    /// Each lane's draws for the current round.
+    drawn: Draws,
+    /// The closest hits of the paths' rays.
+    hits: [Option<SurfaceHit>; PACKET],
+    /// The hits' shading geometry, as columns.
+    rx: Receivers,
+    /// Per lane: the BSDF and light-sample context of its hit (`None`: no material or no hit).
+    shading: [Option<LaneShading>; PACKET],
+    /// Lanes with a [`LaneShading`]: the vertices that sample lights and BSDFs.
+    shaded: u32,
+    /// Light samples for the triangle-light kernel.
+    tri_lanes: TriangleLightLanes,
+    /// Lanes whose light sample is taken one lane at a time.
+    lone_light: u32,
+    /// Per `lone_light` lane: the light it picked.
+    picked: [SelectedLight; PACKET],
+    /// BSDF samples for the Lambertian kernel.
+    bsdf_lanes: DiffuseBsdfLanes,
+    /// Lanes whose BSDF sample is taken one lane at a time.
+    lone_bsdf: u32,
+    /// The BSDF rays of the round.
+    bsdf_rays: BsdfRays,
+    /// The nearest emitter along each BSDF ray.
+    emitter_hits: [Option<SurfaceHit>; PACKET],
+    /// Light samples that count unless their shadow ray is blocked.
+    nee: ShadowRays,
+    /// Emission reached by BSDF rays that counts unless the emitter is hidden.
+    gathered: ShadowRays,
+    /// Per lane: the sum over this vertex's rounds.
+    sums: [Rgb; PACKET],
+}
+
+impl Default for Queues {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Queues {
+    /// Fresh queues.
+    pub fn new() -> Self {
+        Self {
+            paths: PathLanes::new(),
+            drawn: Draws::new(),
+            hits: [None; PACKET],
+            rx: Receivers::new(),
+            shading: [const { None }; PACKET],
+            shaded: 0,
+            tri_lanes: TriangleLightLanes::new(),
+            lone_light: 0,
+            picked: [SelectedLight { index: 0, pmf: 0.0 }; PACKET],
+            bsdf_lanes: DiffuseBsdfLanes::new(),
+            lone_bsdf: 0,
+            bsdf_rays: BsdfRays::new(),
+            emitter_hits: [None; PACKET],
+            nee: ShadowRays::new(),
+            gathered: ShadowRays::new(),
+            sums: [Rgb::ZERO; PACKET],
+        }
+    }
+
+    /// The view the per-lane estimators take of lane `k` (a shaded lane).
+    #[inline]
+    fn view(&self, k: usize) -> Option<Shading<'_>> {
+        let (Some(lane), Some(hit)) = (&self.shading[k], &self.hits[k]) else {
+            return None;
+        };
+        let g = self.rx.geometry(k);
+        Some(Shading {
+            hit,
+            bsdf: &lane.bsdf,
+            ctx: &lane.ctx,
+            frame: g.frame,
+            wo_local: g.wo_local,
+            wo: g.wo,
+        })
+    }
+}
+
+/// The shading state at a hit, as the per-lane estimators read it. The parts whose address
+/// goes to out-of-line calls (hit, BSDF, light context) are borrowed from separate places: a
+/// struct with one field passed by address is kept whole in memory, so owning them would force
+/// every other field (frame, wo) through the stack too.
+struct Shading<'h> {
+    hit: &'h SurfaceHit,
+    bsdf: &'h Bsdf,
+    /// The hit point and the geometric normal flipped toward the viewer.
+    ctx: &'h LightSampleContext,
+    frame: Frame,
+    wo_local: Vec3,
+    /// World-space direction toward the viewer (for selectors that need a [`ShadingPoint`]).
+    wo: Vec3,
+}
+
+impl Shading<'_> {
+    /// The selector's view of this shading point, built only for selectors that read it.
+    /// A transmitting BSDF gathers from both sides, so the selector gets no normal (zero):
+    /// with one, importance-based selectors would give lights behind the surface (the bulb's
+    /// filament) probability 0.
+    #[inline]
+    fn shading_point(&self) -> ShadingPoint {
+        ShadingPoint {
+            p: self.ctx.p,
+            n: if self.bsdf.transmits() {
+                Vec3::ZERO
+            } else {
+                self.ctx.n
+            },
+            wo: self.wo,
+        }
+    }
+}
+
+impl<'a> Integrator<'a> {
+    /// How the strategy combines the techniques.
+    #[inline]
+    fn techniques(&self) -> Techniques {
+        match self.strategy {
+            Strategy::LightArea | Strategy::LightSolidAngle => Techniques::Light,
+            Strategy::Bsdf => Techniques::Bsdf,
+            Strategy::Mis => Techniques::Mis(self.mis),
+        }
+    }
+
+    /// Light sampling mode implied by the strategy.
+    fn mode(&self) -> SamplingMode {
+        match self.strategy {
+            Strategy::LightArea => SamplingMode::Area,
+            Strategy::Mis => self.mis_light,
+            _ => SamplingMode::SolidAngle,
+        }
+    }
+
+    /// Radiance along camera ray `ray` for eye sample `eye` of the pixel whose samples are `px`
+    /// (from [`SamplePattern::pixel`]); also returns the number of rays traced. A packet of one
+    /// lane: the same numbers as that lane of any [`Self::li_packet`].
+    pub fn li(&self, px: &PixelSamples, eye: u32, ray: &Ray) -> (Rgb, u64) {
+        let mut cam = CameraPacket::new();
+        cam.push(0, eye, *ray);
+        let mut out = [Rgb::ZERO; PACKET];
+        let mut queues = Queues::new();
+        let rays = self.li_packet(std::slice::from_ref(px), &cam, &mut out, &mut queues);
+        (out[0], rays)
+    }
+
+    /// Radiance of each lane of `cam` (lane k: eye sample `cam.eye[k]` of the pixel whose
+    /// samples are `pxs[cam.pixel[k]]`, along `cam.rays` lane k) into `out[k]`; returns the
+    /// number of rays traced. The driver of the stages: each kind of ray goes to the geometry
+    /// as one packet query, so the coherent camera and shadow rays of neighbouring samples
+    /// share their traversal.
+    pub fn li_packet(
+        &self,
+        pxs: &[PixelSamples],
+        cam: &CameraPacket,
+        out: &mut [Rgb; PACKET],
+        q: &mut Queues,
+    ) -> u64 {
+        let t = self.techniques();
+        q.paths.start(cam);
+        let m = rounds_at(q.paths.depth, self.shadow_rays.max(1));
+        *out = [Rgb::ZERO; PACKET];
+        // The first round's draws are pure arithmetic that does not depend on the hits:
+        // issued before the camera rays' traversal, they overlap with its memory-bound work.
+        self.draw(pxs, q, t, 0, q.paths.active);
+        let mut rays = self.intersect(&cam.rays, q);
+        self.shade(&cam.rays, q, t, out);
+        // The vertex's M rounds of light and BSDF samples (N eye rays × M shadow rays).
+        q.sums = [Rgb::ZERO; PACKET];
+        for j in 0..m {
+            if j > 0 {
+                self.draw(pxs, q, t, j, q.shaded);
+            }
+            rays += self.sample_lights(q, t);
+            rays += self.sample_bsdfs(pxs, q, t, j);
+            self.gather_emitters(q, t);
+            self.trace_shadows(q);
+            self.accumulate(q, t);
+        }
+        self.finish(q, m, out);
+        rays
+    }
+
+    /// Stage *draw*: round `j`'s light and BSDF draws of the lanes `on` (only the dimensions
+    /// the techniques read), at the vertex's dimensions and sample index (`dims.rs`). The
+    /// permutation hash chains of the dimensions are independent, so drawing them back to back
+    /// lets the CPU overlap them instead of waiting on each behind a ray query; the lobe choice
+    /// is drawn later, only for receivers whose BSDF has lobes to choose (values are pure
+    /// functions of pixel, dimension and index, so skipping it changes nothing).
+    // Forced inline: out of line, the draws came back through memory after a call.
+    #[inline(always)]
+    fn draw(&self, pxs: &[PixelSamples], q: &mut Queues, t: Techniques, j: u32, on: u32) {
+        let (n, m, depth) = (self.eye_rays.max(1), self.shadow_rays.max(1), q.paths.depth);
+        let dims = VertexDims::at(depth);
+        let (light, bsdf) = (t.light(), t.bsdf());
+        for k in bits(on) {
+            let px = &pxs[q.paths.pixel[k] as usize];
+            let (index, count) = sample_index(depth, q.paths.sample[k], j, n, m);
+            let d = &mut q.drawn;
+            if light {
+                d.light_select[k] = px.sample_1d(dims.light_select, index, count);
+                let u = px.sample_2d(dims.light, index, count);
+                [d.light[0][k], d.light[1][k]] = [u.x, u.y];
+            }
+            if bsdf {
+                let u = px.sample_2d(dims.bsdf, index, count);
+                [d.bsdf[0][k], d.bsdf[1][k]] = [u.x, u.y];
+            }
+        }
+    }
+
+    /// Stage *intersect*: the closest hit of every active path's ray, with the hits' columns
+    /// for the shading kernel. Returns the rays traced.
+    #[inline(always)]
+    fn intersect(&self, rays: &RayPacket, q: &mut Queues) -> u64 {
+        let active = q.paths.active;
+        self.scene
+            .geometry
+            .intersect_packet_cols(rays, active, &mut q.hits, &mut q.rx.cols);
+        u64::from(active.count_ones())
+    }
+
+    /// Stage *shade*: every hit's shading geometry (all lanes at once), then per lane the
+    /// emission the ray found (an emitter hit or, for rays that escaped, the infinite lights),
+    /// weighted by [`emission_weight`] against the vertex it left and by β, into `out`; and
+    /// the BSDF at each hit with a material, routed to the Lambertian kernels when
+    /// [`Bsdf::lane_kind`] says they evaluate it.
+    #[inline(always)]
+    fn shade(&self, rays: &RayPacket, q: &mut Queues, t: Techniques, out: &mut [Rgb; PACKET]) {
+        q.rx.shade(rays, self.scene.geometry.isa());
+        q.rx.diffuse = 0;
+        let mut shaded = 0;
+        for k in bits(q.paths.active) {
+            let le = match &q.hits[k] {
+                None => {
+                    q.shading[k] = None;
+                    self.escaped(rays.ray(k).d.normalize(), &q.paths, k, t)
+                }
+                Some(hit) => {
+                    let le = self.shade_hit(k, hit, &mut q.rx, &mut q.shading[k], &q.paths, t);
+                    shaded |= (q.shading[k].is_some() as u32) << k;
+                    le
+                }
+            };
+            out[k] += q.paths.beta.get(k) * le;
+        }
+        q.shaded = shaded;
+    }
+
+    /// Stage *sample_lights*: each shaded lane picks a light and samples it; the light's
+    /// [`LightSource`] kind routes the sample to the triangle-light kernel (for receivers the
+    /// Lambertian kernels take) or to the per-lane path. Their shadow rays and values go to
+    /// the `nee` queue. Returns the shadow rays made.
+    #[inline(always)]
+    fn sample_lights(&self, q: &mut Queues, t: Techniques) -> u64 {
+        q.nee.active = 0;
+        if !t.light() {
+            return 0;
+        }
+        let scene = self.scene;
+        q.tri_lanes.active = 0;
+        q.lone_light = 0;
+        let uniform = self.selector.uniform_count();
+        for k in bits(q.shaded) {
+            let u = q.drawn.light_select[k];
+            let sel = match uniform {
+                Some(count) => UniformSelector::pick(count, u),
+                None => match q.view(k) {
+                    Some(sh) => self.selector.sample(&sh.shading_point(), u),
+                    None => continue,
+                },
+            };
+            let Some(sel) = sel else { continue };
+            let diffuse = q.rx.diffuse >> k & 1 != 0;
+            match scene.lights[sel.index as usize].lane_kind() {
+                Some(LaneLight::Triangle(tri)) if diffuse => q.tri_lanes.load(k, tri, sel.pmf),
+                _ => {
+                    q.picked[k] = sel;
+                    q.lone_light |= 1 << k;
+                }
+            }
+        }
+        let mut rays = 0;
+        // The kernel writes every lane of its output, so it goes first and the per-lane path
+        // then fills in its own lanes.
+        if q.tri_lanes.active != 0 {
+            let isa = scene.geometry.isa();
+            let (mis, mode) = (t.mis(), self.mode());
+            let u = &q.drawn.light;
+            rays += u64::from(q.tri_lanes.run(&q.rx, u, mis, mode, isa, &mut q.nee));
+        }
+        for k in bits(q.lone_light) {
+            let Some(sh) = q.view(k) else { continue };
+            if let Some((r, v)) = self.light_sample(&sh, q.picked[k], q.drawn.light(k), t) {
+                q.nee.set(k, &r, v);
+                rays += 1;
+            }
+        }
+        rays
+    }
+
+    /// Stage *sample_bsdfs*: each shaded lane samples its BSDF (round `j`): Lambertian
+    /// receivers in the kernel, the others one lane at a time; the rays and their weights go
+    /// to the `bsdf_rays` queue. Returns the rays made (one logical ray per sample, whatever
+    /// comes of it: an emitter query, maybe a visibility test).
+    #[inline(always)]
+    fn sample_bsdfs(&self, pxs: &[PixelSamples], q: &mut Queues, t: Techniques, j: u32) -> u64 {
+        q.bsdf_rays.clear();
+        if !t.bsdf() {
+            return 0;
+        }
+        q.bsdf_lanes.active = q.shaded & q.rx.diffuse;
+        q.lone_bsdf = q.shaded & !q.rx.diffuse;
+        let mut rays = 0;
+        // The kernel goes first, as in `sample_lights`.
+        if q.bsdf_lanes.active != 0 {
+            let isa = self.scene.geometry.isa();
+            rays += u64::from(
+                q.bsdf_lanes
+                    .run(&q.rx, &q.drawn.bsdf, isa, &mut q.bsdf_rays),
+            );
+        }
+        let (n, m, depth) = (self.eye_rays.max(1), self.shadow_rays.max(1), q.paths.depth);
+        let dim = VertexDims::at(depth).lobe;
+        for k in bits(q.lone_bsdf) {
+            let Some(sh) = q.view(k) else { continue };
+            let px = &pxs[q.paths.pixel[k] as usize];
+            let (index, count) = sample_index(depth, q.paths.sample[k], j, n, m);
+            let lobe = px.sample_1d(dim, index, count);
+            if let Some(b) = self.bsdf_ray(&sh, lobe, q.drawn.bsdf(k)) {
+                rays += 1;
+                q.bsdf_rays.set(k, &b);
+            }
+        }
+        rays
+    }
+
+    /// Stage *gather_emitters*, for BSDF rays that end their path (all of them in direct
+    /// lighting): the nearest emitter along each (a BVH of emitters only) and the value it
+    /// gives, with the ray whose blocking voids it, to the `gathered` queue. The first hit of
+    /// the ray is an emitter exactly when that emitter is visible, so this is the closest-hit
+    /// estimator without a closest-hit query for the many rays that miss every light.
+    #[inline(always)]
+    fn gather_emitters(&self, q: &mut Queues, t: Techniques) {
+        let scene = self.scene;
+        q.gathered.active = 0;
+        if q.bsdf_rays.active == 0 {
+            return;
+        }
+        scene
+            .emitters
+            .intersect_packet(&q.bsdf_rays.rays, q.bsdf_rays.active, &mut q.emitter_hits);
+        for k in bits(q.bsdf_rays.active) {
+            let hit = q.emitter_hits[k].as_ref();
+            // Most BSDF rays reach no light: nothing to gather, no view to build.
+            if hit.is_none() && scene.infinite_lights.is_empty() {
+                continue;
+            }
+            let Some(sh) = q.view(k) else { continue };
+            let b = q.bsdf_rays.get(k);
+            if let Some((r, v)) = self.bsdf_gather(&sh, &b, hit, t) {
+                q.gathered.set(k, &r, v);
+            }
+        }
+    }
+
+    /// Stage *trace_shadows*: the visibility of every light sample and gathered emitter, one
+    /// packet query each.
+    #[inline(always)]
+    fn trace_shadows(&self, q: &mut Queues) {
+        q.nee.resolve(&self.scene.geometry);
+        q.gathered.resolve(&self.scene.geometry);
+    }
+
+    /// Stage *accumulate*: the round's clear values into the vertex's sums (light sample first,
+    /// then BSDF sample).
+    #[inline(always)]
+    fn accumulate(&self, q: &mut Queues, t: Techniques) {
+        if t.light() {
+            q.nee.add_to(q.shaded, &mut q.sums);
+        }
+        if t.bsdf() {
+            q.gathered.add_to(q.shaded, &mut q.sums);
+        }
+    }
+
+    /// Stage *finish*: each shaded path adds β times the mean of its `m` rounds to its
+    /// radiance. Then continue or terminate: direct lighting's paths end here.
+    #[inline(always)]
+    fn finish(&self, q: &mut Queues, m: u32, out: &mut [Rgb; PACKET]) {
+        for k in bits(q.shaded) {
+            out[k] += q.paths.beta.get(k) * (q.sums[k] / m as f32);
+        }
+        q.paths.active = 0;
+    }
+
+    /// The emitted radiance path `k`'s ray finds at `hit` (its shading geometry in `rx`),
+    /// weighted against light sampling at the vertex the ray left (in `paths`); the hit's BSDF
+    /// and light-sample context (if it has a material) go to `lane`, and a BSDF the Lambertian
+    /// kernels evaluate marks the lane diffuse in `rx`.
+    #[inline(always)]
+    fn shade_hit(
+        &self,
+        k: usize,
+        hit: &SurfaceHit,
+        rx: &mut Receivers,
+        lane: &mut Option<LaneShading>,
+        paths: &PathLanes,
+        t: Techniques,
+    ) -> Rgb {
+        let scene = self.scene;
+        let g = rx.geometry(k);
+        let mut l = Rgb::ZERO;
+        if hit.light != NO_LIGHT {
+            let light = &scene.lights[hit.light as usize];
+            let le = light.radiance(hit.p, hit.ng, hit.uv, g.wo);
+            let w = emission_weight(t, paths.prev_delta(k), || {
+                let prev = paths.prev(k);
+                let wi = -g.wo;
+                let at = &prev.at;
+                let nee = nee_pdf(
+                    self.selector,
+                    light,
+                    hit.light,
+                    at,
+                    wi,
+                    hit.p,
+                    hit.ng,
+                    self.mode(),
+                );
+                (prev.pdf, nee)
+            });
+            l += le * w;
+        }
+        let Some(material) = scene.materials.get(hit.material as usize) else {
+            *lane = None;
+            return l;
+        };
+        // The BSDF is stored straight into the lane: a diffuse one from registers, any other
+        // by the out-of-line constructor. (Both paths through one local, the copy out of it
+        // read 16-byte pieces before the smaller stores that wrote them had landed: a
+        // store-forwarding stall on every hit.)
+        let ctx = LightSampleContext { p: hit.p, n: g.n };
+        let lane = match material.lambert(hit) {
+            Some(b) => lane.insert(LaneShading {
+                bsdf: Bsdf::Lambert(b),
+                ctx,
+            }),
+            None => lane.insert(LaneShading {
+                bsdf: material.bsdf(hit, g.front),
+                ctx,
+            }),
+        };
+        if self.bsdf_sampling != LobeSampling::Importance {
+            lane.bsdf.set_sampling(self.bsdf_sampling);
+        }
+        if let Some(LaneBsdf::Lambert(albedo)) = lane.bsdf.lane_kind() {
+            rx.set_diffuse(k, albedo);
+        }
+        l
+    }
+
+    /// Radiance of the infinite lights seen along unit direction `wi` by path `k`'s ray,
+    /// which escaped, each weighted against light sampling at the vertex the ray left.
+    #[inline]
+    fn escaped(&self, wi: Vec3, paths: &PathLanes, k: usize, t: Techniques) -> Rgb {
+        let scene = self.scene;
+        escaped_radiance(&scene.lights, &scene.infinite_lights, wi, |i| {
+            emission_weight(t, paths.prev_delta(k), || {
+                let prev = paths.prev(k);
+                let light = &scene.lights[i as usize];
+                let (p, n) = (Vec3::ZERO, Vec3::ZERO);
+                let nee = nee_pdf(self.selector, light, i, &prev.at, wi, p, n, self.mode());
+                (prev.pdf, nee)
+            })
+        })
+    }
+
+    /// One light-sampling estimate of light `sel` (per-lane path): the shadow ray it needs and
+    /// its value if that ray is clear (`None` when it is zero anyway).
+    fn light_sample(
+        &self,
+        sh: &Shading,
+        sel: SelectedLight,
+        u: Vec2,
+        t: Techniques,
+    ) -> Option<(Ray, Rgb)> {
+        let light = &self.scene.lights[sel.index as usize];
+        let ls = light.sample_li(sh.ctx, u, self.mode())?;
+        light_estimate(
+            &ls,
+            sel.pmf,
+            sh.bsdf,
+            &sh.frame,
+            sh.wo_local,
+            sh.ctx,
+            sh.hit,
+            t.mis(),
+        )
+    }
+
+    /// One BSDF sample (per-lane path) as a ray with its weight f·cos / pdf (`None` when the
+    /// estimate is zero without tracing it).
+    fn bsdf_ray(&self, sh: &Shading, lobe: f32, u: Vec2) -> Option<BsdfRay> {
+        // Lambert inline: `Bsdf::sample` carries every BSDF and stays out of line, so the
+        // common diffuse hit paid a call and a `BsdfSample` returned through memory.
+        let (bs, transmits) = match sh.bsdf {
+            Bsdf::Lambert(b) => (b.sample(sh.wo_local, lobe, u), false),
+            other => (other.sample(sh.wo_local, lobe, u), other.transmits()),
+        };
+        bsdf_ray_through(&bs?, transmits, &sh.frame, sh.ctx.n, sh.hit)
+    }
+
+    /// What BSDF ray `b` from `sh` gathers given the nearest emitter `hit` along it (`None`:
+    /// it escapes unless blocked): the ray whose blocking voids it and its value, weighted
+    /// against light sampling at `sh`.
+    fn bsdf_gather(
+        &self,
+        sh: &Shading,
+        b: &BsdfRay,
+        hit: Option<&SurfaceHit>,
+        t: Techniques,
+    ) -> Option<(Ray, Rgb)> {
+        let wi = b.ray.d;
+        let mode = self.mode();
+        if let Some(h) = hit {
+            let light = &self.scene.lights[h.light as usize];
+            let v = emitter_hit_value(light, h.p, h.ng, h.uv, wi, b.weight, || {
+                emission_weight(t, b.delta, || {
+                    let at = sh.shading_point();
+                    (
+                        b.pdf,
+                        nee_pdf(self.selector, light, h.light, &at, wi, h.p, h.ng, mode),
+                    )
+                })
+            })?;
+            return Some((super::estimator::shadow_ray(sh.hit, h.p), v));
+        }
+        if self.scene.infinite_lights.is_empty() {
+            return None;
+        }
+        let scene = self.scene;
+        let sum = escaped_radiance(&scene.lights, &scene.infinite_lights, wi, |i| {
+            emission_weight(t, b.delta, || {
+                let light = &scene.lights[i as usize];
+                let at = sh.shading_point();
+                let (p, n) = (Vec3::ZERO, Vec3::ZERO);
+                (b.pdf, nee_pdf(self.selector, light, i, &at, wi, p, n, mode))
+            })
+        });
+        Some((b.ray, b.weight * sum))
+    }
+}
