@@ -67,8 +67,7 @@ fn read_image<'py>(py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyArray3<
 #[pyo3(signature = (path, array, exposure=0.0))]
 fn write_image(path: &str, array: PyReadonlyArray3<'_, f32>, exposure: f32) -> PyResult<()> {
     let img = from_array(&array)?;
-    penumbra::image::write_image(&img, Path::new(path), exposure)
-        .map_err(|e| to_py(e, Kind::Value))
+    penumbra::image::write_image(&img, Path::new(path), exposure).map_err(|e| to_py(e, Kind::Value))
 }
 
 /// MSE, relMSE and MAE of `test` against `reference`; names are used in warnings.

@@ -330,7 +330,9 @@ fn parse_res(res: &Bound<'_, PyAny>) -> PyResult<(u32, u32)> {
             .split_once(['x', 'X'])
             .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
         return parsed.ok_or_else(|| {
-            PyValueError::new_err(format!("res: expected \"WxH\" (e.g. \"512x512\"), got {s:?}"))
+            PyValueError::new_err(format!(
+                "res: expected \"WxH\" (e.g. \"512x512\"), got {s:?}"
+            ))
         });
     }
     res.extract::<(u32, u32)>()

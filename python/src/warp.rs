@@ -28,12 +28,19 @@ fn routine(name: &str, params: &[String]) -> PyResult<Warp> {
 
 /// Every routine: (name, summary, [(key, default, help)]).
 #[pyfunction]
-fn warp_list() -> Vec<(&'static str, &'static str, Vec<(&'static str, &'static str, &'static str)>)>
-{
+fn warp_list() -> Vec<(
+    &'static str,
+    &'static str,
+    Vec<(&'static str, &'static str, &'static str)>,
+)> {
     ROUTINES
         .iter()
         .map(|r| {
-            let p = r.params.iter().map(|s| (s.key, s.default, s.help)).collect();
+            let p = r
+                .params
+                .iter()
+                .map(|s| (s.key, s.default, s.help))
+                .collect();
             (r.name, r.summary, p)
         })
         .collect()
