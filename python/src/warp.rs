@@ -26,13 +26,15 @@ fn routine(name: &str, params: &[String]) -> PyResult<Warp> {
     build(name, params).map_err(|e| to_py(e, Kind::Value))
 }
 
+/// A routine's parameter as Python sees it: (key, default, help).
+type ParamRow = (&'static str, &'static str, &'static str);
+
+/// Samples (m × dim) and their pdfs, as numpy arrays.
+type SamplesPdf<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f64>>);
+
 /// Every routine: (name, summary, [(key, default, help)]).
 #[pyfunction]
-fn warp_list() -> Vec<(
-    &'static str,
-    &'static str,
-    Vec<(&'static str, &'static str, &'static str)>,
-)> {
+fn warp_list() -> Vec<(&'static str, &'static str, Vec<ParamRow>)> {
     ROUTINES
         .iter()
         .map(|r| {
@@ -57,7 +59,7 @@ fn warp_sample<'py>(
     params: Vec<String>,
     pattern: Option<&str>,
     seed: Option<u64>,
-) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<SamplesPdf<'py>> {
     const MAX: usize = 100_000_000;
     if n == 0 || n > MAX {
         return Err(PyValueError::new_err(format!(
