@@ -19,6 +19,7 @@ pub mod lab;
 pub mod light_selection;
 pub mod lights;
 pub mod material;
+pub mod progressive;
 pub mod sampling;
 pub mod scene;
 

@@ -20,13 +20,16 @@ enum Phase {
     Rendering,
     /// Writing an output file: let the writer clean up and return.
     Writing,
+    /// Rendering in passes: the first signal only sets the flag, so the pass loop drops the
+    /// pass in flight and writes the completed samples; a second one exits at once.
+    Passes,
 }
 
 /// State shared with the signal thread.
 #[derive(Debug)]
 struct Shared {
-    /// Set by the first SIGINT/SIGTERM.
-    cancelled: AtomicBool,
+    /// Set by the first SIGINT/SIGTERM (shared with the renderer in [`Phase::Passes`]).
+    cancelled: Arc<AtomicBool>,
     /// The signal received (0 before any).
     signal: AtomicI32,
     /// Held by the signal thread while it decides, so no write starts in between.
@@ -59,7 +62,7 @@ impl Interrupt {
     pub fn install() -> anyhow::Result<Interrupt> {
         use signal_hook::consts::{SIGINT, SIGTERM};
         let shared = Arc::new(Shared {
-            cancelled: AtomicBool::new(false),
+            cancelled: Arc::new(AtomicBool::new(false)),
             signal: AtomicI32::new(0),
             phase: Mutex::new(Phase::Rendering),
         });
@@ -70,11 +73,14 @@ impl Interrupt {
             .spawn(move || {
                 for sig in signals.forever() {
                     let phase = s.phase.lock().unwrap_or_else(PoisonError::into_inner);
-                    if s.signal.load(Ordering::SeqCst) == 0 {
+                    let first = s.signal.load(Ordering::SeqCst) == 0;
+                    if first {
                         s.signal.store(sig, Ordering::SeqCst);
                     }
                     s.cancelled.store(true, Ordering::SeqCst);
-                    if *phase == Phase::Rendering {
+                    if *phase == Phase::Passes && first {
+                        eprintln!("interrupted: finishing with the completed samples");
+                    } else if *phase != Phase::Writing {
                         // Exit while holding the lock: no write can start any more.
                         eprintln!("interrupted");
                         std::process::exit(128 + sig);
@@ -94,7 +100,7 @@ impl Interrupt {
     ) -> anyhow::Result<T> {
         self.set_phase(Phase::Writing)?;
         let ctl = WriteControl {
-            cancel: Some(&self.shared.cancelled),
+            cancel: Some(self.shared.cancelled.as_ref()),
             chunk_pause,
         };
         let result = write(&ctl);
@@ -105,6 +111,54 @@ impl Interrupt {
             (Err(interrupted), _) => Err(interrupted),
             (Ok(()), result) => result,
         }
+    }
+
+    /// Run `f` (given the flag that a signal sets) in the pass phase: the first signal sets
+    /// the flag instead of exiting, so `f` can stop at the end of a pass and write what it has
+    /// with [`Interrupt::final_write`]. Writes inside `f` are not cancelled by the flag.
+    pub fn passes<T>(&self, f: impl FnOnce(&Arc<AtomicBool>) -> T) -> T {
+        *self
+            .shared
+            .phase
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = Phase::Passes;
+        let r = f(&self.shared.cancelled);
+        *self
+            .shared
+            .phase
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = Phase::Rendering;
+        r
+    }
+
+    /// The signal received so far, if any.
+    pub fn signal(&self) -> Option<i32> {
+        match self.shared.signal.load(Ordering::SeqCst) {
+            0 => None,
+            s => Some(s),
+        }
+    }
+
+    /// Write the last image of a pass-phase render even though a signal came (it is the
+    /// image of the completed samples, which the signal asked for): not cancellable; a
+    /// further signal during it exits at once, leaving the old output intact (the write
+    /// goes to a temp file renamed over it).
+    pub fn final_write<T>(
+        &self,
+        write: impl FnOnce(&WriteControl) -> anyhow::Result<T>,
+    ) -> anyhow::Result<T> {
+        *self
+            .shared
+            .phase
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = Phase::Passes;
+        let r = write(&WriteControl::default());
+        *self
+            .shared
+            .phase
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = Phase::Rendering;
+        r
     }
 
     /// Switch phase; fails with [`Interrupted`] if a signal has arrived.

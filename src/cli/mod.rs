@@ -28,6 +28,8 @@ pub enum Command {
     Warp(warp::Args),
     /// Combine the sample-range parts of a render (`render --spp-range`) into the whole image.
     Merge(merge::Args),
+    /// Watch a render converge in the browser: a local web server with A/B comparison.
+    View(view::Args),
 }
 
 pub mod bench;
@@ -38,6 +40,7 @@ pub mod memory;
 pub mod merge;
 pub mod messages;
 pub mod render;
+pub mod view;
 pub mod warp;
 
 /// Dispatch a parsed command line.
@@ -59,6 +62,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Bench(a)) => bench::run(a),
         Some(Command::Warp(a)) => warp::run_cmd(a),
         Some(Command::Merge(a)) => merge::run(a),
+        Some(Command::View(a)) => view::run(a),
         None => match Cli::try_parse_from(["penumbra", "render"])?.command {
             Some(Command::Render(a)) => render::run(a),
             _ => unreachable!("`render` parses to the render command"),

@@ -16,6 +16,7 @@ use super::memory::{self, Need};
 use super::messages;
 use penumbra::image::io::{check_output_path, remove_stale_temps, write_image_with};
 use penumbra::image::parts::{Part, PartInfo, render_key, write_part};
+use penumbra::progressive::{Accumulator, PassPolicy, Stop, render_passes};
 
 /// Arguments of `penumbra render`.
 #[derive(clap::Args, Debug, Clone)]
@@ -94,6 +95,38 @@ pub struct Args {
     /// records them; `penumbra merge` combines the parts.
     #[arg(long, value_name = "A..B", value_parser = parse_range)]
     pub spp_range: Option<std::ops::Range<u32>>,
+    /// Render in passes until SECONDS of render time are spent (or --spp is reached; with
+    /// --time the default --spp is 65536, the scene's own count is ignored).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, conflicts_with = "spp_range")]
+    pub time: Option<f64>,
+    /// Render in passes of growing sample count and write the output after every pass
+    /// (atomically: the file is always a valid image of the samples so far; an EXR records
+    /// the count). Ctrl-C then writes the completed samples and exits 130 (SIGTERM: 143).
+    #[arg(long, conflicts_with = "spp_range")]
+    pub progressive: bool,
+    /// Continue the partial render PART.exr (written by --progressive, --time or an
+    /// interrupted pass render, or --spp-range 0..K) to --spp samples; the settings must be
+    /// those of the partial render.
+    #[arg(long, value_name = "PART.exr", conflicts_with = "spp_range")]
+    pub resume: Option<PathBuf>,
+}
+
+/// Default sample count of a `--time` render: a cap the budget normally ends first.
+pub const TIME_SPP: u32 = 65536;
+
+/// Parse a positive, finite number of seconds.
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(t) if t.is_finite() && t > 0.0 && t < 1e9 => Ok(t),
+        _ => Err(format!("expected a positive number of seconds, got '{s}'")),
+    }
+}
+
+impl Args {
+    /// Whether the render runs in passes (time budget, progressive output or resume).
+    pub fn passes(&self) -> bool {
+        self.time.is_some() || self.progressive || self.resume.is_some()
+    }
 }
 
 /// Parse `X,Y,Z` (finite numbers).
@@ -195,8 +228,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // The loaders build the BVHs (scene and emitters) as their last step and time them.
     let bvh_time = scene.geometry.build_time + scene.emitters.build_time;
     let res = args.res.unwrap_or(scene.film.resolution);
+    let spp = match args.time {
+        Some(_) => args.spp.unwrap_or(TIME_SPP),
+        None => args.spp.or(scene.film.spp).unwrap_or(64),
+    };
     let opts = RenderOptions {
-        spp: args.spp.or(scene.film.spp).unwrap_or(64),
+        spp,
         shadow_rays: args.shadow_rays,
         seed: args.seed,
         strategy: args.strategy,
@@ -234,6 +271,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let need = Need::new(res, threads, scene.lights.len());
     memory::check(&need, memory::available().as_ref())?;
+    if args.passes() {
+        let setup = Setup {
+            args: &args,
+            scene: &scene,
+            res,
+            opts,
+            out,
+            start,
+            load_time: load_time.saturating_sub(bvh_time),
+            bvh_time,
+        };
+        return with_threads(args.threads, || run_passes(&setup, &interrupt));
+    }
 
     let render_start = Instant::now();
     let (img, stats) = match args.threads {
@@ -293,6 +343,204 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     );
     writeln!(std::io::stdout(), "{line}").context("writing to standard output")?;
     Ok(())
+}
+
+/// Run `f` on a pool of `threads` workers (default: rayon's global pool).
+fn with_threads<T: Send>(
+    threads: Option<usize>,
+    f: impl FnOnce() -> anyhow::Result<T> + Send,
+) -> anyhow::Result<T> {
+    match threads {
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .context("creating the thread pool")?
+            .install(f),
+        None => f(),
+    }
+}
+
+/// What a pass render needs from `run`.
+struct Setup<'a> {
+    args: &'a Args,
+    scene: &'a penumbra::scene::Scene,
+    res: UVec2,
+    opts: RenderOptions,
+    out: PathBuf,
+    start: Instant,
+    load_time: Duration,
+    bvh_time: Duration,
+}
+
+/// Write the image of the samples in `acc` to `out`: an EXR as a part of samples
+/// `0..count` of the render (so `--resume` can continue it), other formats as plain images.
+pub fn write_accumulated(
+    acc: &Accumulator,
+    out: &Path,
+    key: &str,
+    spp: u32,
+    exposure: f32,
+    ctl: &penumbra::image::io::WriteControl,
+) -> anyhow::Result<()> {
+    let image = acc.image();
+    if is_exr(Some(out)) {
+        let part = Part {
+            image,
+            info: PartInfo {
+                samples: 0..acc.count(),
+                spp,
+                render: key.to_string(),
+            },
+        };
+        write_part(&part, out, ctl)
+    } else {
+        write_image_with(&image, out, exposure, ctl)
+    }
+}
+
+/// Read `--resume PART` and check that it is a partial render of these settings.
+pub fn resume_from(path: &Path, key: &str, spp: u32, res: UVec2) -> anyhow::Result<Accumulator> {
+    let part = penumbra::image::parts::read_part(path)?;
+    let i = &part.info;
+    anyhow::ensure!(
+        i.samples.start == 0,
+        "{}: holds samples {}..{}; only a render of samples 0..K can be resumed",
+        path.display(),
+        i.samples.start,
+        i.samples.end
+    );
+    anyhow::ensure!(
+        i.spp == spp,
+        "{}: is part of a {}-spp render, this one has {spp} spp (the patterns stratify over \
+         the spp, so the samples differ): give --spp {}",
+        path.display(),
+        i.spp,
+        i.spp
+    );
+    anyhow::ensure!(
+        part.image.width == res.x && part.image.height == res.y,
+        "{}: is {}x{}, this render is {}x{}",
+        path.display(),
+        part.image.width,
+        part.image.height,
+        res.x,
+        res.y
+    );
+    anyhow::ensure!(
+        i.render == key,
+        "{}: was rendered with other settings:\n  its:  {}\n  these: {key}",
+        path.display(),
+        i.render
+    );
+    Ok(Accumulator::from_mean(&part.image, i.count()))
+}
+
+/// The pass loop of `--time`, `--progressive` and `--resume`: passes until the spp or the
+/// budget is reached or a signal comes, the output written after every pass (with
+/// `--progressive`) and at the end, even after a signal (then exit 128 + signal).
+fn run_passes(s: &Setup, interrupt: &Interrupt) -> anyhow::Result<()> {
+    let args = s.args;
+    let key = render_key(&args.scene, &load_options(args), s.res, &s.opts);
+    let mut acc = match &args.resume {
+        Some(part) => resume_from(part, &key, s.opts.spp, s.res)?,
+        None => Accumulator::new(s.res),
+    };
+    let resumed = acc.count();
+    let opts = RenderOptions {
+        progress: false,
+        ..s.opts.clone()
+    };
+    let policy = PassPolicy {
+        budget: args.time.map(Duration::from_secs_f64),
+        ..PassPolicy::default()
+    };
+    let sensor = &s.scene.film.sensor;
+    let post = |img: &mut penumbra::image::Image| sensor.apply(img);
+    let mut write_time = Duration::ZERO;
+    let progress = interrupt.passes(|cancel| {
+        render_passes(
+            s.scene,
+            &opts,
+            &mut acc,
+            &policy,
+            cancel,
+            &post,
+            &mut |acc, pass| {
+                if !args.quiet {
+                    eprintln!(
+                        "pass: samples {}..{} in {:.3} s ({:.1} Mrays/s)",
+                        pass.samples.start,
+                        pass.samples.end,
+                        pass.time.as_secs_f64(),
+                        pass.rays as f64 / pass.time.as_secs_f64().max(1e-9) / 1e6
+                    );
+                }
+                if args.progressive && acc.count() < opts.spp {
+                    let t = Instant::now();
+                    write_accumulated(
+                        acc,
+                        &s.out,
+                        &key,
+                        opts.spp,
+                        args.exposure,
+                        &Default::default(),
+                    )?;
+                    write_time += t.elapsed();
+                }
+                Ok(())
+            },
+        )
+    })?;
+    let signal = interrupt.signal();
+    if acc.count() == 0 {
+        match signal {
+            Some(signal) => {
+                eprintln!("no pass completed: {} was not written", s.out.display());
+                return Err(super::interrupt::Interrupted { signal }.into());
+            }
+            None => anyhow::bail!("no pass completed"),
+        }
+    }
+    let t = Instant::now();
+    interrupt
+        .final_write(|ctl| write_accumulated(&acc, &s.out, &key, opts.spp, args.exposure, ctl))?;
+    write_time += t.elapsed();
+    let secs = |d: Duration| d.as_secs_f64();
+    let why = match progress.stop {
+        Stop::Done => "done".to_string(),
+        Stop::Budget => format!("time budget {} s", args.time.unwrap_or(0.0)),
+        Stop::Cancelled => "interrupted".to_string(),
+    };
+    let resumed = if resumed > 0 {
+        format!(" (resumed from {resumed})")
+    } else {
+        String::new()
+    };
+    let line = format!(
+        "{}x{}  {} of {} spp{resumed} in {} passes ({why}) x {} shadow rays  {}  load {:.3} s  \
+         bvh {:.3} s  render {:.3} s  write {:.3} s  total {:.3} s  {:.2} M rays  {:.1} Mrays/s  \
+         -> {}",
+        s.res.x,
+        s.res.y,
+        acc.count(),
+        opts.spp,
+        progress.passes,
+        opts.shadow_rays,
+        opts.strategy,
+        secs(s.load_time),
+        secs(s.bvh_time),
+        secs(progress.time),
+        secs(write_time),
+        secs(s.start.elapsed()),
+        progress.rays as f64 / 1e6,
+        progress.rays as f64 / secs(progress.time).max(1e-9) / 1e6,
+        s.out.display()
+    );
+    writeln!(std::io::stdout(), "{line}").context("writing to standard output")?;
+    match signal {
+        Some(signal) => Err(super::interrupt::Interrupted { signal }.into()),
+        None => Ok(()),
+    }
 }
 
 /// Parse `A..B` for `--spp-range`.

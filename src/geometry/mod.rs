@@ -1,25 +1,29 @@
 //! Shapes, transforms, rays and the ray-query acceleration structures (own BVH2 and its 4-wide
 //! collapse, obvhs CWBVH).
 
-pub mod accel;
-pub mod bvh;
-pub mod float;
+mod accel;
+pub mod alpha;
+mod bvh;
+mod float;
 pub mod interaction;
-pub mod packet;
+pub(crate) mod packet;
+mod primitive;
 pub mod quadric;
 pub mod ray;
 mod simd16;
 pub mod transform;
-pub mod tree2;
-pub mod tri4;
+mod tree2;
+mod tri4;
 pub mod triangle;
-pub mod wide;
+mod wide;
 
-pub use accel::{Backend, Geometry, MeshShading, PrimKind, Primitive};
+pub use accel::{Backend, Geometry};
+pub use alpha::{Alpha, AlphaTexture};
 pub use interaction::{ShadingGeometry, SurfaceHit};
 pub use packet::{HitColumns, PACKET, PacketRayForm, RayPacket};
+pub use primitive::{MeshShading, PrimKind, Primitive};
 pub use quadric::{Quadric, QuadricKind};
-pub use ray::{Ray, random_query_rays};
+pub use ray::{Ray, bounce_query_rays, random_query_rays};
 pub use transform::Transform;
 
 /// Closest-hit and any-hit ray queries: what integrators and lights need from geometry.

@@ -1,6 +1,7 @@
 //! Rays and the offsets that keep secondary rays off the surface they leave.
 
-use crate::sampling::{PatternKind, make_pattern, uniform_sphere};
+use super::RayQuery;
+use crate::sampling::{Frame, PatternKind, cosine_hemisphere, make_pattern, uniform_sphere};
 use glam::{UVec2, Vec3};
 
 /// A ray `o + t·d`, valid for t in (0, t_max). `d` need not be normalised for shadow rays
@@ -45,6 +46,26 @@ pub fn random_query_rays(bounds: (Vec3, Vec3), n: u32) -> Vec<Ray> {
             let (a, b) = (pat.sample_2d(px, 0, 0, 1), pat.sample_2d(px, 1, 0, 1));
             let o = lo + (hi - lo) * Vec3::new(a.x, a.y, pat.sample_1d(px, 2, 0, 1));
             Ray::new(o, uniform_sphere(b))
+        })
+        .collect()
+}
+
+/// Secondary rays like a path tracer's diffuse bounces, the incoherent workload of
+/// `penumbra bench`'s bounce rows and of `examples/embree_compare`: for each ray of `primary`
+/// (camera rays) that hits `g`, one unbounded ray from the hit (its spawn origin) in a
+/// cosine-distributed direction about the normal facing the arriving ray (seeded random
+/// pattern, ray i's numbers from index i).
+pub fn bounce_query_rays(g: &impl RayQuery, primary: &[Ray]) -> Vec<Ray> {
+    let pat = make_pattern(PatternKind::Random, 2);
+    primary
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| {
+            let h = g.intersect(r)?;
+            let n = if r.d.dot(h.ng) < 0.0 { h.ng } else { -h.ng };
+            let u = pat.sample_2d(UVec2::new(i as u32, 0), 0, 0, 1);
+            let d = Frame::from_normal(n).to_world(cosine_hemisphere(u));
+            Some(Ray::new(h.spawn_origin(d), d))
         })
         .collect()
 }

@@ -12,6 +12,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::Ray;
+pub(super) use crate::isa::Portable;
+use crate::isa::Token;
 use std::ops::{Add, Mul, Sub};
 
 /// Lanes per vector: rays per packet.
@@ -20,18 +22,21 @@ pub const LANES: usize = 16;
 /// One f32 per ray, in memory.
 pub type Lanes = [f32; LANES];
 
-/// A 16-lane f32 vector type with lane masks (see the module docs). Nominally `pub` (the module
-/// is private, so no other crate can name it) because the sealed supertrait of the public
-/// `packet::PacketRayForm` names it.
-pub trait Simd: Copy {
+/// A 16-lane f32 vector type with lane masks (see the module docs), implemented by the
+/// instruction-set tokens of [`crate::isa`]. The operations that make vectors or masks from
+/// nothing take the token (`self`); every other one takes a vector, which exists only where a
+/// token did: so the intrinsics run only on CPUs that have them, by construction. Nominally
+/// `pub` (the module is private, so no other crate can name it) because the sealed supertrait
+/// of the public `packet::PacketRayForm` names it.
+pub trait Simd: Token {
     /// Sixteen f32 lanes.
     type F: Copy + Add<Output = Self::F> + Sub<Output = Self::F> + Mul<Output = Self::F>;
     /// A lane mask.
     type M: Copy;
     /// Every lane `x`.
-    fn splat(x: f32) -> Self::F;
+    fn splat(self, x: f32) -> Self::F;
     /// The lanes of `a`.
-    fn load(a: &Lanes) -> Self::F;
+    fn load(self, a: &Lanes) -> Self::F;
     /// Write the lanes to `a`.
     fn store(v: Self::F, a: &mut Lanes);
     /// Lane-wise IEEE quotient.
@@ -40,7 +45,7 @@ pub trait Simd: Copy {
     fn sqrt(a: Self::F) -> Self::F;
     /// The rays' origins, directions and t_max transposed to lanes: `[o.x, o.y, o.z, d.x,
     /// d.y, d.z, t_max]`.
-    fn rays(rays: &[Ray; LANES]) -> [Self::F; 7];
+    fn rays(self, rays: &[Ray; LANES]) -> [Self::F; 7];
     /// `if a < b { a } else { b }` per lane (SSE `minps`).
     fn min(a: Self::F, b: Self::F) -> Self::F;
     /// `if a > b { a } else { b }` per lane (SSE `maxps`).
@@ -75,9 +80,45 @@ pub trait Simd: Copy {
     /// `a` elsewhere.
     fn inc_bits(m: Self::M, a: Self::F) -> Self::F;
     /// The mask with lane i set where bit i of `b` is (the inverse of [`Simd::bits`]).
-    fn mask(b: u32) -> Self::M;
+    fn mask(self, b: u32) -> Self::M;
     /// The 16 × 16 transpose: lane k of result i is lane i of `rows[k]` (bits moved as is).
     fn transpose(rows: [Self::F; LANES]) -> [Self::F; LANES];
+}
+
+/// Code generic over the [`Simd`] backends (the 16-ray packet kernels).
+pub(crate) trait SimdKernel {
+    /// What the kernel returns.
+    type Output;
+    /// The kernel on backend `s`.
+    fn run<S: Simd>(self, s: S) -> Self::Output;
+}
+
+/// `k` on the [`Simd`] backend of token `t`: called from a [`crate::isa::Kernel`], so inside
+/// the function `Cpu::dispatch` compiled for `t`'s set (the other arms fold away: `t`'s type
+/// fixes which one is taken).
+#[inline(always)]
+pub(crate) fn on_simd<T: Token, K: SimdKernel>(t: T, k: K) -> K::Output {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(a) = t.avx512() {
+        return k.run(a);
+    }
+    #[cfg(target_arch = "x86_64")]
+    if let Some(a) = t.avx2() {
+        return k.run(a);
+    }
+    let _ = t;
+    k.run(Portable)
+}
+
+/// A [`SimdKernel`] as a [`crate::isa::Kernel`], for `Cpu::dispatch`.
+pub(crate) struct OnSimd<K>(pub K);
+
+impl<K: SimdKernel> crate::isa::Kernel for OnSimd<K> {
+    type Output = K::Output;
+    #[inline(always)]
+    fn run<T: Token>(self, t: T) -> K::Output {
+        on_simd(t, self.0)
+    }
 }
 
 /// [`Simd::transpose`] through memory, for the backends without a faster one.
@@ -107,13 +148,10 @@ fn ray_arrays(rays: &[Ray; LANES]) -> [Lanes; 7] {
     a
 }
 
-/// The portable backend: plain lane loops (what LLVM makes of them).
+/// Sixteen lanes of the portable backend: plain lane loops (what LLVM makes of them). `pub`
+/// only because the public token [`Portable`] implements [`Simd`] (the module is private).
 #[derive(Clone, Copy)]
-pub(super) struct Portable;
-
-/// Sixteen lanes of [`Portable`].
-#[derive(Clone, Copy)]
-pub(super) struct PV(Lanes);
+pub struct PV(Lanes);
 
 macro_rules! lanewise {
     ($t:ty, $tr:ident, $f:ident, $op:tt) => {
@@ -167,11 +205,11 @@ impl Simd for Portable {
     type F = PV;
     type M = [u32; LANES];
     #[inline(always)]
-    fn splat(x: f32) -> PV {
+    fn splat(self, x: f32) -> PV {
         PV([x; LANES])
     }
     #[inline(always)]
-    fn load(a: &Lanes) -> PV {
+    fn load(self, a: &Lanes) -> PV {
         PV(*a)
     }
     #[inline(always)]
@@ -191,7 +229,7 @@ impl Simd for Portable {
         PV(r)
     }
     #[inline(always)]
-    fn rays(rays: &[Ray; LANES]) -> [PV; 7] {
+    fn rays(self, rays: &[Ray; LANES]) -> [PV; 7] {
         ray_arrays(rays).map(PV)
     }
     #[inline(always)]
@@ -289,7 +327,7 @@ impl Simd for Portable {
         PV(r)
     }
     #[inline(always)]
-    fn mask(b: u32) -> Self::M {
+    fn mask(self, b: u32) -> Self::M {
         let mut m = [0; LANES];
         for i in 0..LANES {
             m[i] = 0u32.wrapping_sub(b >> i & 1);
@@ -302,15 +340,15 @@ impl Simd for Portable {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-pub(super) use x86::{Avx2, Avx512};
-
-/// The x86-64 backends. Their operations may only run on CPUs with the backend's features:
-/// the kernels instantiate them inside `#[target_feature]` functions that are entered only
-/// after `is_x86_feature_detected!`, which is what the `SAFETY` comments below rely on.
+/// The x86-64 backends, implemented for the tokens [`Avx2`] and [`Avx512`]: a vector `A2` or
+/// `A5` is made only from a token (or from another vector), and a token only on a CPU with
+/// its features, which is what the `SAFETY` comments below rely on. The kernels run inside
+/// `crate::isa::Cpu::dispatch`'s `#[target_feature]` functions, into which these
+/// `#[inline(always)]` operations inline.
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::{LANES, Lanes, Ray, Simd, transpose_lanes};
+    use crate::isa::{Avx2, Avx512};
     use std::arch::x86_64::*;
     use std::mem::{offset_of, size_of};
 
@@ -331,21 +369,15 @@ mod x86 {
         (i * size_of::<Ray>()) as i32
     }
 
-    /// AVX2 backend: two `__m256` per vector; a mask is the sign bits of a vector.
+    /// Sixteen lanes of [`Avx2`]: two `__m256`; a mask is the sign bits of a vector. The
+    /// field is private: only the token's operations make one.
     #[derive(Clone, Copy)]
-    pub(in crate::geometry) struct Avx2;
+    pub struct A2(__m256, __m256);
 
-    /// Sixteen lanes of [`Avx2`].
+    /// Sixteen lanes of [`Avx512`]: one `__m512`; masks are `__mmask16`. The field is
+    /// private: only the token's operations make one.
     #[derive(Clone, Copy)]
-    pub(in crate::geometry) struct A2(__m256, __m256);
-
-    /// AVX-512 backend: one `__m512`, masks in `__mmask16`.
-    #[derive(Clone, Copy)]
-    pub(in crate::geometry) struct Avx512;
-
-    /// Sixteen lanes of [`Avx512`].
-    #[derive(Clone, Copy)]
-    pub(in crate::geometry) struct A5(__m512);
+    pub struct A5(__m512);
 
     macro_rules! binop {
         ($t:ident, $tr:ident, $f:ident, $i2:ident, $i5:ident) => {
@@ -371,6 +403,26 @@ mod x86 {
     binop!(A2, Sub, sub, _mm256_sub_ps, _mm512_sub_ps);
     binop!(A2, Mul, mul, _mm256_mul_ps, _mm512_mul_ps);
 
+    /// Every lane `x`. Private: called by the token's `splat` and by operations that hold an
+    /// `A2` (so the CPU runs AVX2).
+    #[inline(always)]
+    fn set2(x: f32) -> A2 {
+        // SAFETY: AVX2 is available (see the module docs).
+        unsafe { A2(_mm256_set1_ps(x), _mm256_set1_ps(x)) }
+    }
+
+    /// The lanes of `a` (private, as [`set2`]).
+    #[inline(always)]
+    fn load2(a: &Lanes) -> A2 {
+        // SAFETY: AVX2 is available; `a` holds 16 floats (unaligned loads).
+        unsafe {
+            A2(
+                _mm256_loadu_ps(a.as_ptr()),
+                _mm256_loadu_ps(a.as_ptr().add(8)),
+            )
+        }
+    }
+
     /// Apply a two-operand `__m256` intrinsic to both halves.
     macro_rules! halves {
         ($f:expr, $a:expr, $b:expr) => {
@@ -383,19 +435,12 @@ mod x86 {
         type F = A2;
         type M = A2;
         #[inline(always)]
-        fn splat(x: f32) -> A2 {
-            // SAFETY: AVX2 is available (see the module docs).
-            unsafe { A2(_mm256_set1_ps(x), _mm256_set1_ps(x)) }
+        fn splat(self, x: f32) -> A2 {
+            set2(x)
         }
         #[inline(always)]
-        fn load(a: &Lanes) -> A2 {
-            // SAFETY: AVX2 is available; `a` holds 16 floats (unaligned loads).
-            unsafe {
-                A2(
-                    _mm256_loadu_ps(a.as_ptr()),
-                    _mm256_loadu_ps(a.as_ptr().add(8)),
-                )
-            }
+        fn load(self, a: &Lanes) -> A2 {
+            load2(a)
         }
         #[inline(always)]
         fn store(v: A2, a: &mut Lanes) {
@@ -415,7 +460,7 @@ mod x86 {
             unsafe { A2(_mm256_sqrt_ps(a.0), _mm256_sqrt_ps(a.1)) }
         }
         #[inline(always)]
-        fn rays(rays: &[Ray; LANES]) -> [A2; 7] {
+        fn rays(self, rays: &[Ray; LANES]) -> [A2; 7] {
             let base = rays.as_ptr() as *const f32;
             // SAFETY: AVX2 is available; every gathered address is ray i's field at byte
             // offset ray_offset(i) + FIELDS[k] < size_of_val(rays), inside the array.
@@ -469,8 +514,8 @@ mod x86 {
         }
         #[inline(always)]
         fn sign_one(a: A2) -> A2 {
-            let s = Self::splat(-0.0);
-            let one = Self::splat(1.0);
+            let s = set2(-0.0);
+            let one = set2(1.0);
             // SAFETY: AVX2 is available (see the module docs).
             unsafe {
                 A2(
@@ -482,7 +527,7 @@ mod x86 {
         #[inline(always)]
         fn abs(a: A2) -> A2 {
             // `_mm256_andnot_ps(x, y)` is `!x & y`.
-            halves!(_mm256_andnot_ps, Self::splat(-0.0), a)
+            halves!(_mm256_andnot_ps, set2(-0.0), a)
         }
         #[inline(always)]
         fn select(m: A2, a: A2, b: A2) -> A2 {
@@ -544,7 +589,7 @@ mod x86 {
             Self::select(m, up, a)
         }
         #[inline(always)]
-        fn mask(b: u32) -> A2 {
+        fn mask(self, b: u32) -> A2 {
             // SAFETY: AVX2 is available (see the module docs).
             unsafe {
                 let lo = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
@@ -563,9 +608,9 @@ mod x86 {
                 Self::store(rows[k], &mut a[k]);
             }
             let t = transpose_lanes(&a);
-            let mut out = [Self::splat(0.0); LANES];
+            let mut out = [set2(0.0); LANES];
             for i in 0..LANES {
-                out[i] = Self::load(&t[i]);
+                out[i] = load2(&t[i]);
             }
             out
         }
@@ -575,12 +620,12 @@ mod x86 {
         type F = A5;
         type M = __mmask16;
         #[inline(always)]
-        fn splat(x: f32) -> A5 {
+        fn splat(self, x: f32) -> A5 {
             // SAFETY: AVX-512F is available (see the module docs).
             unsafe { A5(_mm512_set1_ps(x)) }
         }
         #[inline(always)]
-        fn load(a: &Lanes) -> A5 {
+        fn load(self, a: &Lanes) -> A5 {
             // SAFETY: AVX-512F is available; `a` holds 16 floats (unaligned load).
             unsafe { A5(_mm512_loadu_ps(a.as_ptr())) }
         }
@@ -600,14 +645,14 @@ mod x86 {
             unsafe { A5(_mm512_sqrt_ps(a.0)) }
         }
         #[inline(always)]
-        fn rays(rays: &[Ray; LANES]) -> [A5; 7] {
+        fn rays(self, rays: &[Ray; LANES]) -> [A5; 7] {
             // Ray i's seven floats as row i (masked loads: nothing past the ray is read),
             // transposed: field k of every ray is then row FIELDS[k] / 4. Shuffles instead of
             // seven gathers, which are slow on some CPUs (Zen 4).
             const RAY_FLOATS: usize = size_of::<Ray>() / 4;
             const _: () = assert!(size_of::<Ray>() == 28 && RAY_FLOATS == 7);
             let base = rays.as_ptr() as *const f32;
-            let mut rows = [Self::splat(0.0); LANES];
+            let mut rows = [self.splat(0.0); LANES];
             for i in 0..LANES {
                 // SAFETY: AVX-512F is available; lanes 0..7 lie in ray i (28 bytes from
                 // base + 7i floats), and masked-off lanes are not accessed.
@@ -705,7 +750,7 @@ mod x86 {
             }
         }
         #[inline(always)]
-        fn mask(b: u32) -> __mmask16 {
+        fn mask(self, b: u32) -> __mmask16 {
             b as __mmask16
         }
         #[inline(always)]
@@ -806,11 +851,11 @@ mod tests {
     }
 
     /// Every operation of backend `S` on the special values, as bit patterns.
-    fn results<S: Simd>() -> Vec<u32> {
+    fn results<S: Simd>(s: S) -> Vec<u32> {
         let mut v = Vec::new();
         for round in 0..4 {
             let (a, b) = std::hint::black_box(rows(round));
-            let (x, y) = (S::load(&a), S::load(&b));
+            let (x, y) = (s.load(&a), s.load(&b));
             let values = [
                 x + y,
                 x - y,
@@ -833,7 +878,7 @@ mod tests {
                 S::eq(x, y),
                 S::sign(x),
                 S::eq_bits(x, y),
-                S::mask(0x8421 << round),
+                s.mask(0x8421 << round),
             ];
             let (m0, m1) = (masks[0], masks[2]);
             let combos = [
@@ -845,7 +890,7 @@ mod tests {
             v.extend(masks.iter().chain(&combos).map(|&m| S::bits(m)));
         }
         let rows: [S::F; LANES] =
-            std::array::from_fn(|k| S::load(&std::array::from_fn(|i| (k * LANES + i) as f32)));
+            std::array::from_fn(|k| s.load(&std::array::from_fn(|i| (k * LANES + i) as f32)));
         for f in S::transpose(rows) {
             v.extend(lane_bits::<S>(f));
         }
@@ -854,7 +899,7 @@ mod tests {
             d: Vec3::new(1.0, i as f32 * 0.25, -2.0),
             t_max: 100.0 + i as f32,
         });
-        for f in S::rays(&rays) {
+        for f in s.rays(&rays) {
             v.extend(lane_bits::<S>(f));
         }
         v
@@ -864,7 +909,7 @@ mod tests {
     #[test]
     fn portable_lanes_are_the_scalar_operations() {
         let (a, b) = rows(1);
-        let r = results::<Portable>();
+        let r = results(Portable);
         let per_round = 11 * LANES + 10;
         for i in 0..LANES {
             let (x, y) = (a[i], b[i]);
@@ -893,22 +938,18 @@ mod tests {
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn x86_backends_match_portable_lanes() {
-        let want = results::<Portable>();
-        if std::is_x86_feature_detected!("avx2") {
-            #[target_feature(enable = "avx2")]
-            fn avx2() -> Vec<u32> {
-                results::<Avx2>()
+        struct Results;
+        impl SimdKernel for Results {
+            type Output = Vec<u32>;
+            #[inline(always)]
+            fn run<S: Simd>(self, s: S) -> Vec<u32> {
+                results(s)
             }
-            // SAFETY: AVX2 was detected just above.
-            assert_eq!(unsafe { avx2() }, want);
         }
-        if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512dq") {
-            #[target_feature(enable = "avx512f,avx512dq")]
-            fn avx512() -> Vec<u32> {
-                results::<Avx512>()
-            }
-            // SAFETY: AVX-512F and DQ were detected just above.
-            assert_eq!(unsafe { avx512() }, want);
+        let want = results(Portable);
+        for isa in crate::isa::Isa::available() {
+            let cpu = isa.on_this_cpu().expect("available");
+            assert_eq!(cpu.dispatch(OnSimd(Results)), want, "{isa:?}");
         }
     }
 }

@@ -16,27 +16,38 @@ pub fn mix64(mut x: u64) -> u64 {
 
 /// [`mix64`] of 8 u64 lanes on AVX-512 (DQ: 64-bit multiply), lane for lane the same.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq")]
-pub(crate) fn mix64_avx512(x: std::arch::x86_64::__m512i) -> std::arch::x86_64::__m512i {
+#[inline(always)]
+pub(crate) fn mix64_avx512(
+    _: crate::isa::Avx512,
+    x: std::arch::x86_64::__m512i,
+) -> std::arch::x86_64::__m512i {
     use std::arch::x86_64::*;
-    let x = _mm512_xor_si512(x, _mm512_srli_epi64::<30>(x));
-    let x = _mm512_mullo_epi64(x, _mm512_set1_epi64(0xbf58_476d_1ce4_e5b9_u64 as i64));
-    let x = _mm512_xor_si512(x, _mm512_srli_epi64::<27>(x));
-    let x = _mm512_mullo_epi64(x, _mm512_set1_epi64(0x94d0_49bb_1331_11eb_u64 as i64));
-    _mm512_xor_si512(x, _mm512_srli_epi64::<31>(x))
+    // SAFETY: the token proves the CPU runs AVX-512 (F and DQ).
+    unsafe {
+        let x = _mm512_xor_si512(x, _mm512_srli_epi64::<30>(x));
+        let x = _mm512_mullo_epi64(x, _mm512_set1_epi64(0xbf58_476d_1ce4_e5b9_u64 as i64));
+        let x = _mm512_xor_si512(x, _mm512_srli_epi64::<27>(x));
+        let x = _mm512_mullo_epi64(x, _mm512_set1_epi64(0x94d0_49bb_1331_11eb_u64 as i64));
+        _mm512_xor_si512(x, _mm512_srli_epi64::<31>(x))
+    }
 }
 
 /// [`hash_step`] of 8 u64 lanes on AVX-512 (DQ), lane for lane the same.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq")]
+#[inline(always)]
 pub(crate) fn hash_step_avx512(
+    t: crate::isa::Avx512,
     h: std::arch::x86_64::__m512i,
     k: std::arch::x86_64::__m512i,
 ) -> std::arch::x86_64::__m512i {
     use std::arch::x86_64::*;
-    let c = _mm512_set1_epi64(0x9e37_79b9_7f4a_7c15_u64 as i64);
-    let t = _mm512_add_epi64(_mm512_add_epi64(k, c), _mm512_slli_epi64::<6>(h));
-    mix64_avx512(_mm512_xor_si512(h, t))
+    // SAFETY: the token proves the CPU runs AVX-512.
+    let x = unsafe {
+        let c = _mm512_set1_epi64(0x9e37_79b9_7f4a_7c15_u64 as i64);
+        let t = _mm512_add_epi64(_mm512_add_epi64(k, c), _mm512_slli_epi64::<6>(h));
+        _mm512_xor_si512(h, t)
+    };
+    mix64_avx512(t, x)
 }
 
 /// Hash any number of 64-bit keys into one well-mixed 64-bit value.

@@ -37,7 +37,9 @@ use super::ONE_MINUS_EPSILON;
 use super::error::SamplingError;
 use super::hash::{HASH_INIT, hash_keys, hash_step, mix64, uniform_pair};
 use super::permutation::{PermDomain, Permutation};
-use crate::isa::Isa;
+#[cfg(target_arch = "x86_64")]
+use crate::isa::Avx512;
+use crate::isa::{Cpu, Isa, Kernel, Token};
 use std::cell::Cell;
 
 /// The pattern names accepted by `--pattern`.
@@ -158,7 +160,7 @@ pub struct Pattern {
     /// the default x86-64 target has SSE2 only (4 u32 lanes, no 64-bit vector multiply), so
     /// they are also compiled for AVX2 and AVX-512 (16 u32 lanes = one vector), with the same
     /// values (integer ops, exact conversions, IEEE division, a compare-select).
-    isa: Isa,
+    cpu: Cpu,
 }
 
 impl Pattern {
@@ -167,7 +169,7 @@ impl Pattern {
         Self {
             seed,
             kind,
-            isa: Isa::detect(),
+            cpu: Cpu::detect(),
         }
     }
 
@@ -409,9 +411,19 @@ impl SamplePattern for Pattern {
         out.reset(*self, pixel);
         #[cfg(target_arch = "x86_64")]
         if out.raw_mode {
-            // SAFETY: raw mode means `self.isa` is Avx512 (from `Isa::detect`, or in tests
-            // one of `Isa::available`): the CPU has these features.
-            unsafe { self.raw_stratified_avx512(pixel, &mut out.raw) };
+            /// [`Pattern::raw_stratified_avx512`] as a kernel.
+            struct Raw<'a>(&'a Pattern, UVec2, &'a mut [RawSets; 2]);
+            impl Kernel for Raw<'_> {
+                type Output = ();
+                #[inline(always)]
+                fn run<T: Token>(self, t: T) {
+                    // Raw mode is entered only on AVX-512 (`Pattern::raw_mode`).
+                    if let Some(a) = t.avx512() {
+                        self.0.raw_stratified_avx512(a, self.1, self.2);
+                    }
+                }
+            }
+            self.cpu.dispatch(Raw(self, pixel, &mut out.raw));
             return;
         }
         let prefix = self.pixel_hash(pixel);
@@ -430,25 +442,38 @@ impl Pattern {
     /// the round keys of a dimension are derived when its chunk is filled, for the few
     /// dimensions an integrator uses).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    fn raw_stratified_avx512(&self, pixel: UVec2, raw: &mut [RawSets; 2]) {
+    #[inline(always)]
+    fn raw_stratified_avx512(&self, t: Avx512, pixel: UVec2, raw: &mut [RawSets; 2]) {
         use super::hash::{hash_step_avx512, mix64_avx512};
         use std::arch::x86_64::*;
         const _: () = assert!(CACHED_DIMS == 8, "one 8-lane vector of dimensions");
-        let prefix = _mm512_set1_epi64(self.pixel_hash(pixel) as i64);
-        let dims = hash_step_avx512(prefix, _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+        // SAFETY: `t` proves the CPU runs AVX-512.
+        let (prefix, lanes) = unsafe {
+            (
+                _mm512_set1_epi64(self.pixel_hash(pixel) as i64),
+                _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7),
+            )
+        };
+        let dims = hash_step_avx512(t, prefix, lanes);
         for (tag, out) in [TAG_1D, TAG_2D].into_iter().zip(raw.iter_mut()) {
             // The `stratified` arm of `SetKeys::new` for the 8 keys of one tag.
-            let key = hash_step_avx512(dims, _mm512_set1_epi64(tag as i64));
-            let k = mix64_avx512(key);
-            let k2 = mix64_avx512(k);
-            let jitter = hash_step_avx512(key, _mm512_set1_epi64(TAG_JITTER as i64));
-            for (o, v) in [&mut out.k, &mut out.k2, &mut out.jitter]
-                .into_iter()
-                .zip([k, k2, jitter])
-            {
-                // SAFETY: `o` is 8 u64 = 64 bytes, the width of the unaligned store.
-                unsafe { _mm512_storeu_si512(o.as_mut_ptr() as *mut __m512i, v) };
+            // SAFETY: as above.
+            let (tag, tag_jitter) = unsafe {
+                (
+                    _mm512_set1_epi64(tag as i64),
+                    _mm512_set1_epi64(TAG_JITTER as i64),
+                )
+            };
+            let key = hash_step_avx512(t, dims, tag);
+            let k = mix64_avx512(t, key);
+            let k2 = mix64_avx512(t, k);
+            let jitter = hash_step_avx512(t, key, tag_jitter);
+            // SAFETY: AVX-512 as above; each field is 8 u64 = 64 bytes, the width of the
+            // unaligned store.
+            unsafe {
+                _mm512_storeu_si512(out.k.as_mut_ptr() as *mut __m512i, k);
+                _mm512_storeu_si512(out.k2.as_mut_ptr() as *mut __m512i, k2);
+                _mm512_storeu_si512(out.jitter.as_mut_ptr() as *mut __m512i, jitter);
             }
         }
     }
@@ -457,7 +482,7 @@ impl Pattern {
     fn raw_mode(&self) -> bool {
         cfg!(target_arch = "x86_64")
             && self.kind == PatternKind::Stratified
-            && self.isa == Isa::Avx512
+            && self.cpu.isa() == Isa::Avx512
     }
 
     /// The [`PixelSamples`] of `pixel` with these sets' keys and empty caches.
@@ -616,45 +641,57 @@ impl FastStrata {
         v
     }
 
-    /// [`FastStrata::chunk_1d`] on `isa`.
+    /// [`FastStrata::chunk_1d`] on `cpu`.
     #[inline(always)]
-    fn chunk_1d_on(&self, isa: Isa, set: &SetKeys, base: u32) -> [f32; CHUNK] {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `isa` is `Pattern::isa` (from `Isa::detect`) or, in tests, one of
-            // `Isa::available`: a set this CPU runs, here AVX-512 F/BW/DQ/VL.
-            Isa::Avx512 => unsafe { self.chunk_1d_avx512(set, base) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as above, a set this CPU runs: AVX2.
-            Isa::Avx2 => unsafe { self.chunk_1d_avx2(set, base) },
-            _ => self.chunk_1d(set, base),
+    fn chunk_1d_on(&self, cpu: Cpu, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+        /// The chunk fill as a kernel: the AVX-512 form on AVX-512, else the portable loops
+        /// compiled for the set.
+        struct Fill<'a>(&'a FastStrata, &'a SetKeys, u32);
+        impl Kernel for Fill<'_> {
+            type Output = [f32; CHUNK];
+            #[inline(always)]
+            fn run<T: Token>(self, t: T) -> [f32; CHUNK] {
+                #[cfg(target_arch = "x86_64")]
+                if let Some(a) = t.avx512() {
+                    return self.0.chunk_1d_avx512(a, self.1, self.2);
+                }
+                let _ = t;
+                self.0.chunk_1d(self.1, self.2)
+            }
         }
+        cpu.dispatch(Fill(self, set, base))
     }
 
-    /// [`FastStrata::chunk_2d`] on `isa`.
+    /// [`FastStrata::chunk_2d`] on `cpu`.
     #[inline(always)]
-    fn chunk_2d_on(&self, isa: Isa, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as in `chunk_1d_on`.
-            Isa::Avx512 => unsafe { self.chunk_2d_avx512(set, base) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as in `chunk_1d_on`.
-            Isa::Avx2 => unsafe { self.chunk_2d_avx2(set, base) },
-            _ => self.chunk_2d(set, base),
+    fn chunk_2d_on(&self, cpu: Cpu, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+        /// As in [`FastStrata::chunk_1d_on`].
+        struct Fill<'a>(&'a FastStrata, &'a SetKeys, u32);
+        impl Kernel for Fill<'_> {
+            type Output = [Vec2; CHUNK];
+            #[inline(always)]
+            fn run<T: Token>(self, t: T) -> [Vec2; CHUNK] {
+                #[cfg(target_arch = "x86_64")]
+                if let Some(a) = t.avx512() {
+                    return self.0.chunk_2d_avx512(a, self.1, self.2);
+                }
+                let _ = t;
+                self.0.chunk_2d(self.1, self.2)
+            }
         }
+        cpu.dispatch(Fill(self, set, base))
     }
 
     /// [`FastStrata::chunk_1d`] on AVX-512, written with intrinsics, one 16-lane vector per
     /// step (compiled from the portable loops, LLVM split the 16 lanes 8 + 4 + 2 + 1 + 1); any
     /// count, since the permutation cycle-walks on lane masks.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    fn chunk_1d_avx512(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
+    #[inline(always)]
+    fn chunk_1d_avx512(&self, t: Avx512, set: &SetKeys, base: u32) -> [f32; CHUNK] {
         use std::arch::x86_64::*;
-        let v = self.chunk_1d_vec_avx512(&set.perm, set.jitter_fast, base);
+        let v = self.chunk_1d_vec_avx512(t, &set.perm, set.jitter_fast, base);
         let mut out = [0.0f32; CHUNK];
-        // SAFETY: `out` is 16 f32 = 64 bytes, the width of the unaligned store.
+        // SAFETY: `t` proves AVX-512; `out` is 16 f32 = 64 bytes, the width of the store.
         unsafe { _mm512_storeu_ps(out.as_mut_ptr(), v) };
         out
     }
@@ -662,81 +699,72 @@ impl FastStrata {
     /// The values of [`FastStrata::chunk_1d_avx512`] in one vector, from the set's
     /// permutation and `jitter_fast` key.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    #[inline(always)]
     fn chunk_1d_vec_avx512(
         &self,
+        t: Avx512,
         perm: &Permutation,
         jitter_fast: u64,
         base: u32,
     ) -> std::arch::x86_64::__m512 {
-        let strata = perm.apply_16_avx512(base, &self.dom);
-        let (jx, _) = jitters_avx512(jitter_fast, base);
+        let strata = perm.apply_16_avx512(t, base, &self.dom);
+        let (jx, _) = jitters_avx512(t, jitter_fast, base);
         if self.small_1d {
-            fixed_small_avx512(strata, jx, self.div_1d)
+            fixed_small_avx512(t, strata, jx, self.div_1d)
         } else {
-            fixed_wide_avx512(strata, jx, self.div_1d)
+            fixed_wide_avx512(t, strata, jx, self.div_1d)
         }
     }
 
     /// [`FastStrata::chunk_2d`] on AVX-512 (see [`FastStrata::chunk_1d_avx512`]).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    fn chunk_2d_avx512(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
+    #[inline(always)]
+    fn chunk_2d_avx512(&self, t: Avx512, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
         if !self.small_2d {
             return self.chunk_2d(set, base);
         }
         let mut out = [Vec2::ZERO; CHUNK];
-        let (x, y) = self.chunk_2d_vec_avx512(&set.perm, set.jitter_fast, base);
+        let (x, y) = self.chunk_2d_vec_avx512(t, &set.perm, set.jitter_fast, base);
         // SAFETY: `out` is 16 `Vec2`.
-        unsafe { store_2d_avx512(out.as_mut_ptr(), x, y) };
+        unsafe { store_2d_avx512(t, out.as_mut_ptr(), x, y) };
         out
     }
 
     /// The x and y values of [`FastStrata::chunk_2d_avx512`] as two vectors (`small_2d` only),
     /// from the set's permutation and `jitter_fast` key.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    #[inline(always)]
     fn chunk_2d_vec_avx512(
         &self,
+        t: Avx512,
         perm: &Permutation,
         jitter_fast: u64,
         base: u32,
     ) -> (std::arch::x86_64::__m512, std::arch::x86_64::__m512) {
         use std::arch::x86_64::*;
-        let strata = perm.apply_16_avx512(base, &self.dom);
-        let (jx, jy) = jitters_avx512(jitter_fast, base);
-        let (sx, sy) = if self.nx_log2 != u32::MAX {
-            (
-                _mm512_and_si512(strata, _mm512_set1_epi32(self.nx_mask as i32)),
-                _mm512_srl_epi32(strata, _mm_cvtsi32_si128(self.nx_log2 as i32)),
-            )
-        } else {
-            // `split_f32` on 16 lanes (exact conversions, IEEE division, truncation).
-            let nx = _mm512_set1_epi32(self.nx as i32);
-            let q = _mm512_cvttps_epu32(_mm512_div_ps(
-                _mm512_cvtepi32_ps(strata),
-                _mm512_cvtepi32_ps(nx),
-            ));
-            (_mm512_sub_epi32(strata, _mm512_mullo_epi32(q, nx)), q)
+        let strata = perm.apply_16_avx512(t, base, &self.dom);
+        let (jx, jy) = jitters_avx512(t, jitter_fast, base);
+        // SAFETY: `t` proves the CPU runs AVX-512.
+        let (sx, sy) = unsafe {
+            if self.nx_log2 != u32::MAX {
+                (
+                    _mm512_and_si512(strata, _mm512_set1_epi32(self.nx_mask as i32)),
+                    _mm512_srl_epi32(strata, _mm_cvtsi32_si128(self.nx_log2 as i32)),
+                )
+            } else {
+                // `split_f32` on 16 lanes (exact conversions, IEEE division, truncation).
+                let nx = _mm512_set1_epi32(self.nx as i32);
+                let q = _mm512_cvttps_epu32(_mm512_div_ps(
+                    _mm512_cvtepi32_ps(strata),
+                    _mm512_cvtepi32_ps(nx),
+                ));
+                (_mm512_sub_epi32(strata, _mm512_mullo_epi32(q, nx)), q)
+            }
         };
         (
-            fixed_small_avx512(sx, jx, self.div_x),
-            fixed_small_avx512(sy, jy, self.div_y),
+            fixed_small_avx512(t, sx, jx, self.div_x),
+            fixed_small_avx512(t, sy, jy, self.div_y),
         )
-    }
-
-    /// [`FastStrata::chunk_1d`] compiled for AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn chunk_1d_avx2(&self, set: &SetKeys, base: u32) -> [f32; CHUNK] {
-        self.chunk_1d(set, base)
-    }
-
-    /// [`FastStrata::chunk_2d`] compiled for AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn chunk_2d_avx2(&self, set: &SetKeys, base: u32) -> [Vec2; CHUNK] {
-        self.chunk_2d(set, base)
     }
 }
 
@@ -746,20 +774,21 @@ impl FastStrata {
 /// # Safety
 /// `out` must be valid for writing 16 `Vec2` (no alignment needed).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[inline(always)]
 unsafe fn store_2d_avx512(
+    _: Avx512,
     out: *mut Vec2,
     x: std::arch::x86_64::__m512,
     y: std::arch::x86_64::__m512,
 ) {
     use std::arch::x86_64::*;
-    // Lanes ≥ 16 of the index pick from `y`.
-    let lo = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
-    let hi = _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
     let p = out as *mut f32;
-    // SAFETY: `Vec2` is `repr(C)` (x, y), so 16 of them are 32 contiguous f32 = two 64-byte
-    // unaligned stores, valid by the caller's contract.
+    // SAFETY: the token proves AVX-512; `Vec2` is `repr(C)` (x, y), so 16 of them are 32
+    // contiguous f32 = two 64-byte unaligned stores, valid by the caller's contract.
     unsafe {
+        // Lanes ≥ 16 of the index pick from `y`.
+        let lo = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+        let hi = _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
         _mm512_storeu_ps(p, _mm512_permutex2var_ps(x, lo, y));
         _mm512_storeu_ps(p.add(16), _mm512_permutex2var_ps(x, hi, y));
     }
@@ -768,8 +797,9 @@ unsafe fn store_2d_avx512(
 /// The 24-bit jitters (x, y) of indices `base..base + 16` of a set with key `jitter_fast` on
 /// AVX-512: the same hashes as [`FastStrata::jitter_hashes`], 8 u64 lanes at a time.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+#[inline(always)]
 fn jitters_avx512(
+    t: Avx512,
     jitter_fast: u64,
     base: u32,
 ) -> (std::arch::x86_64::__m512i, std::arch::x86_64::__m512i) {
@@ -780,53 +810,66 @@ fn jitters_avx512(
     // `jitter_fast + (base + k) · H` is `(jitter_fast + base · H) + k · H` (mod 2^64): one
     // scalar start and constant steps instead of a conversion and a 64-bit multiply per lane.
     let start = jitter_fast.wrapping_add((base as u64).wrapping_mul(HASH_INIT));
-    let start = _mm512_set1_epi64(start as i64);
     let step = |k: u64| k.wrapping_mul(HASH_INIT) as i64;
-    let lo = _mm512_setr_epi64(
-        step(0),
-        step(1),
-        step(2),
-        step(3),
-        step(4),
-        step(5),
-        step(6),
-        step(7),
-    );
-    let hi = _mm512_setr_epi64(
-        step(8),
-        step(9),
-        step(10),
-        step(11),
-        step(12),
-        step(13),
-        step(14),
-        step(15),
-    );
-    let h0 = mix64_avx512(_mm512_add_epi64(start, lo));
-    let h1 = mix64_avx512(_mm512_add_epi64(start, hi));
-    // The low (`h as u32`) and high (`(h >> 32) as u32`) halves of the 16 hashes: the even
-    // and odd u32 words of (h0, h1); `(h >> 40) as u32` is the high half shifted by 8.
-    let even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
-    let odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
-    let jx = _mm512_srli_epi32::<8>(_mm512_permutex2var_epi32(h0, even, h1));
-    let jy = _mm512_srli_epi32::<8>(_mm512_permutex2var_epi32(h0, odd, h1));
-    (jx, jy)
+    // SAFETY: `t` proves the CPU runs AVX-512.
+    let (start, lo, hi) = unsafe {
+        let start = _mm512_set1_epi64(start as i64);
+        let lo = _mm512_setr_epi64(
+            step(0),
+            step(1),
+            step(2),
+            step(3),
+            step(4),
+            step(5),
+            step(6),
+            step(7),
+        );
+        let hi = _mm512_setr_epi64(
+            step(8),
+            step(9),
+            step(10),
+            step(11),
+            step(12),
+            step(13),
+            step(14),
+            step(15),
+        );
+        (start, lo, hi)
+    };
+    // SAFETY: as above.
+    let (l, h) = unsafe { (_mm512_add_epi64(start, lo), _mm512_add_epi64(start, hi)) };
+    let h0 = mix64_avx512(t, l);
+    let h1 = mix64_avx512(t, h);
+    // SAFETY: as above.
+    unsafe {
+        // The low (`h as u32`) and high (`(h >> 32) as u32`) halves of the 16 hashes: the even
+        // and odd u32 words of (h0, h1); `(h >> 40) as u32` is the high half shifted by 8.
+        let even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+        let odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+        let jx = _mm512_srli_epi32::<8>(_mm512_permutex2var_epi32(h0, even, h1));
+        let jy = _mm512_srli_epi32::<8>(_mm512_permutex2var_epi32(h0, odd, h1));
+        (jx, jy)
+    }
 }
 
 /// The `small` form of [`fixed_chunk`] on 16 lanes: (stratum << 24 | j) as i32 → f32 (round
 /// to nearest, as `as f32`), IEEE division, then `v < 1⁻ ? v : 1⁻`, which is exactly
 /// `vminps(v, 1⁻)` (it returns the second operand unless v < 1⁻).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[inline(always)]
 fn fixed_small_avx512(
+    _: Avx512,
     strata: std::arch::x86_64::__m512i,
     j: std::arch::x86_64::__m512i,
     div: f32,
 ) -> std::arch::x86_64::__m512 {
     use std::arch::x86_64::*;
-    let fixed = _mm512_or_si512(_mm512_slli_epi32::<24>(strata), j);
-    let v = _mm512_div_ps(_mm512_cvtepi32_ps(fixed), _mm512_set1_ps(div));
-    _mm512_min_ps(v, _mm512_set1_ps(ONE_MINUS_EPSILON))
+    // SAFETY: the token proves the CPU runs AVX-512.
+    unsafe {
+        let fixed = _mm512_or_si512(_mm512_slli_epi32::<24>(strata), j);
+        let v = _mm512_div_ps(_mm512_cvtepi32_ps(fixed), _mm512_set1_ps(div));
+        _mm512_min_ps(v, _mm512_set1_ps(ONE_MINUS_EPSILON))
+    }
 }
 
 /// (s mod nx, s / nx) for s, nx < 2^24 through an f32 division, which vectorises (a u32
@@ -843,25 +886,35 @@ fn split_f32(s: u32, nx: u32) -> (u32, u32) {
 /// 8 i64 lanes → f32 (round to nearest, as the scalar `as i64 as f32`), IEEE division, then
 /// the same `vminps` as [`fixed_small_avx512`].
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq")]
+#[inline(always)]
 fn fixed_wide_avx512(
+    _: Avx512,
     strata: std::arch::x86_64::__m512i,
     j: std::arch::x86_64::__m512i,
     div: f32,
 ) -> std::arch::x86_64::__m512 {
     use std::arch::x86_64::*;
-    let half = |s: __m256i, j: __m256i| {
-        let s = _mm512_slli_epi64::<24>(_mm512_cvtepu32_epi64(s));
-        _mm512_cvtepi64_ps(_mm512_or_si512(s, _mm512_cvtepu32_epi64(j)))
-    };
-    let lo = half(_mm512_castsi512_si256(strata), _mm512_castsi512_si256(j));
-    let hi = half(
-        _mm512_extracti64x4_epi64::<1>(strata),
-        _mm512_extracti64x4_epi64::<1>(j),
-    );
-    let fixed = _mm512_insertf32x8::<1>(_mm512_castps256_ps512(lo), hi);
-    let v = _mm512_div_ps(fixed, _mm512_set1_ps(div));
-    _mm512_min_ps(v, _mm512_set1_ps(ONE_MINUS_EPSILON))
+    // SAFETY: the token proves the CPU runs AVX-512 (F and DQ).
+    unsafe {
+        // Eight lanes (a 256-bit half) at a time, unrolled: a closure would be compiled
+        // without the AVX-512 features.
+        let (s0, j0) = (_mm512_castsi512_si256(strata), _mm512_castsi512_si256(j));
+        let (s1, j1) = (
+            _mm512_extracti64x4_epi64::<1>(strata),
+            _mm512_extracti64x4_epi64::<1>(j),
+        );
+        let lo = _mm512_cvtepi64_ps(_mm512_or_si512(
+            _mm512_slli_epi64::<24>(_mm512_cvtepu32_epi64(s0)),
+            _mm512_cvtepu32_epi64(j0),
+        ));
+        let hi = _mm512_cvtepi64_ps(_mm512_or_si512(
+            _mm512_slli_epi64::<24>(_mm512_cvtepu32_epi64(s1)),
+            _mm512_cvtepu32_epi64(j1),
+        ));
+        let fixed = _mm512_insertf32x8::<1>(_mm512_castps256_ps512(lo), hi);
+        let v = _mm512_div_ps(fixed, _mm512_set1_ps(div));
+        _mm512_min_ps(v, _mm512_set1_ps(ONE_MINUS_EPSILON))
+    }
 }
 
 /// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form that
@@ -1103,7 +1156,7 @@ impl PixelSamples {
                 general: |p: &Pattern| p.sample_1d(self.pixel, dim, index, count),
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_1d(kind, i, st),
                 fast: |f: &FastStrata, set: &SetKeys, base| {
-                    f.chunk_1d_on(self.pattern.isa, set, base)
+                    f.chunk_1d_on(self.pattern.cpu, set, base)
                 },
             },
         )
@@ -1140,7 +1193,7 @@ impl PixelSamples {
                 general: |p: &Pattern| p.sample_2d(self.pixel, dim, index, count),
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_2d(kind, i, st),
                 fast: |f: &FastStrata, set: &SetKeys, base| {
-                    f.chunk_2d_on(self.pattern.isa, set, base)
+                    f.chunk_2d_on(self.pattern.cpu, set, base)
                 },
             },
         )
@@ -1195,16 +1248,29 @@ impl PixelSamples {
                 masks[1] |= 1 << k;
             }
         }
-        // SAFETY: raw mode means the pattern's isa is Avx512, a set this CPU runs.
-        unsafe { self.fill_avx512(&f, base, count, masks) };
+        /// [`PixelSamples::fill_avx512`] as a kernel.
+        struct Fill<'a>(&'a PixelSamples, &'a FastStrata, u32, u32, [u32; 2]);
+        impl Kernel for Fill<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<T: Token>(self, t: T) {
+                // Raw mode is entered only on AVX-512 (`Pattern::raw_mode`).
+                if let Some(a) = t.avx512() {
+                    self.0.fill_avx512(a, self.1, self.2, self.3, self.4);
+                }
+            }
+        }
+        self.pattern
+            .cpu
+            .dispatch(Fill(self, &f, base, count, masks));
         Some((index - base) as usize)
     }
 
     /// Fill the 1D chunks of the dimensions in `masks[0]` and the 2D chunks of those in
     /// `masks[1]` (`small_2d` only) with their values at `base` of `count`, from the raw keys.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    fn fill_avx512(&self, f: &FastStrata, base: u32, count: u32, masks: [u32; 2]) {
+    #[inline(always)]
+    fn fill_avx512(&self, t: Avx512, f: &FastStrata, base: u32, count: u32, masks: [u32; 2]) {
         use std::arch::x86_64::*;
         let [mut m1, mut m2] = masks;
         while m1 != 0 {
@@ -1212,9 +1278,10 @@ impl PixelSamples {
             m1 &= m1 - 1;
             let r = &self.raw[0];
             let perm = Permutation::from_mixed(r.k[d], r.k2[d]);
-            let v = f.chunk_1d_vec_avx512(&perm, r.jitter[d].wrapping_add(HASH_INIT), base);
+            let v = f.chunk_1d_vec_avx512(t, &perm, r.jitter[d].wrapping_add(HASH_INIT), base);
             let c = &self.chunks_1d[d];
-            // SAFETY: the chunk's values are 16 f32 = 64 bytes, the width of the store.
+            // SAFETY: `t` proves AVX-512; the chunk's values are 16 f32 = 64 bytes, the width
+            // of the store.
             unsafe { _mm512_storeu_ps(c.values_ptr(), v) };
             c.mark(base, count);
         }
@@ -1223,10 +1290,10 @@ impl PixelSamples {
             m2 &= m2 - 1;
             let r = &self.raw[1];
             let perm = Permutation::from_mixed(r.k[d], r.k2[d]);
-            let (x, y) = f.chunk_2d_vec_avx512(&perm, r.jitter[d].wrapping_add(HASH_INIT), base);
+            let (x, y) = f.chunk_2d_vec_avx512(t, &perm, r.jitter[d].wrapping_add(HASH_INIT), base);
             let c = &self.chunks_2d[d];
             // SAFETY: the chunk's values are 16 `Vec2`.
-            unsafe { store_2d_avx512(c.values_ptr(), x, y) };
+            unsafe { store_2d_avx512(t, c.values_ptr(), x, y) };
             c.mark(base, count);
         }
     }
@@ -1319,7 +1386,11 @@ mod tests {
             .into_iter()
             .flat_map(|k| Isa::available().into_iter().map(move |i| (k, i)))
         {
-            let pat = Pattern { seed: 7, kind, isa };
+            let pat = Pattern {
+                seed: 7,
+                kind,
+                cpu: isa.cpu(),
+            };
             for pixel in [UVec2::new(0, 0), UVec2::new(13, 511)] {
                 let px = pat.pixel(pixel);
                 assert_eq!(px.pixel(), pixel);
@@ -1359,7 +1430,11 @@ mod tests {
             .into_iter()
             .flat_map(|k| Isa::available().into_iter().map(move |i| (k, i)))
         {
-            let pat = Pattern { seed: 5, kind, isa };
+            let pat = Pattern {
+                seed: 5,
+                kind,
+                cpu: isa.cpu(),
+            };
             let mut px = pat.pixel(UVec2::new(9, 9));
             for (n, pixel) in [UVec2::new(0, 0), UVec2::new(3, 1), UVec2::new(3, 2)]
                 .into_iter()
@@ -1402,7 +1477,7 @@ mod tests {
             let pat = Pattern {
                 seed: 3,
                 kind: PatternKind::Stratified,
-                isa,
+                cpu: isa.cpu(),
             };
             let mut px = pat.pixel(UVec2::ZERO);
             for (p, pixel) in [UVec2::new(4, 5), UVec2::new(6, 5), UVec2::new(9, 1)]
@@ -1466,7 +1541,7 @@ mod tests {
             let pat = Pattern {
                 seed: 11,
                 kind: PatternKind::Stratified,
-                isa,
+                cpu: isa.cpu(),
             };
             for pixel in [UVec2::new(1, 2), UVec2::new(300, 7)] {
                 let px = pat.pixel(pixel);

@@ -143,49 +143,78 @@ impl Permutation {
     /// the same rounds, lane for lane (u32 wrapping multiply, logical shifts by the same
     /// counts, masks); for a non-power-of-two n, lanes outside [0, n) walk on under a lane mask
     /// until every lane is inside (indices ≥ n start from 0, as in `apply_many`).
-    #[target_feature(enable = "avx512f")]
+    #[inline(always)]
     pub(crate) fn apply_16_avx512(
         &self,
+        t: crate::isa::Avx512,
         base: u32,
         dom: &PermDomain,
     ) -> std::arch::x86_64::__m512i {
         use std::arch::x86_64::*;
-        let mask = _mm512_set1_epi32(dom.mask as i32);
-        // Shift counts < 32 (bits ≤ 32), as the scalar `>>`.
-        let s1 = _mm_cvtsi32_si128(dom.s1 as i32);
-        let s2 = _mm_cvtsi32_si128(dom.s2 as i32);
-        let fixed = _mm512_set1_epi32(0x2c1b_3c6d);
-        let keys = self.r.map(|r| {
-            (
-                _mm512_set1_epi32(r.x as i32),
-                _mm512_set1_epi32(r.m as i32),
-                _mm512_set1_epi32(r.a as i32),
-            )
-        });
-        let rounds = |mut i: __m512i| {
-            for (x, m, a) in keys {
-                i = _mm512_xor_si512(i, x);
-                i = _mm512_and_si512(_mm512_mullo_epi32(i, m), mask);
-                i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s1));
-                i = _mm512_add_epi32(i, a);
-                i = _mm512_and_si512(_mm512_mullo_epi32(i, fixed), mask);
-                i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s2));
+        /// The rounds on 16 lanes (a function, not a closure: a closure would be compiled
+        /// without the AVX-512 features).
+        #[inline(always)]
+        fn rounds(
+            _: crate::isa::Avx512,
+            mut i: __m512i,
+            keys: &[(__m512i, __m512i, __m512i); 3],
+            mask: __m512i,
+            (s1, s2): (__m128i, __m128i),
+        ) -> __m512i {
+            // SAFETY: the token proves the CPU runs AVX-512.
+            unsafe {
+                let fixed = _mm512_set1_epi32(0x2c1b_3c6d);
+                for &(x, m, a) in keys {
+                    i = _mm512_xor_si512(i, x);
+                    i = _mm512_and_si512(_mm512_mullo_epi32(i, m), mask);
+                    i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s1));
+                    i = _mm512_add_epi32(i, a);
+                    i = _mm512_and_si512(_mm512_mullo_epi32(i, fixed), mask);
+                    i = _mm512_xor_si512(i, _mm512_srl_epi32(i, s2));
+                }
+                i
             }
-            i
-        };
-        let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-        let idx = _mm512_add_epi32(_mm512_set1_epi32(base as i32), lanes);
-        if dom.is_pow2() {
-            return rounds(idx);
         }
-        let n = _mm512_set1_epi32(dom.n as i32);
-        let mut i = rounds(_mm512_maskz_mov_epi32(_mm512_cmplt_epu32_mask(idx, n), idx));
-        loop {
-            let out = _mm512_cmpge_epu32_mask(i, n);
-            if out == 0 {
-                return i;
+        // SAFETY: the token proves the CPU runs AVX-512.
+        unsafe {
+            let mask = _mm512_set1_epi32(dom.mask as i32);
+            // Shift counts < 32 (bits ≤ 32), as the scalar `>>`.
+            let shifts = (
+                _mm_cvtsi32_si128(dom.s1 as i32),
+                _mm_cvtsi32_si128(dom.s2 as i32),
+            );
+            let mut keys = [(
+                _mm512_setzero_si512(),
+                _mm512_setzero_si512(),
+                _mm512_setzero_si512(),
+            ); 3];
+            for (k, r) in keys.iter_mut().zip(&self.r) {
+                *k = (
+                    _mm512_set1_epi32(r.x as i32),
+                    _mm512_set1_epi32(r.m as i32),
+                    _mm512_set1_epi32(r.a as i32),
+                );
             }
-            i = _mm512_mask_mov_epi32(i, out, rounds(i));
+            let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+            let idx = _mm512_add_epi32(_mm512_set1_epi32(base as i32), lanes);
+            if dom.is_pow2() {
+                return rounds(t, idx, &keys, mask, shifts);
+            }
+            let n = _mm512_set1_epi32(dom.n as i32);
+            let mut i = rounds(
+                t,
+                _mm512_maskz_mov_epi32(_mm512_cmplt_epu32_mask(idx, n), idx),
+                &keys,
+                mask,
+                shifts,
+            );
+            loop {
+                let out = _mm512_cmpge_epu32_mask(i, n);
+                if out == 0 {
+                    return i;
+                }
+                i = _mm512_mask_mov_epi32(i, out, rounds(t, i, &keys, mask, shifts));
+            }
         }
     }
 }

@@ -4,7 +4,7 @@ use super::mesh_repair::{MeshRepair, repair_mesh};
 use super::{AreaEmission, FilmSpec, Scene, TriangleMesh};
 use crate::camera::Camera;
 use crate::geometry::{
-    Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Transform,
+    Alpha, Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Transform,
     interaction::NO_LIGHT,
 };
 use crate::lights::{DiskLight, Light, QuadLight, SphereLight, TriangleLight};
@@ -78,9 +78,21 @@ impl SceneBuilder {
     /// repaired (nothing was added if `kept() == 0`).
     pub fn add_mesh_repaired(
         &mut self,
+        mesh: TriangleMesh,
+        material: u32,
+        emission: Option<AreaEmission>,
+    ) -> anyhow::Result<MeshRepair> {
+        self.add_mesh_cut_out(mesh, material, emission, None)
+    }
+
+    /// [`SceneBuilder::add_mesh_repaired`] with an alpha cut-out (pbrt-v4's shape `alpha`):
+    /// every ray query ignores the hits its mask does not keep (see [`Alpha`]).
+    pub fn add_mesh_cut_out(
+        &mut self,
         mut mesh: TriangleMesh,
         material: u32,
         emission: Option<AreaEmission>,
+        alpha: Option<Alpha>,
     ) -> anyhow::Result<MeshRepair> {
         self.meshes_seen += 1;
         self.check_material(material)?;
@@ -176,6 +188,7 @@ impl SceneBuilder {
             normals,
             uvs,
             flip: flip_normals,
+            alpha,
         });
         Ok(repair)
     }

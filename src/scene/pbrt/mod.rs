@@ -35,6 +35,8 @@ use tokenizer::{Loc, err_at};
 pub struct ShapeCall {
     /// World-space geometry.
     pub geom: ShapeGeom,
+    /// The shape's alpha cut-out (meshes only).
+    pub alpha: Option<crate::geometry::Alpha>,
     /// Builder material index (into [`PbrtScene::materials`]).
     pub material: u32,
     /// Area emission, if an `AreaLightSource` was active.
@@ -110,7 +112,7 @@ impl PbrtScene {
             let r = match s.geom {
                 // Meshes were repaired when read; an instance's transform can still overflow.
                 ShapeGeom::Mesh(mesh) => {
-                    b.add_mesh_repaired(mesh, s.material, s.emission)
+                    b.add_mesh_cut_out(mesh, s.material, s.emission, s.alpha)
                         .map(|rep| {
                             // One warning per ObjectInstance line, however many shapes.
                             if !rep.is_clean() && warned_at.insert(s.loc.file_line()) {

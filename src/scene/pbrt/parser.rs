@@ -4,7 +4,7 @@
 use super::lights::{AreaLightDesc, parse_area_light, parse_light};
 use super::materials::{MaterialCtx, MaterialDesc, parse_material};
 use super::params::ParamSet;
-use super::shapes::{ShapeCtx, make_shape};
+use super::shapes::{ShapeCtx, make_shape, shape_alpha};
 use super::textures::{TextureTable, Warn};
 use super::tokenizer::{Loc, Tok, Token, Tokenizer, err_at};
 use super::upgrade;
@@ -804,6 +804,7 @@ impl Parser {
                     .iter()
                     .map(|s| ShapeCall {
                         geom: s.geom.transformed(&t),
+                        alpha: s.alpha.clone(),
                         material: s.material,
                         emission: s.emission,
                         reverse_orientation: s.reverse_orientation,
@@ -941,9 +942,9 @@ impl Parser {
             loc,
         };
         let mut pending = Vec::new();
-        let geom = make_shape(ty, ps, &ctx, &mut |k: &str, l: &Loc, m: String| {
-            pending.push((k.to_string(), l.clone(), m))
-        })?;
+        let mut warn = |k: &str, l: &Loc, m: String| pending.push((k.to_string(), l.clone(), m));
+        let geom = make_shape(ty, ps, &ctx, &mut warn)?;
+        let alpha = shape_alpha(ty, ps, &self.textures, loc, &mut warn)?;
         for (k, l, m) in pending {
             self.warn(&k, &l, m);
         }
@@ -970,6 +971,7 @@ impl Parser {
         }
         let call = ShapeCall {
             geom,
+            alpha,
             material,
             emission,
             reverse_orientation: self.gs.reverse,

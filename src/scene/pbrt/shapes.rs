@@ -4,9 +4,9 @@
 
 use super::params::ParamSet;
 use super::ply::read_ply;
-use super::textures::{Warn, resolve};
+use super::textures::{TextureTable, Warn, resolve};
 use super::tokenizer::{Loc, err_at};
-use crate::geometry::Transform;
+use crate::geometry::{Alpha, Transform};
 use crate::scene::TriangleMesh;
 use crate::scene::mesh_repair::repair_mesh;
 use glam::{Mat4, Vec2, Vec3};
@@ -262,15 +262,13 @@ pub fn make_shape(
     warn: &mut Warn,
 ) -> anyhow::Result<Option<ShapeGeom>> {
     let loc = ctx.loc;
-    for p in ["alpha", "displacement"] {
-        if params.has(p) {
-            let _ = params.find(p);
-            warn(
-                &format!("shape-{p}"),
-                loc,
-                format!("shape parameter '{p}' is ignored"),
-            );
-        }
+    if params.has("displacement") {
+        let _ = params.find("displacement");
+        warn(
+            "shape-displacement",
+            loc,
+            "shape parameter 'displacement' is ignored".into(),
+        );
     }
     Ok(Some(match kind {
         "trianglemesh" => {
@@ -413,4 +411,39 @@ pub fn make_shape(
             return Ok(None);
         }
     }))
+}
+
+/// The shape's `"float alpha"` / `"texture alpha"` cut-out (pbrt-v4: none when the coverage is
+/// 1). Coverage is clamped to [0, 1]; a varying float texture, which penumbra's float textures
+/// cannot yet give the geometry, is warned about by the texture table and read as opaque.
+/// Spheres and disks keep no cut-out (warned).
+pub fn shape_alpha(
+    kind: &str,
+    params: &ParamSet,
+    textures: &TextureTable,
+    loc: &Loc,
+    warn: &mut Warn,
+) -> anyhow::Result<Option<Alpha>> {
+    if !params.has("alpha") {
+        return Ok(None);
+    }
+    let a = textures.float_param(params, "alpha", 1.0, warn)?;
+    if !a.is_finite() {
+        return Err(err_at(
+            params.loc_of("alpha").as_ref().unwrap_or(loc),
+            format!("'alpha' must be a finite number, found {a}"),
+        ));
+    }
+    if a >= 1.0 {
+        return Ok(None);
+    }
+    if matches!(kind, "sphere" | "disk") {
+        warn(
+            "shape-alpha-quadric",
+            loc,
+            format!("'alpha' on a {kind} is not supported; rendered opaque"),
+        );
+        return Ok(None);
+    }
+    Ok(Some(Alpha::Constant(a.max(0.0))))
 }

@@ -1,62 +1,23 @@
 //! [`Geometry`]: every primitive of a scene behind one BVH — penumbra's 4-wide BVH with
 //! 4-triangle packets ([`super::wide`], the default), its own binned-SAH BVH2 ([`super::bvh`]) or
-//! obvhs's compressed-wide BVH (CWBVH), see [`Backend`].
+//! obvhs's compressed-wide BVH (CWBVH), see [`Backend`]. The one-ray queries and hit records
+//! are here, the 16-ray packet queries in [`packet`].
+
+mod packet;
 
 use super::bvh::Bvh;
-use super::packet::{ColumnSink, PACKET, PacketHits, PacketRays, bits};
+use super::primitive::{MeshShading, PrimKind, Primitive, prim_bounds, triangle_normal};
 use super::quadric::Quadric;
-#[cfg(target_arch = "x86_64")]
-use super::simd16::{Avx2, Avx512};
-use super::simd16::{Portable, Simd};
 use super::tree2::Tree2;
-use super::triangle::{POINT_ERROR_GAMMA, RayShear, barycentric_error};
+use super::triangle::{RayShear, barycentric_error};
 use super::wide::{Bary, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
-use crate::isa::Isa;
+use crate::isa::{Cpu, Isa};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::RayHit;
 use std::time::{Duration, Instant};
-
-/// Per-vertex data of a mesh that hit records interpolate.
-#[derive(Clone, Debug, Default)]
-pub struct MeshShading {
-    /// Optional per-vertex shading normals.
-    pub normals: Option<Vec<Vec3>>,
-    /// Optional per-vertex texture coordinates.
-    pub uvs: Option<Vec<Vec2>>,
-    /// Flip the geometric normal (only when there are no vertex normals).
-    pub flip: bool,
-}
-
-/// What a primitive is.
-#[derive(Clone, Copy, Debug)]
-pub enum PrimKind {
-    /// Triangle `tri` (its vertex indices are `indices[3·tri..]`) of mesh `mesh`.
-    Triangle {
-        /// Mesh index into `Geometry::meshes`.
-        mesh: u32,
-        /// Vertex indices into the mesh's arrays.
-        v: [u32; 3],
-    },
-    /// Index into `Geometry::quadrics`.
-    Quadric(u32),
-}
-
-/// A primitive: triangle vertices inline for the hot intersection loop, plus its ids. Vertices
-/// (not edges) are stored so that neighbours see bit-identical shared vertices (watertight).
-#[derive(Clone, Copy, Debug)]
-pub struct Primitive {
-    /// Triangle vertices (unused for quadrics).
-    pub p: [Vec3; 3],
-    /// Shape.
-    pub kind: PrimKind,
-    /// Material index.
-    pub material: u32,
-    /// Area light index or `NO_LIGHT`.
-    pub light: u32,
-}
 
 /// Which acceleration structure [`Geometry`] builds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -94,14 +55,16 @@ pub struct Geometry {
     /// Wall time of the BVH build.
     pub build_time: Duration,
     /// Vector instruction set of the packet queries, detected once here rather than per query.
-    pub(super) isa: Isa,
+    cpu: Cpu,
+    /// Some mesh has an alpha cut-out (its triangles are tested through [`Self::other_t`]).
+    has_alpha: bool,
 }
 
 impl Geometry {
     /// The vector instruction set detected when this geometry was built (what its packet
     /// queries, and the integrator's lane kernels, run on).
     pub fn isa(&self) -> Isa {
-        self.isa
+        self.cpu.isa()
     }
 
     /// Build the default BVH over `prims` (reordered internally so the BVH's leaf order is the
@@ -124,6 +87,21 @@ impl Geometry {
             bounds.0 = bounds.0.min(*lo);
             bounds.1 = bounds.1.max(*hi);
         }
+        // Triangles of cut-out meshes are tested by `other_t` (with their alpha test), not by
+        // the wide BVH's packet triangle tests.
+        let mut called_back: Vec<bool> = prims
+            .iter()
+            .map(|p| match p.kind {
+                PrimKind::Triangle { mesh, .. } => {
+                    meshes.get(mesh as usize).is_some_and(|m| m.alpha.is_some())
+                }
+                PrimKind::Quadric(_) => false,
+            })
+            .collect();
+        let has_alpha = called_back.contains(&true);
+        if !has_alpha {
+            called_back.clear();
+        }
         let (order, accel): (Vec<u32>, Accel) = if prims.is_empty() {
             (Vec::new(), Accel::None)
         } else {
@@ -132,12 +110,12 @@ impl Geometry {
                     // PLOC + reinsertion gives the better tree; the binned-SAH one is
                     // depth-limited, so it is the fallback for degenerate inputs.
                     let mut tree = Tree2::ploc(&boxes);
-                    let wide = match WideBvh::build(&tree, &prims) {
+                    let wide = match WideBvh::build(&tree, &prims, &called_back) {
                         Some(w) => w,
                         None => {
                             tree = Tree2::from_bvh(Bvh::build(&boxes));
                             // Never empty: the binned-SAH tree is at most 64 levels deep.
-                            WideBvh::build(&tree, &prims).unwrap_or_default()
+                            WideBvh::build(&tree, &prims, &called_back).unwrap_or_default()
                         }
                     };
                     (tree.order, Accel::Wide(wide))
@@ -177,7 +155,8 @@ impl Geometry {
             accel,
             bounds,
             build_time: start.elapsed(),
-            isa: Isa::detect(),
+            cpu: Cpu::detect(),
+            has_alpha,
         }
     }
 
@@ -235,31 +214,87 @@ impl Geometry {
     fn prim_hit(&self, id: usize, shear: &RayShear, o: Vec3, d: Vec3, t_max: f32) -> (f32, Bary) {
         let p = &self.prims[id];
         match p.kind {
+            PrimKind::Triangle { .. } if self.has_alpha => self
+                .alpha_triangle(id, o, d, t_max)
+                .unwrap_or((f32::INFINITY, NO_BARY)),
             PrimKind::Triangle { .. } => match shear.intersect(p.p[0], p.p[1], p.p[2], t_max) {
                 Some((t, b0, b1, b2)) => (t, [b0, b1, b2]),
                 None => (f32::INFINITY, NO_BARY),
             },
-            PrimKind::Quadric(_) => (self.quadric_t(id, o, d, t_max), NO_BARY),
+            PrimKind::Quadric(_) => (self.other_t(id, o, d, t_max), NO_BARY),
         }
     }
 
-    /// Hit distance of non-triangle primitive `id` below `t_max`, or +∞.
+    /// Hit distance below `t_max` (else +∞) of primitive `id` that the wide BVH does not test
+    /// itself: a quadric, or a triangle of a cut-out mesh (alpha-tested).
     #[inline(always)]
-    fn quadric_t(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+    fn other_t(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
         match self.prims[id].kind {
             PrimKind::Quadric(q) => self.quadrics[q as usize]
                 .intersect_t(o, d, t_max)
                 .unwrap_or(f32::INFINITY),
-            PrimKind::Triangle { .. } => f32::INFINITY,
+            PrimKind::Triangle { .. } => self
+                .alpha_triangle(id, o, d, t_max)
+                .map_or(f32::INFINITY, |(t, _)| t),
         }
     }
 
-    /// [`Self::quadric_t`] kept out of line for the wide traversal: inlined, the compiler
+    /// Triangle `id`'s hit below `t_max` (t, barycentrics) if its mesh's alpha mask keeps it
+    /// (any hit of a triangle without one).
+    #[inline(never)]
+    fn alpha_triangle(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> Option<(f32, Bary)> {
+        let p = &self.prims[id];
+        let PrimKind::Triangle { mesh, v } = p.kind else {
+            return None;
+        };
+        let (t, b0, b1, b2) = RayShear::new(o, d).intersect(p.p[0], p.p[1], p.p[2], t_max)?;
+        let b = [b0, b1, b2];
+        let m = &self.meshes[mesh as usize];
+        match &m.alpha {
+            None => Some((t, b)),
+            Some(a) => {
+                let key = ((mesh as u64) << 32 | v[0] as u64)
+                    ^ ((v[1] as u64) << 21 | (v[2] as u64) << 42);
+                a.keeps(mesh_uv(m, v, b), o, d, key).then_some((t, b))
+            }
+        }
+    }
+
+    /// Barycentrics of the accepted hit at `t` of primitive `id`, whose traversal reported
+    /// placeholders when it is a cut-out triangle (tested through [`Self::other_t`]): the same
+    /// triangle test again, hence the same values.
+    #[inline(always)]
+    fn final_bary(&self, id: usize, ray: &Ray, b: Bary) -> Bary {
+        if !self.has_alpha {
+            return b;
+        }
+        let p = &self.prims[id];
+        match p.kind {
+            PrimKind::Triangle { mesh, .. } if self.meshes[mesh as usize].alpha.is_some() => {
+                RayShear::new(ray.o, ray.d)
+                    .intersect(p.p[0], p.p[1], p.p[2], f32::INFINITY)
+                    .map_or(b, |(_, b0, b1, b2)| [b0, b1, b2])
+            }
+            _ => b,
+        }
+    }
+
+    /// True if a hit on primitive `id` needs [`Self::final_bary`] (packet queries redo those).
+    #[inline(always)]
+    pub(super) fn is_cut_out(&self, id: usize) -> bool {
+        self.has_alpha
+            && match self.prims[id].kind {
+                PrimKind::Triangle { mesh, .. } => self.meshes[mesh as usize].alpha.is_some(),
+                PrimKind::Quadric(_) => false,
+            }
+    }
+
+    /// [`Self::other_t`] kept out of line for the wide traversal: inlined, the compiler
     /// hoists its per-ray setup (splats of the ray) out of the traversal loop, which every ray
     /// pays for although triangle-only scenes never run it.
     #[inline(never)]
-    pub(super) fn quadric_t_outlined(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
-        self.quadric_t(id, o, d, t_max)
+    pub(super) fn other_t_outlined(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
+        self.other_t(id, o, d, t_max)
     }
 
     /// Hit distance of primitive `id` below `t_max`, or +∞ (any-hit queries).
@@ -303,13 +338,7 @@ impl Geometry {
                         ng
                     }
                 };
-                let uv = match &m.uvs {
-                    Some(uv) => {
-                        uv[v[0] as usize] * b0 + uv[v[1] as usize] * b1 + uv[v[2] as usize] * b2
-                    }
-                    // pbrt-v4's default parameterisation (0,0), (1,0), (1,1).
-                    None => Vec2::new(b1 + b2, b2),
-                };
+                let uv = mesh_uv(m, v, [b0, b1, b2]);
                 let err = barycentric_error([b0, b1, b2], verts);
                 SurfaceHit {
                     t,
@@ -341,222 +370,6 @@ impl Geometry {
     }
 }
 
-impl Geometry {
-    /// The hit records of the rays `lanes` of a packet query (`hits` finished), into `out`,
-    /// on backend `isa` (one this CPU runs): `out[i] = Some(self.surface_hit(..))` for each,
-    /// bit for bit, and its point, normals and error bound to lane i of `cols`.
-    pub(super) fn hit_records<R: PacketRays + ?Sized, C: ColumnSink>(
-        &self,
-        isa: Isa,
-        rays: &R,
-        hits: &PacketHits,
-        lanes: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-        cols: &mut C,
-    ) {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: callers pass a set this CPU runs (`Geometry::isa` or `Isa::supported`).
-            Isa::Avx512 => unsafe { self.hit_records_avx512(rays, hits, lanes, out, cols) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as above: the CPU runs AVX2.
-            Isa::Avx2 => unsafe { self.hit_records_avx2(rays, hits, lanes, out, cols) },
-            _ => self.hit_records_impl::<Portable, R, C>(rays, hits, lanes, out, cols),
-        }
-    }
-
-    /// [`Self::hit_records_impl`] on AVX-512.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512dq")]
-    fn hit_records_avx512<R: PacketRays + ?Sized, C: ColumnSink>(
-        &self,
-        rays: &R,
-        hits: &PacketHits,
-        lanes: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-        cols: &mut C,
-    ) {
-        self.hit_records_impl::<Avx512, R, C>(rays, hits, lanes, out, cols)
-    }
-
-    /// [`Self::hit_records_impl`] on AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn hit_records_avx2<R: PacketRays + ?Sized, C: ColumnSink>(
-        &self,
-        rays: &R,
-        hits: &PacketHits,
-        lanes: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-        cols: &mut C,
-    ) {
-        self.hit_records_impl::<Avx2, R, C>(rays, hits, lanes, out, cols)
-    }
-
-    /// Rays that hit the same triangle (most of a coherent packet) get their records on the
-    /// vector lanes at once; single rays and quadric hits go through [`Self::surface_hit`].
-    #[inline(always)]
-    fn hit_records_impl<S: Simd, R: PacketRays + ?Sized, C: ColumnSink>(
-        &self,
-        rays: &R,
-        hits: &PacketHits,
-        mut lanes: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-        cols: &mut C,
-    ) {
-        let ids = S::load(&hits.id);
-        while lanes != 0 {
-            let first = lanes.trailing_zeros() as usize & (PACKET - 1);
-            let group = S::bits(S::eq_bits(ids, S::splat(hits.id[first]))) & lanes;
-            lanes &= !group;
-            let id = hits.id[first].to_bits() as usize;
-            // SAFETY: as in `surface_hit`, ids reported by a traversal index `prims`.
-            let p = unsafe { self.prims.get_unchecked(id) };
-            match p.kind {
-                PrimKind::Triangle { mesh, v } if group & (group - 1) != 0 => {
-                    self.triangle_records::<S, C>(id, p, mesh, v, hits, group, out, cols);
-                }
-                _ => {
-                    for i in bits(group) {
-                        let (id, t, b) = hits.hit(i);
-                        let h = self.surface_hit(id, &rays.ray(i), t, b);
-                        cols.set_lane(i, &h);
-                        out[i] = Some(h);
-                    }
-                }
-            }
-        }
-    }
-
-    /// [`Self::surface_hit`]'s triangle branch for the rays `group`, which all hit triangle
-    /// `id` (= `p`, of mesh `mesh` with vertex indices `v`): each lane does that branch's f32
-    /// operations in its order (glam's `Vec3` arithmetic is per component), so the records
-    /// are the same bits.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
-    fn triangle_records<S: Simd, C: ColumnSink>(
-        &self,
-        id: usize,
-        p: &Primitive,
-        mesh: u32,
-        v: [u32; 3],
-        hits: &PacketHits,
-        group: u32,
-        out: &mut [Option<SurfaceHit>; PACKET],
-        cols: &mut C,
-    ) {
-        let sp = S::splat;
-        let zero = sp(0.0);
-        let b = [
-            S::load(&hits.b[0]),
-            S::load(&hits.b[1]),
-            S::load(&hits.b[2]),
-        ];
-        let verts = [p.p[0].to_array(), p.p[1].to_array(), p.p[2].to_array()];
-        // pos = v0·b0 + v1·b1 + v2·b2 and `barycentric_error`'s sum of |products|.
-        let mut pos = [zero; 3];
-        let mut err = [zero; 3];
-        for a in 0..3 {
-            let q = [
-                sp(verts[0][a]) * b[0],
-                sp(verts[1][a]) * b[1],
-                sp(verts[2][a]) * b[2],
-            ];
-            pos[a] = q[0] + q[1] + q[2];
-            err[a] = (S::abs(q[0]) + S::abs(q[1]) + S::abs(q[2])) * sp(POINT_ERROR_GAMMA);
-        }
-        // SAFETY: `tri_ng` has one entry per primitive, and `id` indexes `prims`.
-        let tri_ng = unsafe { *self.tri_ng.get_unchecked(id) }.to_array();
-        let m = &self.meshes[mesh as usize];
-        let (ng, ns) = match &m.normals {
-            Some(n) => {
-                let nv = [
-                    n[v[0] as usize].to_array(),
-                    n[v[1] as usize].to_array(),
-                    n[v[2] as usize].to_array(),
-                ];
-                let mut r = [zero; 3];
-                for a in 0..3 {
-                    r[a] = sp(nv[0][a]) * b[0] + sp(nv[1][a]) * b[1] + sp(nv[2][a]) * b[2];
-                }
-                // `unit_or_zero`: 0 < 1/|r| < ∞ is its integer test as float compares.
-                let rcp = S::div(sp(1.0), S::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
-                let valid = S::and(S::lt(zero, rcp), S::lt(rcp, sp(f32::INFINITY)));
-                let mut u = [zero; 3];
-                let mut g = [zero; 3];
-                for a in 0..3 {
-                    u[a] = S::select(valid, r[a] * rcp, zero);
-                    g[a] = sp(tri_ng[a]);
-                }
-                let is_zero = S::and(
-                    S::and(S::eq(u[0], zero), S::eq(u[1], zero)),
-                    S::eq(u[2], zero),
-                );
-                let d = g[0] * u[0] + g[1] * u[1] + g[2] * u[2];
-                let flip = S::andnot(S::lt(d, zero), is_zero);
-                let (mut ng, mut ns) = ([zero; 3], [zero; 3]);
-                for a in 0..3 {
-                    ng[a] = S::select(flip, sp(-tri_ng[a]), g[a]);
-                    ns[a] = S::select(is_zero, g[a], u[a]);
-                }
-                (ng, ns)
-            }
-            None => {
-                let n = if m.flip {
-                    [-tri_ng[0], -tri_ng[1], -tri_ng[2]]
-                } else {
-                    tri_ng
-                };
-                let g = [sp(n[0]), sp(n[1]), sp(n[2])];
-                (g, g)
-            }
-        };
-        let uv = match &m.uvs {
-            Some(uv) => {
-                let w = [
-                    uv[v[0] as usize].to_array(),
-                    uv[v[1] as usize].to_array(),
-                    uv[v[2] as usize].to_array(),
-                ];
-                let mut c = [zero; 2];
-                for a in 0..2 {
-                    c[a] = sp(w[0][a]) * b[0] + sp(w[1][a]) * b[1] + sp(w[2][a]) * b[2];
-                }
-                c
-            }
-            None => [b[1] + b[2], b[2]],
-        };
-        let p_error = err[0] * S::abs(ng[0]) + err[1] * S::abs(ng[1]) + err[2] * S::abs(ng[2]);
-        cols.set_group::<S>(group, &pos, &ng, &ns, p_error);
-        // The fields in `SurfaceHit`'s order, transposed to one row per ray.
-        let rows = S::transpose([
-            S::load(&hits.t),
-            pos[0],
-            pos[1],
-            pos[2],
-            ng[0],
-            ng[1],
-            ng[2],
-            ns[0],
-            ns[1],
-            ns[2],
-            uv[0],
-            uv[1],
-            p_error,
-            sp(f32::from_bits(id as u32)),
-            sp(f32::from_bits(p.material)),
-            sp(f32::from_bits(p.light)),
-        ]);
-        for i in 0..PACKET {
-            if group >> i & 1 != 0 {
-                let mut rec = [0.0f32; PACKET];
-                S::store(rows[i], &mut rec);
-                out[i] = Some(SurfaceHit::from_lanes(rec));
-            }
-        }
-    }
-}
-
 /// `v.normalize_or_zero()`, bit for bit (same length, reciprocal and product), but with the
 /// validity test 0 < 1/|v| < ∞ as one integer compare: the positive finite non-zero floats
 /// are exactly the bit patterns 1..=0x7f7f_ffff (zero wraps below, +∞, NaN and negative
@@ -571,22 +384,14 @@ fn unit_or_zero(v: Vec3) -> Vec3 {
     }
 }
 
-/// Unit geometric normal of triangle `p` (winding order), zero if degenerate.
-fn triangle_normal(p: [Vec3; 3]) -> Vec3 {
-    (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()
-}
-
-fn prim_bounds(p: &Primitive, quadrics: &[Quadric]) -> (Vec3, Vec3) {
-    match p.kind {
-        PrimKind::Triangle { .. } => {
-            let [a, b, c] = p.p;
-            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-            // Axis-aligned triangles have flat boxes, which slab tests may reject for rays that
-            // do hit them: pad by a relative epsilon.
-            let pad = (hi - lo).max_element() * 1e-6 + lo.abs().max(hi.abs()).max_element() * 1e-7;
-            (lo - pad, hi + pad)
-        }
-        PrimKind::Quadric(q) => quadrics[q as usize].bounds(),
+/// Texture coordinates of mesh `m`'s triangle `v` at barycentrics `b`.
+#[inline(always)]
+fn mesh_uv(m: &MeshShading, v: [u32; 3], b: Bary) -> Vec2 {
+    let [b0, b1, b2] = b;
+    match &m.uvs {
+        Some(uv) => uv[v[0] as usize] * b0 + uv[v[1] as usize] * b1 + uv[v[2] as usize] * b2,
+        // pbrt-v4's default parameterisation (0,0), (1,0), (1,1).
+        None => Vec2::new(b1 + b2, b2),
     }
 }
 
@@ -640,7 +445,7 @@ impl Geometry {
         match &self.accel {
             Accel::None => false,
             Accel::Wide(bvh) => bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.quadric_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
+                self.other_t(id, ray.o, ray.d, ray.t_max) < ray.t_max
             }),
             Accel::Own(bvh) => {
                 let shear = shear();
@@ -664,11 +469,11 @@ impl Geometry {
         let (id, t, b) = match &self.accel {
             // The wide BVH tests triangles itself; only quadrics come back here.
             Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                self.quadric_t_outlined(id, ray.o, ray.d, t_max)
+                self.other_t_outlined(id, ray.o, ray.d, t_max)
             })?,
             _ => self.closest_by_callback(ray)?,
         };
-        Some(self.surface_hit(id, ray, t, b))
+        Some(self.surface_hit(id, ray, t, self.final_bary(id, ray, b)))
     }
 }
 
@@ -688,7 +493,7 @@ impl RayQuery for Geometry {
         // four into a jump table that every shadow ray pays for).
         if let Accel::Wide(bvh) = &self.accel {
             return bvh.any(ray.o, ray.d, ray.t_max, |id| {
-                self.quadric_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
+                self.other_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max
             });
         }
         self.occluded_other(ray)

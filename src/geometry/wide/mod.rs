@@ -1,0 +1,56 @@
+//! A 4-wide BVH: a binary BVH ([`Tree2`](super::tree2::Tree2): obvhs's PLOC tree or
+//! penumbra's binned-SAH one) collapsed so that each node holds up to four children whose
+//! boxes are tested together (SoA, one `Vec4` per box plane), and leaves are runs of
+//! [`TriPacket`]s whose four triangles are tested together
+//! ([`RayShear4`](super::tri4::RayShear4)).
+//!
+//! [`build`] makes it, [`ray`] traces one ray through it, [`packet`] sixteen at once.
+
+mod build;
+mod packet;
+mod ray;
+
+pub(super) use packet::PacketHits;
+
+use super::tri4::TriPacket;
+use glam::{Vec3, Vec4};
+
+/// Child-reference flag: the low bits are the first packet of a leaf, not a node index.
+const LEAF: u32 = 1 << 31;
+/// Deepest binary tree that is collapsed (deeper ones are rejected by [`WideBvh::build`]).
+const MAX_TREE_DEPTH: usize = 96;
+/// Traversal stack depth: each wide level consumes at least one binary level, and a node
+/// pushes at most three children.
+const STACK: usize = 3 * MAX_TREE_DEPTH + 1;
+
+/// Triangle barycentrics (b0, b1, b2) of a hit (unused for other primitives).
+pub type Bary = [f32; 3];
+
+/// One node: `b[0][axis]` / `b[1][axis]` hold the lower / upper box plane of the four children.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+struct Node4 {
+    /// Box planes: `b[side][axis]` lane c = that plane of child c.
+    b: [[Vec4; 3]; 2],
+    /// Node index, or `LEAF | first packet` (unused slots have inverted boxes and are never
+    /// followed).
+    child: [u32; 4],
+}
+
+/// The 4-wide BVH (see the module docs). Primitive ids are leaf-order indices of the BVH2.
+#[derive(Clone, Debug, Default)]
+pub struct WideBvh {
+    nodes: Vec<Node4>,
+    packets: Vec<TriPacket>,
+    /// Set when the whole tree is one leaf (the emitter-only geometry of most scenes): its
+    /// box (the root's lane 0) and leaf reference, for [`WideBvh::closest`]'s fast path.
+    single_leaf: Option<SingleLeaf>,
+}
+
+/// The box and leaf reference of a tree that is a single leaf.
+#[derive(Clone, Copy, Debug)]
+struct SingleLeaf {
+    lo: Vec3,
+    hi: Vec3,
+    child: u32,
+}
