@@ -131,24 +131,27 @@ def _chunk_workers():
 
 
 def test_killed_worker_chunk_is_retried_and_the_image_is_exact(cluster, scene):
-    spp, chunks = 256, 8
-    killed = []
+    # Chunks of 128 spp at 64x48: long enough (a few tenths of a second) to be caught mid-run.
+    spp, chunks = 1024, 8
+    killed, done = [], threading.Event()
 
     def killer():
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and not killed:
+        while not done.is_set() and not killed:
             pids = _chunk_workers()
             if pids:
-                time.sleep(0.1)  # mid-chunk, not at its first instruction
+                time.sleep(0.05)  # mid-chunk, not at its first instruction
                 if pids[0] in _chunk_workers():  # still rendering a chunk
                     os.kill(pids[0], signal.SIGKILL)
                     killed.append(pids[0])
-            time.sleep(0.02)
+            time.sleep(0.01)
 
     t = threading.Thread(target=killer)
     t.start()
-    parts = distributed.render_parts("cornell", spp, chunks, res=RES, seed=11, max_retries=2)
-    t.join()
+    try:
+        parts = distributed.render_parts("cornell", spp, chunks, res=RES, seed=11, max_retries=2)
+    finally:
+        done.set()
+        t.join()
     assert killed, "no render chunk was seen running: nothing was killed"
     assert not pathlib.Path(f"/proc/{killed[0]}").exists()
     assert [p.range for p in parts] == distributed.chunk_ranges(spp, chunks)
