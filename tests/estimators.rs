@@ -12,7 +12,7 @@ use penumbra::geometry::{Ray, Transform};
 use penumbra::integrator::MisHeuristic;
 use penumbra::integrator::Strategy;
 use penumbra::integrator::stages::Integrator;
-use penumbra::light_selection::make_selector;
+use penumbra::light_selection::{SelectorKind, make_selector};
 use penumbra::lights::{Light, UniformInfiniteLight};
 use penumbra::material::{Material, Texture};
 use penumbra::sampling::{PatternKind, make_pattern};
@@ -58,7 +58,7 @@ fn scene(add: impl FnOnce(&mut SceneBuilder)) -> Scene {
 /// Mean and standard error of the radiance toward a ray hitting the plane at the origin,
 /// over `pixels` independent sample sets of `spp` eye samples × `m` light samples.
 fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> (f64, f64) {
-    let selector = make_selector("uniform", scene, 7).unwrap();
+    let selector = make_selector(SelectorKind::Uniform, scene, 7);
     let pattern = make_pattern(pattern, 7);
     let spp = 16;
     let est = Integrator {

@@ -921,3 +921,86 @@ fn warnings_carry_at_most_one_warning_marker() {
         l.warnings
     );
 }
+
+/// A 1×1 PNG of code values (200, 128, 230).
+fn normal_png() -> Vec<u8> {
+    let img = image::RgbImage::from_pixel(1, 1, image::Rgb([200, 128, 230]));
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png)
+        .expect("encode png");
+    out.into_inner()
+}
+
+#[test]
+fn gltf_normal_texture_is_linear_scaled_and_follows_the_uv_handedness() {
+    use penumbra::material::{Material, NormalPerturbation};
+    let d = scratch("gltf-normal");
+    write(&d, "t.bin", &triangle_bin([0, 1, 2]));
+    // One image as both base colour (sRGB-decoded) and normal texture (linear).
+    let json = gltf_json(r#"{"byteLength": 44, "uri": "t.bin"}"#)
+        .replace(
+            r#""metallicFactor": 0}"#,
+            r#""metallicFactor": 0, "baseColorTexture": {"index": 0}}, "normalTexture": {"index": 0, "scale": 0.5}"#,
+        )
+        .replace(
+            r#""buffers":"#,
+            &format!(
+                r#""textures": [{{"source": 0}}], "images": [{{"uri": "data:image/png;base64,{}"}}], "buffers":"#,
+                base64(&normal_png())
+            ),
+        );
+    let p = write(&d, "s.gltf", json.as_bytes());
+    let loaded = load_gltf(&p, &LoadOptions::default()).expect("load");
+    let v = match &loaded.scene.materials[0] {
+        Material::Varying(v) => v,
+        m => panic!("expected a normal-mapped material, got {m:?}"),
+    };
+    match &v.base {
+        Material::Diffuse { reflectance } => {
+            let c = reflectance.eval(Vec2::splat(0.5)) / Vec3::new(0.2, 0.4, 0.6);
+            let want = Vec3::new(200.0, 128.0, 230.0)
+                .map(|x| penumbra::image::io::srgb_to_linear(x / 255.0));
+            assert!((c - want).abs().max_element() < 1e-4, "{c} vs {want}");
+        }
+        m => panic!("{m:?}"),
+    }
+    let n = v.normal.as_ref().expect("normal map");
+    match n {
+        NormalPerturbation::NormalMap {
+            image,
+            scale,
+            uv_handed,
+        } => {
+            assert_eq!(*scale, 0.5);
+            assert!(*uv_handed);
+            let want = Vec3::new(200.0, 128.0, 230.0) / 255.0;
+            assert!(
+                (image.pixels[0] - want).abs().max_element() < 1e-6,
+                "{}",
+                image.pixels[0]
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // Tangent-space (2c − 1)·(scale, scale, 1), normalised, in the frame (∂p/∂u, ±n × ∂p/∂u, n).
+    let t = (Vec3::new(200.0, 128.0, 230.0) / 255.0 * 2.0 - Vec3::ONE) * Vec3::new(0.5, 0.5, 1.0);
+    let t = t.normalize();
+    let uv = Vec2::splat(0.5);
+    let right = n.shading_normal(uv, Vec3::Z, Vec3::Z, Vec3::X, Vec3::Y);
+    assert!((right - t).abs().max_element() < 1e-5, "{right} vs {t}");
+    // Mirrored uvs (∂p/∂v = −y): the bitangent, and so the map's green, flips.
+    let mirrored = n.shading_normal(uv, Vec3::Z, Vec3::Z, Vec3::X, -Vec3::Y);
+    let tm = Vec3::new(t.x, -t.y, t.z);
+    assert!(
+        (mirrored - tm).abs().max_element() < 1e-5,
+        "{mirrored} vs {tm}"
+    );
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("normalTexture tangents")),
+        "{:?}",
+        loaded.warnings
+    );
+}

@@ -9,7 +9,7 @@ use penumbra::image::Image;
 use penumbra::integrator::{RenderOptions, render};
 use penumbra::light_selection::bvh::BvhSelector;
 use penumbra::light_selection::{
-    ExhaustiveSelector, FiniteSelector, LightSelector, SELECTORS, ShadingPoint, make_selector,
+    ExhaustiveSelector, FiniteSelector, LightSelector, SelectorKind, ShadingPoint, make_selector,
 };
 use penumbra::lights::{
     Light, LightBounds, LightSource, PointLight, QuadLight, SpotLight, TriangleLight,
@@ -165,17 +165,19 @@ fn shading_points(n: usize, seed: u64) -> Vec<ShadingPoint> {
 }
 
 fn selectors(scene: &Scene) -> Vec<Box<dyn LightSelector>> {
-    SELECTORS
+    SelectorKind::ALL
         .iter()
-        .map(|name| make_selector(name, scene, 1).unwrap())
+        .map(|&kind| make_selector(kind, scene, 1))
         .collect()
 }
 
 #[test]
 fn unknown_selector_is_an_error() {
-    let scene = test_scene();
-    let err = make_selector("nope", &scene, 0).err().expect("must fail");
-    assert!(err.to_string().contains("bvh"), "{err}");
+    let err = "nope".parse::<SelectorKind>().expect_err("must fail");
+    assert!(err.contains("nope") && err.contains("bvh"), "{err}");
+    for kind in SelectorKind::ALL {
+        assert_eq!(kind.name().parse::<SelectorKind>(), Ok(kind));
+    }
 }
 
 /// The pmf sums to 1 over all lights — except for the light BVH, which (like pbrt-v4's) can
@@ -404,18 +406,23 @@ fn mean_and_variance(a: &Image, b: &Image) -> (f64, f64) {
 fn renders_agree_with_uniform_within_noise() {
     let scene = test_scene();
     let res = UVec2::new(48, 36);
-    let run = |name: &str, seed: u64| {
+    let run = |kind: SelectorKind, seed: u64| {
         let opts = RenderOptions {
             // Uniform selection has heavy-tailed noise here: give it more samples.
-            spp: if name == "uniform" { 48 } else { 16 },
+            spp: if kind == SelectorKind::Uniform {
+                48
+            } else {
+                16
+            },
             seed,
-            light_selection: name.into(),
+            light_selection: kind,
             ..RenderOptions::default()
         };
         render(&scene, res, &opts).unwrap().0
     };
-    let (mu, vu) = mean_and_variance(&run("uniform", 1), &run("uniform", 2));
-    for name in SELECTORS.iter().filter(|&&n| n != "uniform") {
+    let uniform = SelectorKind::Uniform;
+    let (mu, vu) = mean_and_variance(&run(uniform, 1), &run(uniform, 2));
+    for name in SelectorKind::ALL.into_iter().filter(|&k| k != uniform) {
         let (m, v) = mean_and_variance(&run(name, 3), &run(name, 4));
         let sigma = (v + vu).sqrt();
         eprintln!(

@@ -10,15 +10,21 @@ use penumbra::integrator::film::filter_sample;
 use penumbra::integrator::queues::CameraPacket;
 use penumbra::integrator::stages::{Integrator, Queues};
 use penumbra::integrator::{MisHeuristic, Strategy};
-use penumbra::light_selection::make_selector;
+use penumbra::light_selection::{SelectorKind, make_selector};
 use penumbra::lights::SamplingMode;
 use penumbra::sampling::{PatternKind, PixelSamples, make_pattern};
 use penumbra::scene::Scene;
 use penumbra::scene::load::{LoadOptions, load};
 
 /// Checks every lane; returns (lanes checked, lanes with light).
-fn check(scene: &Scene, strategy: Strategy, selection: &str, spp: u32, m: u32) -> (u32, u32) {
-    let selector = make_selector(selection, scene, 3).unwrap();
+fn check(
+    scene: &Scene,
+    strategy: Strategy,
+    selection: SelectorKind,
+    spp: u32,
+    m: u32,
+) -> (u32, u32) {
+    let selector = make_selector(selection, scene, 3);
     let pattern = make_pattern(PatternKind::Stratified, 3);
     let est = Integrator {
         scene,
@@ -100,8 +106,8 @@ fn packet_lanes_equal_single_samples_on_cornell_and_phong() {
         let scene = builtin(name);
         let mut n = (0, 0);
         for s in Strategy::ALL {
-            n = add(n, check(&scene, s, "uniform", 16, 1));
-            n = add(n, check(&scene, s, "uniform", 3, 2));
+            n = add(n, check(&scene, s, SelectorKind::Uniform, 16, 1));
+            n = add(n, check(&scene, s, SelectorKind::Uniform, 3, 2));
         }
         assert_lit(n);
     }
@@ -112,8 +118,8 @@ fn packet_lanes_equal_single_samples_with_many_lights() {
     let scene = builtin("many-mesh");
     let mut n = (0, 0);
     for s in [Strategy::Mis, Strategy::Bsdf] {
-        n = add(n, check(&scene, s, "power", 5, 1));
-        n = add(n, check(&scene, s, "bvh", 16, 2));
+        n = add(n, check(&scene, s, SelectorKind::Power, 5, 1));
+        n = add(n, check(&scene, s, SelectorKind::Bvh, 16, 2));
     }
     assert_lit(n);
 }

@@ -275,7 +275,7 @@ fn integrator_directive_maps_to_path_with_its_depth_and_light_sampler() {
     let spec = s.integrator.clone().unwrap();
     assert_eq!(spec.kind, IntegratorKind::Path);
     assert_eq!(spec.max_depth, 7);
-    assert_eq!(spec.light_selection.as_deref(), Some("power"));
+    assert_eq!(spec.light_selection.map(|k| k.name()), Some("power"));
     assert!(
         s.warnings.iter().any(|w| w.contains("regularize")),
         "{:?}",
@@ -301,7 +301,10 @@ fn integrator_directive_maps_to_path_with_its_depth_and_light_sampler() {
         let s = parse(&format!(
             r#"Integrator "path" "string lightsampler" "{name}""#
         ));
-        assert_eq!(s.integrator.unwrap().light_selection.as_deref(), Some(want));
+        assert_eq!(
+            s.integrator.unwrap().light_selection.map(|k| k.name()),
+            Some(want)
+        );
     }
 }
 

@@ -87,12 +87,13 @@ fn cornell_box_bitterli_parses() {
 }
 
 #[test]
-fn defaults_film_1280x720_fov_90_box_filter() {
+fn defaults_film_1280x720_fov_90_gaussian_filter() {
     let s = parse("WorldBegin");
     assert_eq!(s.film.resolution, glam::UVec2::new(1280, 720));
     assert_eq!(s.camera.fov_deg, 90.0);
     assert_eq!(s.film.spp, None);
-    assert!(matches!(s.film.filter, Filter::Box { .. }));
+    // pbrt-v4's default filter.
+    assert!(matches!(s.film.filter, Filter::Gaussian { sigma: 0.5, .. }));
     assert!(s.shapes.is_empty() && s.materials.is_empty());
 }
 
@@ -353,19 +354,18 @@ WorldBegin"#,
             .iter()
             .any(|w| w.contains("\"volpath\" rendered by penumbra's path tracer"))
     );
-    assert!(
-        s.warnings
-            .iter()
-            .any(|w| w.starts_with("t.pbrt:6:") && w.contains("lensradius"))
-    );
+    // The thin lens is rendered: no warning about it.
+    assert!(!s.warnings.iter().any(|w| w.contains("lensradius")));
+    assert_eq!(s.camera.lens.radius, 0.1);
     let s = parse("PixelFilter \"gaussian\"\nWorldBegin");
     assert_eq!(
         s.film.filter,
-        Filter::Triangle {
-            radius: Vec2::splat(1.5)
+        Filter::Gaussian {
+            radius: Vec2::splat(1.5),
+            sigma: 0.5
         }
     );
-    assert!(s.warnings.iter().any(|w| w.contains("gaussian")));
+    assert!(!s.warnings.iter().any(|w| w.contains("gaussian")));
 }
 
 #[test]
@@ -529,7 +529,8 @@ Material "conductor" "texture roughness" "r"
         TextureDesc::Image {
             path: d.join("wood.png"),
             scale: Rgb::splat(0.5),
-            invert: false
+            invert: false,
+            encoding: penumbra::scene::pbrt::textures::Encoding::SRgb,
         }
     );
     assert!(
@@ -641,10 +642,13 @@ LightSource "goniometric"
         LightDesc::EnvMap {
             path,
             scale,
+            layout,
             light_to_world,
         } => {
             assert_eq!(path, &d.join("sky.exr"));
             assert_eq!(*scale, 2.0);
+            // 8×4 is not square: read as lat-long, with a warning.
+            assert_eq!(*layout, penumbra::lights::envmap::EnvLayout::LatLong);
             assert!(close(
                 light_to_world.point(Vec3::ZERO),
                 Vec3::new(0.0, 5.0, 0.0)

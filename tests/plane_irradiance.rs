@@ -20,7 +20,7 @@ use penumbra::geometry::{Backend, PACKET, PrimKind, Ray, RayQuery, SurfaceHit, T
 use penumbra::integrator::queues::CameraPacket;
 use penumbra::integrator::stages::{Integrator, Queues};
 use penumbra::integrator::{MisHeuristic, Strategy};
-use penumbra::light_selection::make_selector;
+use penumbra::light_selection::{SelectorKind, make_selector};
 use penumbra::lights::{
     DistantLight, Light, PointLight, SamplingMode, SpotLight, UniformInfiniteLight,
 };
@@ -609,7 +609,7 @@ const ROUNDS: u32 = 72;
 /// Measured samples of one case and configuration: (estimate, exact) pairs.
 fn measure(b: &Built, c: &Case, cfg: &Config, seed: u64) -> Vec<(f64, f64)> {
     let scene = &b.scene;
-    let selector = make_selector("uniform", scene, seed).unwrap();
+    let selector = make_selector(SelectorKind::Uniform, scene, seed);
     let pattern = make_pattern(PatternKind::Random, seed);
     let est = Integrator {
         scene,

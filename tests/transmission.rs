@@ -17,7 +17,7 @@ use penumbra::camera::Camera;
 use penumbra::geometry::{Ray, Transform};
 use penumbra::integrator::stages::Integrator;
 use penumbra::integrator::{MisHeuristic, Strategy};
-use penumbra::light_selection::make_selector;
+use penumbra::light_selection::{SelectorKind, make_selector};
 use penumbra::lights::{Light, UniformInfiniteLight};
 use penumbra::material::Material;
 use penumbra::sampling::{Frame, PatternKind, make_pattern};
@@ -80,8 +80,14 @@ fn sphere_light(b: &mut SceneBuilder, c: Vec3, r: f32, le: f32) {
 
 /// Mean and standard error of the radiance along `ray` over `pixels` independent sample sets
 /// of 16 eye samples × `m` light/BSDF samples.
-fn estimate(scene: &Scene, strategy: Strategy, selector: &str, ray: &Ray, m: u32) -> (f64, f64) {
-    let selector = make_selector(selector, scene, 7).unwrap();
+fn estimate(
+    scene: &Scene,
+    strategy: Strategy,
+    selector: SelectorKind,
+    ray: &Ray,
+    m: u32,
+) -> (f64, f64) {
+    let selector = make_selector(selector, scene, 7);
     let pattern = make_pattern(PatternKind::Stratified, 7);
     let spp = 16;
     let est = Integrator {
@@ -122,11 +128,17 @@ fn check_all(what: &str, scene: &Scene, ray: &Ray, exact: f64) {
         .into_iter()
         .map(|s| {
             let m = if s == Strategy::Bsdf { 4 } else { 1 };
-            (s.to_string(), estimate(scene, s, "uniform", ray, m))
+            (
+                s.to_string(),
+                estimate(scene, s, SelectorKind::Uniform, ray, m),
+            )
         })
         .collect();
     for s in [Strategy::LightSolidAngle, Strategy::Mis] {
-        runs.push((format!("{s}+bvh"), estimate(scene, s, "bvh", ray, 1)));
+        runs.push((
+            format!("{s}+bvh"),
+            estimate(scene, s, SelectorKind::Bvh, ray, 1),
+        ));
     }
     let mut ok = true;
     for (name, (mean, se)) in &runs {
@@ -301,7 +313,7 @@ fn rough_glass_with_tilted_shading_normals_every_strategy_agrees() {
     let ray = ray_to(Vec3::new(1.0, 0.5, 0.0), Vec3::new(1.0, -2.5, 1.2));
     let runs: Vec<(Strategy, (f64, f64))> = Strategy::ALL
         .into_iter()
-        .map(|st| (st, estimate(&s, st, "uniform", &ray, 2)))
+        .map(|st| (st, estimate(&s, st, SelectorKind::Uniform, &ray, 2)))
         .collect();
     for (st, (m, se)) in &runs {
         eprintln!("tilted shading normals {st}: {m:.6} ± {se:.2e}");

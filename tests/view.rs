@@ -173,7 +173,7 @@ fn endpoints_answer_and_bad_requests_are_400_with_a_reason() {
             "POST",
             "/api/render",
             r#"{"channel":"a","light_selection":"x"}"#,
-            "unknown light_selection 'x'",
+            "unknown light selection 'x'",
         ),
         (
             "POST",

@@ -117,17 +117,7 @@ impl Bxdf for CoatedDiffuse {
                     delta: true,
                 });
             }
-            let wi = self.sampling.sample_hemisphere(u);
-            let pdf = self.pdf(wo, wi);
-            if pdf <= 0.0 {
-                return None;
-            }
-            return Some(BsdfSample {
-                wi,
-                f: self.f(wo, wi),
-                pdf,
-                delta: false,
-            });
+            return super::reflection_sample(self, wo, self.sampling.sample_hemisphere(u));
         }
         if self.sampling != LobeSampling::Importance {
             return super::sample_by_hemisphere(self, self.sampling, wo, u);
@@ -138,19 +128,7 @@ impl Bxdf for CoatedDiffuse {
         } else {
             cosine_hemisphere(u)
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 || !pdf.is_finite() {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.f(wo, wi),
-            pdf,
-            delta: false,
-        })
+        super::reflection_sample(self, wo, wi)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {

@@ -87,19 +87,7 @@ impl Bxdf for Conductor {
         let wi = reflect(wo, wm);
         // Visible normals can still reflect below the horizon (multiple scattering is ignored):
         // those samples have zero weight.
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = Self::pdf_rough(&d, wo, wi);
-        if pdf <= 0.0 || !pdf.is_finite() {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.f(wo, wi),
-            pdf,
-            delta: false,
-        })
+        super::reflection_sample(self, wo, wi)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {

@@ -187,6 +187,27 @@ fn sample_by_hemisphere(
     })
 }
 
+/// The sample at `wi` of a reflection lobe drawn by the BSDF's own importance sampler: `None`
+/// below the horizon (a glossy lobe around the mirror direction pokes under it, and such
+/// directions carry zero weight) or where the pdf is 0 or not finite; else f and pdf at `wi`.
+/// The common tail of the samplers of phong, conductor and coated diffuse.
+#[inline]
+fn reflection_sample(bsdf: &impl Bxdf, wo: Vec3, wi: Vec3) -> Option<BsdfSample> {
+    if wi.z <= 0.0 {
+        return None;
+    }
+    let pdf = bsdf.pdf(wo, wi);
+    if pdf <= 0.0 || !pdf.is_finite() {
+        return None;
+    }
+    Some(BsdfSample {
+        wi,
+        f: bsdf.f(wo, wi),
+        pdf,
+        delta: false,
+    })
+}
+
 /// Closed set of BSDFs (enum dispatch keeps the per-sample path free of virtual calls).
 #[derive(Clone, Debug)]
 pub enum Bsdf {
@@ -277,11 +298,10 @@ impl Bxdf for Bsdf {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         dispatch!(self, b => b.pdf(wo, wi))
     }
-    /// One dispatch for both: one call instead of two saves a call and a match per light
-    /// sample.
+    /// [`Bsdf::f_pdf`]: one dispatch for both.
     #[inline]
     fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        dispatch!(self, b => (b.f(wo, wi), b.pdf(wo, wi)))
+        Bsdf::f_pdf(self, wo, wi)
     }
     #[inline]
     fn is_delta(&self) -> bool {

@@ -114,21 +114,8 @@ impl Bxdf for Phong {
         } else {
             Frame::from_normal(reflect_z(wo)).to_world(cosine_power_hemisphere(u, self.n))
         };
-        // The glossy lobe around the mirror direction pokes below the horizon: such samples
-        // carry zero weight (the lecture's C_digon point), so they are dropped.
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            f: self.f(wo, wi),
-            pdf,
-            delta: false,
-        })
+        // Below the horizon the glossy lobe has zero weight (the lecture's C_digon point).
+        super::reflection_sample(self, wo, wi)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {

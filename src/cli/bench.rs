@@ -6,7 +6,7 @@ use anyhow::Context;
 use glam::UVec2;
 use penumbra::image::{compare, read_image, write_image};
 use penumbra::integrator::{RenderOptions, Strategy, render};
-use penumbra::light_selection::{LightSet, SELECTORS, bvh::BvhSelector, make_selector};
+use penumbra::light_selection::{LightSet, SelectorKind, bvh::BvhSelector, make_selector};
 use penumbra::scene::builtin::{self, BuiltinOptions};
 use penumbra::scene::load::{LoadOptions, load};
 use std::path::PathBuf;
@@ -29,7 +29,7 @@ pub struct Args {
     pub many_lights: bool,
     /// With --many-lights: only these strategies (comma separated); default all.
     #[arg(long, value_delimiter = ',')]
-    pub selectors: Vec<String>,
+    pub selectors: Vec<SelectorKind>,
     /// With --many-lights: reference spp = this × --spp.
     #[arg(long, default_value_t = 32)]
     pub reference_factor: u32,
@@ -134,11 +134,11 @@ fn bvh_section(names: &[String]) -> anyhow::Result<()> {
 const MANY: &[&str] = &["many-open", "many-rooms", "many-mesh"];
 
 /// The strategy the reference of `scene` is rendered with (the best one there, at high spp).
-fn reference_selector(scene: &str) -> &'static str {
+fn reference_selector(scene: &str) -> SelectorKind {
     if scene == "many-rooms" {
-        "adaptive"
+        SelectorKind::Adaptive
     } else {
-        "bvh"
+        SelectorKind::Bvh
     }
 }
 
@@ -174,8 +174,8 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
     } else {
         args.scenes.clone()
     };
-    let selectors: Vec<String> = if args.selectors.is_empty() {
-        SELECTORS.iter().map(|s| s.to_string()).collect()
+    let selectors: Vec<SelectorKind> = if args.selectors.is_empty() {
+        SelectorKind::ALL.to_vec()
     } else {
         args.selectors.clone()
     };
@@ -208,7 +208,7 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
                 let opts = RenderOptions {
                     spp: spp * args.reference_factor,
                     seed: 0x05ee_d4ef,
-                    light_selection: ref_sel.into(),
+                    light_selection: ref_sel,
                     ..RenderOptions::default()
                 };
                 let (img, _) = render(&scene, res, &opts)?;
@@ -217,27 +217,27 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
             }
         };
         let mut rows = Vec::new();
-        for sel in &selectors {
-            if sel == "exhaustive" && n > args.max_exhaustive_lights {
-                rows.push((sel.clone(), None));
+        for &sel in &selectors {
+            if sel == SelectorKind::Exhaustive && n > args.max_exhaustive_lights {
+                rows.push((sel, None));
                 continue;
             }
             let t0 = Instant::now();
-            make_selector(sel, &scene, 0)?;
+            make_selector(sel, &scene, 0);
             let build = t0.elapsed().as_secs_f64();
             let opts = RenderOptions {
                 spp,
-                light_selection: sel.clone(),
+                light_selection: sel,
                 ..RenderOptions::default()
             };
             let (img, stats) = render(&scene, res, &opts)?;
             let rel = compare(&img, &reference)?.rel_mse;
-            rows.push((sel.clone(), Some((build, stats.time.as_secs_f64(), rel))));
+            rows.push((sel, Some((build, stats.time.as_secs_f64(), rel))));
         }
         let eff = |b: f64, t: f64, r: f64| 1.0 / (r * (b + t)).max(1e-300);
         let power = rows
             .iter()
-            .find(|(s, _)| s == "power")
+            .find(|(s, _)| *s == SelectorKind::Power)
             .and_then(|(_, r)| *r)
             .map(|(b, t, r)| eff(b, t, r));
         for (sel, r) in rows {

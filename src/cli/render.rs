@@ -3,6 +3,7 @@
 use anyhow::Context;
 use glam::UVec2;
 use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy, render};
+use penumbra::light_selection::SelectorKind;
 use penumbra::sampling::PatternKind;
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
@@ -66,10 +67,11 @@ pub struct Args {
     /// Sample pattern: fixed, random, grid, stratified, lhs or sobol.
     #[arg(long, default_value = "stratified")]
     pub pattern: PatternKind,
-    /// Light selection strategy (at every path vertex). Default: the scene file's
-    /// `lightsampler`, else uniform.
+    /// Light selection at every path vertex: uniform, power, spatial, adaptive, wald, bvh or
+    /// exhaustive. Default: the scene file's `lightsampler`, else bvh (the most efficient on
+    /// average over the built-in scenes, docs/many-lights.md).
     #[arg(long)]
-    pub light_selection: Option<String>,
+    pub light_selection: Option<SelectorKind>,
     /// Light sampling technique inside `mis`: solid-angle (default) or area.
     #[arg(long, default_value = "solid-angle", value_parser = parse_mode)]
     pub mis_light: penumbra::lights::SamplingMode,
@@ -255,9 +257,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         pattern: args.pattern,
         light_selection: args
             .light_selection
-            .clone()
-            .or_else(|| file.and_then(|i| i.light_selection.clone()))
-            .unwrap_or_else(|| "uniform".into()),
+            .or_else(|| file.and_then(|i| i.light_selection))
+            .unwrap_or(SelectorKind::DEFAULT),
         bsdf_sampling: args.bsdf_sampling,
         mis_light: args.mis_light,
         // The flags override the file's `Integrator`; without either, direct lighting.

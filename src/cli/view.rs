@@ -30,7 +30,7 @@ use penumbra::image::colormap::viridis;
 use penumbra::image::io::{encode_png, read_image, srgb_to_linear, to_rgb8};
 use penumbra::image::metrics::{compare, error_image};
 use penumbra::integrator::{MisHeuristic, RenderOptions, Strategy};
-use penumbra::light_selection::{SELECTORS, ShadingPoint, make_selector};
+use penumbra::light_selection::{SelectorKind, ShadingPoint, make_selector};
 use penumbra::progressive::{Accumulator, PassPolicy, render_passes};
 use penumbra::sampling::PatternKind;
 use penumbra::scene::Scene;
@@ -71,7 +71,7 @@ pub struct Args {
 #[derive(Clone, Debug, PartialEq)]
 struct Settings {
     strategy: Strategy,
-    light_selection: String,
+    light_selection: SelectorKind,
     pattern: PatternKind,
     mis: MisHeuristic,
     bsdf_sampling: LobeSampling,
@@ -84,7 +84,7 @@ impl Settings {
     fn to_json(&self) -> serde_json::Value {
         json!({
             "strategy": self.strategy.name(),
-            "light_selection": self.light_selection,
+            "light_selection": self.light_selection.name(),
             "pattern": self.pattern.name(),
             "mis": match self.mis { MisHeuristic::Power => "power", MisHeuristic::Balance => "balance" },
             "bsdf_sampling": lobe_name(self.bsdf_sampling),
@@ -100,13 +100,7 @@ impl Settings {
             self.strategy = s.parse()?;
         }
         if let Some(s) = &body.light_selection {
-            if !SELECTORS.contains(&s.as_str()) {
-                return Err(format!(
-                    "unknown light_selection '{s}' (expected one of: {})",
-                    SELECTORS.join(", ")
-                ));
-            }
-            self.light_selection = s.clone();
+            self.light_selection = s.parse()?;
         }
         if let Some(s) = &body.pattern {
             self.pattern = s
@@ -216,18 +210,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     );
     anyhow::ensure!(r.spp != Some(0), "--spp must be at least 1");
     anyhow::ensure!(r.threads != Some(0), "--threads must be at least 1");
-    // `render`'s default (a scene file's lightsampler, else uniform), uniform in the viewer.
-    let light_selection = r.light_selection.clone().unwrap_or_else(|| "uniform".into());
-    penumbra::light_selection::SELECTORS
-        .contains(&light_selection.as_str())
-        .then_some(())
-        .with_context(|| {
-            format!(
-                "unknown light selection '{}' (expected one of: {})",
-                light_selection,
-                SELECTORS.join(", ")
-            )
-        })?;
+    // `render`'s default: a scene file's lightsampler, else the default selector.
+    let light_selection = r.light_selection.unwrap_or(SelectorKind::DEFAULT);
     let loaded = load(&r.scene, &load_options(r))?;
     for w in &loaded.warnings {
         eprintln!("{}", messages::format_warning(w));
@@ -337,7 +321,7 @@ fn restart(shared: &Arc<Shared>, ch: usize) {
             strategy: s.strategy,
             mis: s.mis,
             pattern: s.pattern,
-            light_selection: s.light_selection.clone(),
+            light_selection: s.light_selection,
             bsdf_sampling: s.bsdf_sampling,
             ..RenderOptions::default()
         };
@@ -567,7 +551,7 @@ fn state(shared: &Shared) -> serde_json::Value {
         "channels": { "a": ch(&chans[0]), "b": ch(&chans[1]) },
         "choices": {
             "strategy": Strategy::ALL.iter().map(|s| s.name()).collect::<Vec<_>>(),
-            "light_selection": SELECTORS,
+            "light_selection": SelectorKind::ALL.iter().map(|k| k.name()).collect::<Vec<_>>(),
             "pattern": PatternKind::ALL.iter().map(|p| p.name()).collect::<Vec<_>>(),
             "mis": ["power", "balance"],
             "bsdf_sampling": ["importance", "cosine", "uniform"],
@@ -670,7 +654,7 @@ fn pixel(shared: &Shared, q: &[(String, String)]) -> Result<serde_json::Value, S
         "x": x, "y": y,
         "value": value.map(|v| [v.x, v.y, v.z]),
         "samples": count,
-        "light_selection": settings.light_selection,
+        "light_selection": settings.light_selection.name(),
         "light_sampling": light_sampling,
         "hit": null,
         "lights": [],
@@ -692,8 +676,7 @@ fn pixel(shared: &Shared, q: &[(String, String)]) -> Result<serde_json::Value, S
         n: if transmits { glam::Vec3::ZERO } else { n },
         wo,
     };
-    let selector =
-        make_selector(&settings.light_selection, scene, shared.seed).map_err(|e| e.to_string())?;
+    let selector = make_selector(settings.light_selection, scene, shared.seed);
     let mut lights: Vec<serde_json::Value> = Vec::new();
     let mut total = 0.0f64;
     for (i, l) in scene.lights.iter().enumerate() {

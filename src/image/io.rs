@@ -21,7 +21,7 @@ pub const WRITE_EXTENSIONS: &[&str] = &["exr", "pfm", "png"];
 pub const READ_EXTENSIONS: &[&str] = &["exr", "pfm", "png", "tga", "jpg", "jpeg", "hdr"];
 
 /// Lower-cased extension of `path`, or "" when it has none.
-fn extension(path: &Path) -> String {
+pub fn extension(path: &Path) -> String {
     path.extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
@@ -415,6 +415,42 @@ pub fn read_image(path: &Path) -> anyhow::Result<Image> {
         _ => read_with_image_crate(path, true),
     };
     result.with_context(|| format!("reading {}", path.display()))
+}
+
+/// Whether the image file at `path` has colour (R, G, B) channels rather than one grey
+/// channel (with or without alpha): read from its header, without decoding it. The readers
+/// replicate a grey channel to RGB, which is right for textures and wrong for data such as
+/// normal maps, which pbrt-v4 refuses without all three.
+pub fn has_color_channels(path: &Path) -> anyhow::Result<bool> {
+    let inner = || -> anyhow::Result<bool> {
+        Ok(match extension(path).as_str() {
+            "exr" => {
+                let meta = exr::meta::MetaData::read_from_file(path, false)
+                    .map_err(|e| anyhow::anyhow!("{e}"))?;
+                let h = meta
+                    .headers
+                    .first()
+                    .ok_or_else(|| anyhow::anyhow!("no layers"))?;
+                ["R", "G", "B"]
+                    .iter()
+                    .all(|c| h.channels.list.iter().any(|ch| ch.name.to_string() == *c))
+            }
+            "pfm" => {
+                let mut magic = [0u8; 2];
+                std::io::Read::read_exact(&mut std::fs::File::open(path)?, &mut magic)?;
+                &magic == b"PF"
+            }
+            _ => {
+                use image::ImageDecoder;
+                image::ImageReader::open(path)?
+                    .with_guessed_format()?
+                    .into_decoder()?
+                    .color_type()
+                    .has_color()
+            }
+        })
+    };
+    inner().with_context(|| format!("reading {}", path.display()))
 }
 
 /// Why `path` cannot be opened as a file ("file not found", "a folder, not a file"), or

@@ -6,6 +6,11 @@
 /// Pattern dimension of the pixel-filter sample (index: the eye sample, count N).
 pub const DIM_FILTER: u32 = 0;
 
+/// Pattern dimension of the thin-lens sample (index: the eye sample, count N). The last
+/// dimension, beyond those of any path vertex, so that adding it changed no other decision's
+/// numbers (pinhole images are bit-identical to before); read only by cameras with a lens.
+pub const DIM_LENS: u32 = u32::MAX;
+
 /// Dimensions each path vertex takes, after [`DIM_FILTER`].
 pub const DIMS_PER_VERTEX: u32 = 5;
 

@@ -18,6 +18,7 @@ pub mod stages;
 pub use render::{RenderStats, render};
 
 use crate::bsdf::LobeSampling;
+use crate::light_selection::SelectorKind;
 use crate::sampling::{PatternKind, balance_heuristic, power_heuristic};
 use std::fmt;
 use std::ops::Range;
@@ -163,8 +164,8 @@ pub struct RenderOptions {
     pub mis: MisHeuristic,
     /// Sample pattern for every dimension.
     pub pattern: PatternKind,
-    /// Light selection strategy name (see `light_selection`).
-    pub light_selection: String,
+    /// Light selection strategy (see `light_selection`).
+    pub light_selection: SelectorKind,
     /// How `mis` samples lights: by solid angle where supported (default) or by area.
     pub mis_light: crate::lights::SamplingMode,
     /// How BSDF lobes are sampled (the lecture's I₂ variants; importance by default).
@@ -232,7 +233,7 @@ impl Default for RenderOptions {
             strategy: Strategy::Mis,
             mis: MisHeuristic::Power,
             pattern: PatternKind::Stratified,
-            light_selection: "uniform".into(),
+            light_selection: SelectorKind::DEFAULT,
             bsdf_sampling: LobeSampling::Importance,
             mis_light: crate::lights::SamplingMode::SolidAngle,
             integrator: IntegratorKind::Direct,

@@ -3,8 +3,8 @@
 //! image is bit-identical for any thread count and schedule.
 
 use super::RenderOptions;
-use super::dims::DIM_FILTER;
-use super::film::filter_sample;
+use super::dims::{DIM_FILTER, DIM_LENS};
+use super::film::{FilterSampler, filter_sample};
 use super::queues::CameraPacket;
 use super::stages::{Integrator, Queues};
 use crate::Rgb;
@@ -57,7 +57,7 @@ pub fn render(
     );
     anyhow::ensure!(opts.spp > 0, "--spp must be at least 1");
     let samples = opts.samples()?;
-    let selector = make_selector(&opts.light_selection, scene, opts.seed)?;
+    let selector = make_selector(opts.light_selection, scene, opts.seed);
     let pattern = make_pattern(opts.pattern, opts.seed);
     let est = Integrator {
         scene,
@@ -73,6 +73,7 @@ pub fn render(
         roulette: opts.roulette,
     };
     let camera = scene.camera.rays(res);
+    let filter = FilterSampler::new(&scene.film.filter)?;
     let isa = Isa::detect();
     let tiles_x = res.x.div_ceil(TILE);
     let tiles_y = res.y.div_ceil(TILE);
@@ -116,19 +117,27 @@ pub fn render(
                 let mut radiance = [Rgb::ZERO; PACKET];
                 let mut queues = Queues::new();
                 let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
-                let mut flush =
-                    |cam: &mut CameraPacket, pxs: &[PixelSamples], owner: &[usize; PACKET]| {
-                        tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut queues);
-                        for k in 0..cam.n {
-                            let l = radiance[k];
-                            if l.is_finite() {
-                                sums[owner[cam.pixel[k] as usize]] += l;
-                            } else {
-                                tile_bad += 1;
-                            }
+                let mut flush = |cam: &mut CameraPacket,
+                                 pxs: &[PixelSamples],
+                                 owner: &[usize; PACKET],
+                                 weight: &[f32; PACKET]| {
+                    tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut queues);
+                    for k in 0..cam.n {
+                        // Filters with negative lobes weight their samples (mean weight 1);
+                        // box, tent and gaussian samples all weigh exactly 1.
+                        let l = if filter.is_analytic() {
+                            radiance[k]
+                        } else {
+                            radiance[k] * weight[k]
+                        };
+                        if l.is_finite() {
+                            sums[owner[cam.pixel[k] as usize]] += l;
+                        } else {
+                            tile_bad += 1;
                         }
-                        cam.clear();
-                    };
+                    }
+                    cam.clear();
+                };
                 // Per lane: the pixel and filter draw; the camera rays of a full packet are then
                 // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
                 let mut lanes = CameraLanes::new();
@@ -146,19 +155,22 @@ pub fn render(
                             let k = cam.n;
                             lanes.pixel[k] = pixel;
                             lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
+                            if camera.needs_lens_sample() {
+                                lanes.lens[k] = pxs[slot].sample_2d(DIM_LENS, i, opts.spp);
+                            }
                             cam.pixel[k] = slot as u8;
                             cam.eye[k] = i;
                             cam.n = k + 1;
                             if cam.is_full() {
-                                lanes.rays(isa, &camera, &scene.film.filter, &mut cam.rays);
-                                flush(&mut cam, pxs, &owner);
+                                lanes.rays(isa, &camera, &filter, &mut cam.rays);
+                                flush(&mut cam, pxs, &owner, &lanes.weight);
                             }
                         }
                     }
                 }
                 if cam.n > 0 {
-                    lanes.rays(isa, &camera, &scene.film.filter, &mut cam.rays);
-                    flush(&mut cam, pxs, &owner);
+                    lanes.rays(isa, &camera, &filter, &mut cam.rays);
+                    flush(&mut cam, pxs, &owner, &lanes.weight);
                 }
                 let out: Vec<Rgb> = sums.iter().map(|&s| s / samples.len() as f32).collect();
                 rays.fetch_add(tile_rays, Ordering::Relaxed);
@@ -203,6 +215,10 @@ struct CameraLanes {
     pixel: [UVec2; PACKET],
     /// Per lane: the pixel-filter draw.
     u: [Vec2; PACKET],
+    /// Per lane: the lens draw (thin-lens cameras only).
+    lens: [Vec2; PACKET],
+    /// Per lane: the filter weight of the sample (1 unless the filter has negative lobes).
+    weight: [f32; PACKET],
 }
 
 impl CameraLanes {
@@ -210,14 +226,22 @@ impl CameraLanes {
         Self {
             pixel: [UVec2::ZERO; PACKET],
             u: [Vec2::splat(0.5); PACKET],
+            lens: [Vec2::splat(0.5); PACKET],
+            weight: [1.0; PACKET],
         }
     }
 
-    /// The camera ray of every lane into `ray` (lanes past the packet's end get rays too, of
-    /// stale samples, which nothing reads): [`filter_sample`] then [`CameraRays::direction`],
-    /// per lane exactly as the scalar [`CameraRays::generate`], on `isa`'s widest vectors.
+    /// The camera ray (and filter weight) of every lane into `ray` (lanes past the packet's
+    /// end get rays too, of stale samples, which nothing reads). A pinhole perspective camera
+    /// under a box or tent filter, the common case, runs [`filter_sample`] then
+    /// [`CameraRays::direction`] per lane exactly as the scalar [`CameraRays::generate`], on
+    /// `isa`'s widest vectors; other cameras and tabulated filters take one scalar loop.
     #[inline]
-    fn rays(&self, isa: Isa, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
+    fn rays(&mut self, isa: Isa, camera: &CameraRays, filter: &FilterSampler, ray: &mut RayPacket) {
+        if !(camera.is_pinhole() && filter.is_analytic()) {
+            return self.rays_general(camera, filter, ray);
+        }
+        let filter = filter.filter();
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `isa` comes from `Isa::detect`: this CPU runs AVX-512 F.
@@ -226,6 +250,15 @@ impl CameraLanes {
             // SAFETY: as above, this CPU runs AVX2.
             Isa::Avx2 => unsafe { self.rays_avx2(camera, filter, ray) },
             _ => self.rays_portable(camera, filter, ray),
+        }
+    }
+
+    /// Any camera and filter: [`FilterSampler::sample`] then [`CameraRays::generate_lens`].
+    fn rays_general(&mut self, camera: &CameraRays, filter: &FilterSampler, ray: &mut RayPacket) {
+        for k in 0..PACKET {
+            let (p, w) = filter.sample(self.pixel[k], self.u[k]);
+            self.weight[k] = w;
+            ray.set(k, &camera.generate_lens(p, self.lens[k]));
         }
     }
 
@@ -285,7 +318,8 @@ mod tests {
                         lanes.u[k] = pattern.sample_2d(lanes.pixel[k], 0, n, 1 << 20);
                     }
                     let mut out = RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]);
-                    lanes.rays(isa, &rays, &filter, &mut out);
+                    let sampler = FilterSampler::new(&filter).expect("box and tent sample");
+                    lanes.rays(isa, &rays, &sampler, &mut out);
                     for (k, r) in (0..PACKET).map(|k| (k, out.ray(k))) {
                         let want =
                             rays.generate(filter_sample(&filter, lanes.pixel[k], lanes.u[k]));

@@ -34,7 +34,9 @@ use crate::bsdf::{Bsdf, Bxdf, LaneBsdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::packet::bits;
 use crate::geometry::{PACKET, Ray, RayPacket, RayQuery, SurfaceHit};
-use crate::light_selection::{LightSelector, SelectedLight, ShadingPoint, UniformSelector};
+use crate::light_selection::{
+    LightSelector, SelectedLight, SelectorKind, ShadingPoint, UniformSelector,
+};
 use crate::lights::{Emitter, LaneLight, LightSampleContext, LightSource, SamplingMode};
 use crate::sampling::{Frame, PixelSamples, SamplePattern};
 use crate::scene::Scene;
@@ -326,27 +328,31 @@ impl<'a> Integrator<'a> {
     fn intersect(&self, rays: &RayPacket, q: &mut Queues) -> u64 {
         let active = q.paths.active;
         let geometry = &self.scene.geometry;
-        if q.paths.depth == 0 {
+        let counted = if q.paths.depth == 0 {
             geometry.intersect_packet_cols(rays, active, &mut q.hits, &mut q.rx.cols);
-            return u64::from(active.count_ones());
-        }
-        // Later vertices' rays are incoherent: one query per ray beats the packet's shared
-        // traversal there (callgrind, cornell path 64² 4 spp: 200.8M Ir against 216.2M). They
-        // were counted when their BSDF samples made them.
-        let cols = &mut q.rx.cols;
-        for k in bits(active) {
-            let hit = geometry.intersect(&rays.ray(k));
-            if let Some(h) = &hit {
-                for c in 0..3 {
-                    cols.p[c][k] = h.p[c];
-                    cols.ng[c][k] = h.ng[c];
-                    cols.ns[c][k] = h.ns[c];
+            u64::from(active.count_ones())
+        } else {
+            // Later vertices' rays are incoherent: one query per ray beats the packet's shared
+            // traversal there (callgrind, cornell path 64² 4 spp: 200.8M Ir against 216.2M).
+            // They were counted when their BSDF samples made them.
+            let cols = &mut q.rx.cols;
+            for k in bits(active) {
+                let hit = geometry.intersect(&rays.ray(k));
+                if let Some(h) = &hit {
+                    for c in 0..3 {
+                        cols.p[c][k] = h.p[c];
+                        cols.ng[c][k] = h.ng[c];
+                        cols.ns[c][k] = h.ns[c];
+                    }
+                    cols.p_error[k] = h.p_error;
                 }
-                cols.p_error[k] = h.p_error;
+                q.hits[k] = hit;
             }
-            q.hits[k] = hit;
-        }
-        0
+            0
+        };
+        // Normal and bump maps replace the shading normals before the frames are built.
+        crate::scene::shading_normals::perturb_hits(self.scene, &mut q.hits[..], &mut q.rx.cols);
+        counted
     }
 
     /// Stage *shade*: every hit's shading geometry (all lanes at once), then per lane the
@@ -389,7 +395,10 @@ impl<'a> Integrator<'a> {
         let scene = self.scene;
         q.tri_lanes.active = 0;
         q.lone_light = 0;
-        let uniform = self.selector.uniform_count();
+        // Uniform picks ignore the shading point: pick inline, without a ShadingPoint or a
+        // virtual call per sample.
+        let uniform =
+            (self.selector.kind() == SelectorKind::Uniform).then_some(scene.lights.len() as u32);
         for k in bits(q.shaded) {
             let u = q.drawn.light_select[k];
             let sel = match uniform {

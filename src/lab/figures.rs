@@ -6,6 +6,7 @@
 
 use crate::bsdf::LobeSampling;
 use crate::integrator::Strategy;
+use crate::light_selection::SelectorKind;
 use crate::sampling::PatternKind;
 
 /// Which scene a figure renders.
@@ -63,14 +64,14 @@ pub struct Panel {
     pub shadow_rays: u32,
     /// Sample pattern of every dimension.
     pub pattern: PatternKind,
-    /// Light selection strategy name.
-    pub light_selection: String,
+    /// Light selection strategy.
+    pub light_selection: SelectorKind,
     /// Lobe sampling of the BSDFs; `None` keeps each BSDF's default (importance sampling).
     pub lobe: Option<LobeChoice>,
 }
 
 impl Panel {
-    /// A light-selection-uniform, default-lobe panel.
+    /// A panel with the default light selection and lobe sampling.
     fn new(
         label: &str,
         strategy: Strategy,
@@ -84,7 +85,7 @@ impl Panel {
             spp,
             shadow_rays,
             pattern,
-            light_selection: "uniform".into(),
+            light_selection: SelectorKind::DEFAULT,
             lobe: None,
         }
     }
@@ -132,7 +133,14 @@ pub struct Figure {
 }
 
 /// Light selection strategies compared by figure 6, in the lecture's order.
-pub const LIGHT_SELECTIONS: [&str; 6] = ["uniform", "power", "spatial", "adaptive", "wald", "bvh"];
+pub const LIGHT_SELECTIONS: [SelectorKind; 6] = [
+    SelectorKind::Uniform,
+    SelectorKind::Power,
+    SelectorKind::Spatial,
+    SelectorKind::Adaptive,
+    SelectorKind::Wald,
+    SelectorKind::Bvh,
+];
 
 /// The lecture's figures 1–6.
 pub fn lecture_figures() -> Vec<Figure> {
@@ -151,8 +159,8 @@ pub fn lecture_figures() -> Vec<Figure> {
     let lights = LIGHT_SELECTIONS
         .iter()
         .map(|&s| {
-            let mut p = Panel::new(s, LightSolidAngle, 4, 4, Stratified);
-            p.light_selection = s.to_string();
+            let mut p = Panel::new(s.name(), LightSolidAngle, 4, 4, Stratified);
+            p.light_selection = s;
             p
         })
         .collect();

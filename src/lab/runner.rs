@@ -9,6 +9,7 @@ use super::report::{
 };
 use crate::image::{Image, compare, error_image, read_image, save_png_atomic, write_image};
 use crate::integrator::{MisHeuristic, RenderOptions, Strategy, render};
+use crate::light_selection::SelectorKind;
 use crate::sampling::PatternKind;
 use crate::scene::Scene;
 use crate::scene::builtin::BUILTINS;
@@ -98,10 +99,7 @@ fn figure_scene_name(fig: &Figure, main: &str) -> Result<String, String> {
     }
 }
 
-/// Light selections tried, in order, for the reference of a scene with many lights: the first
-/// this build knows is used (uniform selection would leave a many-light reference noisy).
-const REFERENCE_SELECTIONS: [&str; 3] = ["bvh", "power", "uniform"];
-/// Scenes with more lights than this get a reference with [`REFERENCE_SELECTIONS`].
+/// Scenes with more lights than this get references at fewer spp.
 const MANY_LIGHTS: usize = 4;
 /// Many-light references use this fraction of `--reference-spp`: their per-sample cost is
 /// several times Cornell's, and a good selector converges fast enough that the reference
@@ -126,7 +124,7 @@ fn panel_options(panel: &Panel, seed: u64) -> RenderOptions {
         strategy: panel.strategy,
         mis: MisHeuristic::Power,
         pattern: panel.pattern,
-        light_selection: panel.light_selection.clone(),
+        light_selection: panel.light_selection,
         bsdf_sampling: panel.lobe.map(LobeChoice::sampling).unwrap_or_default(),
         ..RenderOptions::default()
     }
@@ -349,17 +347,7 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
             progress.start(&format!("{} {} {}", fig.id, panel.label, panel.counts()));
             let rendered = render(&prep.scene, res, &panel_options(panel, opts.seed));
             progress.done(units);
-            let (img, stats) = match rendered {
-                Ok(r) => r,
-                // Selectors arrive with the many-light work; until then say so and go on.
-                Err(e) if panel.light_selection != "uniform" => {
-                    let why = format!("light selection '{}': {e:#}", panel.light_selection);
-                    notes.push(format!("{} {}: skipped: {why}", fig.id, panel.label));
-                    result.skipped.push(format!("{}: {why}", panel.label));
-                    continue;
-                }
-                Err(e) => return Err(e),
-            };
+            let (img, stats) = rendered?;
             let err = compare(&img, &prep.reference)?;
             let stem = format!("{}-{}", fig.id, panel.slug());
             let files = write_outputs(&opts.out, &stem, &img, &prep.reference)?;
@@ -368,7 +356,7 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
                 label: panel.label.clone(),
                 strategy: panel.strategy.name().to_string(),
                 pattern: panel.pattern.name().to_string(),
-                light_selection: panel.light_selection.clone(),
+                light_selection: panel.light_selection.name().to_string(),
                 lobe: panel.lobe.map(|l| l.name().to_string()),
                 spp: panel.spp,
                 shadow_rays: panel.shadow_rays,
@@ -414,7 +402,7 @@ pub fn run_lab(opts: &LabOptions) -> anyhow::Result<LabResults> {
                     strategy,
                     mis: MisHeuristic::Power,
                     pattern: PatternKind::Stratified,
-                    light_selection: "uniform".into(),
+                    light_selection: SelectorKind::DEFAULT,
                     ..RenderOptions::default()
                 };
                 let (img, stats) = render(&prep.scene, res, &o)?;
@@ -482,6 +470,13 @@ fn cached_reference(
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
         .unwrap_or_default();
+    // Many lights: the light BVH (uniform would leave the reference noisy); a few: uniform,
+    // the cheapest, whose error there equals the others'.
+    let selection = if scene.lights.len() > MANY_LIGHTS {
+        SelectorKind::Bvh
+    } else {
+        SelectorKind::Uniform
+    };
     let mut info = ReferenceInfo {
         scene: name.to_string(),
         source: "cache".into(),
@@ -489,7 +484,7 @@ fn cached_reference(
         spp: Some(spp),
         time_s: 0.0,
         smooth_fraction: 0.0,
-        light_selection: "uniform".into(),
+        light_selection: selection.name().to_string(),
     };
     if path.exists() {
         // A damaged or mis-sized cache is re-rendered rather than trusted.
@@ -501,37 +496,17 @@ fn cached_reference(
             return Ok((img, info));
         }
     }
-    let selections: &[&str] = if scene.lights.len() > MANY_LIGHTS {
-        &REFERENCE_SELECTIONS
-    } else {
-        &["uniform"]
+    let o = RenderOptions {
+        spp,
+        shadow_rays: 1,
+        seed: opts.seed.wrapping_add(REFERENCE_SEED_OFFSET),
+        strategy: Strategy::Mis,
+        mis: MisHeuristic::Power,
+        pattern: PatternKind::Stratified,
+        light_selection: selection,
+        ..RenderOptions::default()
     };
-    let mut rendered = None;
-    for (i, &sel) in selections.iter().enumerate() {
-        let o = RenderOptions {
-            spp,
-            shadow_rays: 1,
-            seed: opts.seed.wrapping_add(REFERENCE_SEED_OFFSET),
-            strategy: Strategy::Mis,
-            mis: MisHeuristic::Power,
-            pattern: PatternKind::Stratified,
-            light_selection: sel.into(),
-            ..RenderOptions::default()
-        };
-        match render(scene, res, &o) {
-            Ok(r) => {
-                info.light_selection = sel.to_string();
-                rendered = Some(r);
-                break;
-            }
-            // An unknown selector fails before rendering; fall back to the next one.
-            Err(_) if i + 1 < selections.len() => continue,
-            Err(e) => return Err(e),
-        }
-    }
-    let Some((img, stats)) = rendered else {
-        anyhow::bail!("no light selection could render the reference of {name}");
-    };
+    let (img, stats) = render(scene, res, &o)?;
     progress.done(cost(res, spp, 1, Strategy::Mis));
     write_image(&img, &path, 0.0)?;
     write_image(&img, &path.with_extension("png"), 0.0)?;

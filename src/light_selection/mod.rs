@@ -17,6 +17,7 @@ pub mod bvh;
 pub mod estimate;
 pub mod exhaustive;
 pub mod importance;
+pub mod kind;
 pub mod power;
 pub mod spatial;
 pub mod uniform;
@@ -26,6 +27,7 @@ pub use adaptive::AdaptiveSelector;
 pub use bvh::BvhSelector;
 pub use exhaustive::ExhaustiveSelector;
 pub use importance::importance;
+pub use kind::SelectorKind;
 pub use power::PowerSelector;
 pub use spatial::SpatialSelector;
 pub use uniform::UniformSelector;
@@ -61,13 +63,11 @@ pub trait LightSelector: Send + Sync {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<SelectedLight>;
     /// Probability that `sample` picks `light` at `ctx`.
     fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32;
+    /// Which strategy this is.
+    fn kind(&self) -> SelectorKind;
     /// Name as accepted by `--light-selection`.
-    fn name(&self) -> &'static str;
-    /// `Some(n)` if this is [`UniformSelector`] over `n` lights, whose picks ignore the shading
-    /// point: the integrator then picks inline (same numbers) without building a
-    /// [`ShadingPoint`] or making a virtual call per sample.
-    fn uniform_count(&self) -> Option<u32> {
-        None
+    fn name(&self) -> &'static str {
+        self.kind().name()
     }
 }
 
@@ -144,15 +144,15 @@ fn sanitize(mut b: LightBounds) -> LightBounds {
 /// A [`FiniteSelector`] plus the fixed share of the unbounded lights: what `make_selector`
 /// returns for every strategy but `uniform`.
 pub struct Selector {
-    name: &'static str,
+    kind: SelectorKind,
     set: LightSet,
     finite: Box<dyn FiniteSelector>,
 }
 
 impl Selector {
-    /// Wrap `finite`, which selects among `set.finite`.
-    pub fn new(name: &'static str, set: LightSet, finite: Box<dyn FiniteSelector>) -> Self {
-        Self { name, set, finite }
+    /// Wrap `finite`, a `kind` strategy that selects among `set.finite`.
+    pub fn new(kind: SelectorKind, set: LightSet, finite: Box<dyn FiniteSelector>) -> Self {
+        Self { kind, set, finite }
     }
 
     /// The inner strategy (for tests and benchmarks).
@@ -199,58 +199,44 @@ impl LightSelector for Selector {
         }
     }
 
-    fn name(&self) -> &'static str {
-        self.name
+    fn kind(&self) -> SelectorKind {
+        self.kind
     }
 }
 
 /// Largest f32 below 1: keeps rescaled sample numbers in [0, 1).
 pub const ONE_MINUS_EPS: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// Every name `make_selector` accepts.
-pub const SELECTORS: &[&str] = &[
-    "uniform",
-    "power",
-    "spatial",
-    "adaptive",
-    "wald",
-    "bvh",
-    "exhaustive",
-];
-
-/// The selector named `name` (as accepted by `--light-selection`) for `scene`. `seed` feeds
-/// the estimation passes of `wald` and `adaptive` (the others are deterministic without it).
+/// The `kind` selector for `scene`. `seed` feeds the estimation passes of `wald` and
+/// `adaptive` (the others are deterministic without it).
 pub fn make_selector(
-    name: &str,
+    kind: SelectorKind,
     scene: &crate::scene::Scene,
     seed: u64,
-) -> anyhow::Result<Box<dyn LightSelector>> {
-    if name == "uniform" {
-        return Ok(Box::new(UniformSelector {
-            count: scene.lights.len() as u32,
-        }));
-    }
-    let set = LightSet::new(&scene.lights);
-    let finite: Box<dyn FiniteSelector> = match name {
-        "power" => Box::new(PowerSelector::new(&set.bounds)),
-        "exhaustive" => Box::new(ExhaustiveSelector::new(&set.bounds)),
-        "bvh" => Box::new(BvhSelector::new(&set.bounds)),
-        "wald" => Box::new(WaldSelector::new(scene, &set, &wald::WaldConfig::new(seed))),
-        "spatial" => Box::new(SpatialSelector::new(scene, &set)),
-        "adaptive" => Box::new(AdaptiveSelector::new(
-            scene,
-            &set,
-            &adaptive::AdaptiveConfig::new(seed),
-        )),
-        other => anyhow::bail!(
-            "unknown light selection '{other}' (expected one of: {})",
-            SELECTORS.join(", ")
-        ),
+) -> Box<dyn LightSelector> {
+    // Every strategy but uniform selects among the finite lights, wrapped by `Selector`.
+    let wrap = |build: &dyn Fn(&LightSet) -> Box<dyn FiniteSelector>| -> Box<dyn LightSelector> {
+        let set = LightSet::new(&scene.lights);
+        let finite = build(&set);
+        Box::new(Selector::new(kind, set, finite))
     };
-    let name = SELECTORS
-        .iter()
-        .copied()
-        .find(|&n| n == name)
-        .unwrap_or("?");
-    Ok(Box::new(Selector::new(name, set, finite)))
+    match kind {
+        SelectorKind::Uniform => Box::new(UniformSelector {
+            count: scene.lights.len() as u32,
+        }),
+        SelectorKind::Power => wrap(&|set| Box::new(PowerSelector::new(&set.bounds))),
+        SelectorKind::Exhaustive => wrap(&|set| Box::new(ExhaustiveSelector::new(&set.bounds))),
+        SelectorKind::Bvh => wrap(&|set| Box::new(BvhSelector::new(&set.bounds))),
+        SelectorKind::Wald => {
+            wrap(&|set| Box::new(WaldSelector::new(scene, set, &wald::WaldConfig::new(seed))))
+        }
+        SelectorKind::Spatial => wrap(&|set| Box::new(SpatialSelector::new(scene, set))),
+        SelectorKind::Adaptive => wrap(&|set| {
+            Box::new(AdaptiveSelector::new(
+                scene,
+                set,
+                &adaptive::AdaptiveConfig::new(seed),
+            ))
+        }),
+    }
 }

@@ -1,6 +1,6 @@
 //! Equal probability 1/N for every light.
 
-use super::{LightSelector, SelectedLight, ShadingPoint};
+use super::{LightSelector, SelectedLight, SelectorKind, ShadingPoint};
 
 /// Uniform light selection.
 #[derive(Clone, Copy, Debug)]
@@ -11,7 +11,8 @@ pub struct UniformSelector {
 
 impl UniformSelector {
     /// The pick of `u` among `count` lights (`None` without lights): the one definition both
-    /// [`LightSelector::sample`] and the integrator's inline fast path use.
+    /// [`LightSelector::sample`] and the integrator's inline fast path (taken when the
+    /// selector's kind is [`SelectorKind::Uniform`]) use.
     #[inline]
     pub fn pick(count: u32, u: f32) -> Option<SelectedLight> {
         if count == 0 {
@@ -38,11 +39,7 @@ impl LightSelector for UniformSelector {
         }
     }
 
-    fn name(&self) -> &'static str {
-        "uniform"
-    }
-
-    fn uniform_count(&self) -> Option<u32> {
-        Some(self.count)
+    fn kind(&self) -> SelectorKind {
+        SelectorKind::Uniform
     }
 }

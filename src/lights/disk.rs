@@ -5,9 +5,8 @@
 //! because `pdf_li` ignores the mode in the same way.
 
 use super::{
-    Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode,
-    area_sample, area_to_solid_angle, diffuse_power, is_positive, planar_radiance,
-    sees_emitting_side,
+    LightBounds, LightLiSample, LightSampleContext, LightSource, Planar, SamplingMode, area_sample,
+    diffuse_power, is_positive, sees_emitting_side,
 };
 use crate::Rgb;
 use crate::sampling::{Frame, concentric_disk};
@@ -50,12 +49,6 @@ impl DiskLight {
     pub fn area(&self) -> f32 {
         PI * self.radius * self.radius
     }
-
-    /// Whether a receiver at `p` can see the emitting side (none from the plane itself).
-    #[inline]
-    fn faces(&self, p: Vec3) -> bool {
-        sees_emitting_side(self.frame.n, self.center, self.two_sided, p)
-    }
 }
 
 impl LightSource for DiskLight {
@@ -97,22 +90,36 @@ impl LightSource for DiskLight {
     }
 }
 
-impl Emitter for DiskLight {
-    fn pdf_li(
-        &self,
-        ctx: &LightSampleContext,
-        _wi: Vec3,
-        p_light: Vec3,
-        _n_light: Vec3,
-        _mode: SamplingMode,
-    ) -> f32 {
-        if !self.faces(ctx.p) {
-            return 0.0;
-        }
-        area_to_solid_angle(1.0 / self.area(), ctx.p, p_light, self.frame.n)
+impl Planar for DiskLight {
+    #[inline]
+    fn normal(&self) -> Vec3 {
+        self.frame.n
     }
 
-    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        planar_radiance(self.frame.n, self.l, self.two_sided, w)
+    #[inline]
+    fn emitted(&self) -> Rgb {
+        self.l
+    }
+
+    #[inline]
+    fn is_two_sided(&self) -> bool {
+        self.two_sided
+    }
+
+    #[inline]
+    fn surface_area(&self) -> f32 {
+        self.area()
+    }
+
+    /// Whether a receiver at `p` can see the emitting side (none from the plane itself).
+    #[inline]
+    fn faces(&self, p: Vec3) -> bool {
+        sees_emitting_side(self.frame.n, self.center, self.two_sided, p)
+    }
+
+    /// Always area sampling (see the module comment), whatever the mode.
+    #[inline]
+    fn spherical_omega(&self, _p: Vec3, _mode: SamplingMode) -> Option<f32> {
+        None
     }
 }

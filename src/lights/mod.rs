@@ -340,36 +340,56 @@ pub(crate) fn sees_emitting_side(n: Vec3, origin: Vec3, two_sided: bool, p: Vec3
     if two_sided { s != 0.0 } else { s > 0.0 }
 }
 
-/// Radiance of a diffuse planar emitter with normal `n` seen along `w` (leaving the surface).
-#[inline]
-pub(crate) fn planar_radiance(n: Vec3, l: Rgb, two_sided: bool, w: Vec3) -> Rgb {
-    if two_sided || n.dot(w) > 0.0 {
-        l
-    } else {
-        Rgb::ZERO
-    }
+/// A flat diffuse emitter of constant radiance (triangle, quad, disk): what their one shared
+/// [`Emitter`] impl needs.
+pub(crate) trait Planar: LightSource {
+    /// Unit geometric normal on the emitting side.
+    fn normal(&self) -> Vec3;
+    /// Emitted radiance.
+    fn emitted(&self) -> Rgb;
+    /// Emits on both sides.
+    fn is_two_sided(&self) -> bool;
+    /// Surface area.
+    fn surface_area(&self) -> f32;
+    /// Whether a receiver at `p` sees the emitting side (one-sided emitters are dark from
+    /// behind; nothing is seen from the plane itself).
+    fn faces(&self, p: Vec3) -> bool;
+    /// Solid angle Ω that `sample_li` samples uniformly from `p` in `mode`, or `None` where it
+    /// samples by area. `sample_li` and `pdf_li` decide by this one rule and use this Ω, so
+    /// a sample and its pdf agree.
+    fn spherical_omega(&self, p: Vec3, mode: SamplingMode) -> Option<f32>;
 }
 
-/// Solid-angle pdf of a planar emitter (area `area`, unit normal `n`) sampling `p_light` from
-/// a receiver at `p`: 1/Ω where the shape's rule chose solid-angle sampling (`omega`), else
-/// the area pdf 1/A converted. Zero when the receiver does not `face` the emitting side, where
-/// `sample_li` never samples. The caller guarantees that the direction hits the emitter, so
-/// no inside test is needed.
-#[inline]
-pub(crate) fn planar_pdf_li(
-    faces: bool,
-    omega: impl FnOnce() -> Option<f32>,
-    area: f32,
-    p: Vec3,
-    p_light: Vec3,
-    n: Vec3,
-) -> f32 {
-    if !faces {
-        return 0.0;
+impl<T: Planar> Emitter for T {
+    /// 1/Ω where the shape's rule chose solid-angle sampling, else the area pdf 1/A converted;
+    /// zero where the receiver does not face the emitting side (`sample_li` never samples
+    /// there). The caller guarantees that the direction hits the emitter, so no inside test.
+    #[inline]
+    fn pdf_li(
+        &self,
+        ctx: &LightSampleContext,
+        _wi: Vec3,
+        p_light: Vec3,
+        _n_light: Vec3,
+        mode: SamplingMode,
+    ) -> f32 {
+        if !self.faces(ctx.p) {
+            return 0.0;
+        }
+        match self.spherical_omega(ctx.p, mode) {
+            Some(omega) => 1.0 / omega,
+            None => area_to_solid_angle(1.0 / self.surface_area(), ctx.p, p_light, self.normal()),
+        }
     }
-    match omega() {
-        Some(omega) => 1.0 / omega,
-        None => area_to_solid_angle(1.0 / area, p, p_light, n),
+
+    /// The constant radiance on the emitting side(s), zero behind a one-sided emitter.
+    #[inline]
+    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
+        if self.is_two_sided() || self.normal().dot(w) > 0.0 {
+            self.emitted()
+        } else {
+            Rgb::ZERO
+        }
     }
 }
 

@@ -3,9 +3,9 @@
 //! [`crate::sampling::SphericalRectangle`]) when the edges are perpendicular.
 
 use super::{
-    Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode,
-    area_sample, diffuse_power, is_positive, planar_pdf_li, planar_radiance, sees_emitting_side,
-    solid_angle_sample, spherical_ok, triangle_solid_angle,
+    LightBounds, LightLiSample, LightSampleContext, LightSource, Planar, SamplingMode, area_sample,
+    diffuse_power, is_positive, sees_emitting_side, solid_angle_sample, spherical_ok,
+    triangle_solid_angle,
 };
 use crate::Rgb;
 use crate::sampling::SphericalRectangle;
@@ -69,30 +69,6 @@ impl QuadLight {
             rectangular: (cos_edges.abs() as f64) <= SphericalRectangle::MAX_EDGE_COS,
         })
     }
-
-    /// Whether a receiver at `p` can see the emitting side (none from the plane itself).
-    #[inline]
-    fn faces(&self, p: Vec3) -> bool {
-        sees_emitting_side(self.n, self.corner, self.two_sided, p)
-    }
-
-    /// Solid angle Ω to sample uniformly from `p` in solid-angle mode (as two spherical
-    /// triangles: cheaper than setting up the rectangle sampler), or `None` where area sampling
-    /// is used instead: skewed parallelograms (the sampler needs right angles) and solid angles
-    /// outside [`spherical_ok`]. `sample_li` and `pdf_li` share this rule and this Ω.
-    fn spherical_omega(&self, p: Vec3, mode: SamplingMode) -> Option<f32> {
-        if mode != SamplingMode::SolidAngle || !self.rectangular {
-            return None;
-        }
-        let (c, c1, c2, c12) = (
-            self.corner,
-            self.corner + self.e1,
-            self.corner + self.e2,
-            self.corner + self.e1 + self.e2,
-        );
-        let omega = triangle_solid_angle(p, c, c1, c12) + triangle_solid_angle(p, c, c12, c2);
-        spherical_ok(omega).then_some(omega)
-    }
 }
 
 impl LightSource for QuadLight {
@@ -147,26 +123,48 @@ impl LightSource for QuadLight {
     }
 }
 
-impl Emitter for QuadLight {
-    fn pdf_li(
-        &self,
-        ctx: &LightSampleContext,
-        _wi: Vec3,
-        p_light: Vec3,
-        _n_light: Vec3,
-        mode: SamplingMode,
-    ) -> f32 {
-        planar_pdf_li(
-            self.faces(ctx.p),
-            || self.spherical_omega(ctx.p, mode),
-            self.area,
-            ctx.p,
-            p_light,
-            self.n,
-        )
+impl Planar for QuadLight {
+    #[inline]
+    fn normal(&self) -> Vec3 {
+        self.n
     }
 
-    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        planar_radiance(self.n, self.l, self.two_sided, w)
+    #[inline]
+    fn emitted(&self) -> Rgb {
+        self.l
+    }
+
+    #[inline]
+    fn is_two_sided(&self) -> bool {
+        self.two_sided
+    }
+
+    #[inline]
+    fn surface_area(&self) -> f32 {
+        self.area
+    }
+
+    /// Whether a receiver at `p` can see the emitting side (none from the plane itself).
+    #[inline]
+    fn faces(&self, p: Vec3) -> bool {
+        sees_emitting_side(self.n, self.corner, self.two_sided, p)
+    }
+
+    /// Solid angle Ω to sample uniformly from `p` in solid-angle mode (as two spherical
+    /// triangles: cheaper than setting up the rectangle sampler), or `None` where area sampling
+    /// is used instead: skewed parallelograms (the sampler needs right angles) and solid angles
+    /// outside [`spherical_ok`]. `sample_li` and `pdf_li` share this rule and this Ω.
+    fn spherical_omega(&self, p: Vec3, mode: SamplingMode) -> Option<f32> {
+        if mode != SamplingMode::SolidAngle || !self.rectangular {
+            return None;
+        }
+        let (c, c1, c2, c12) = (
+            self.corner,
+            self.corner + self.e1,
+            self.corner + self.e2,
+            self.corner + self.e1 + self.e2,
+        );
+        let omega = triangle_solid_angle(p, c, c1, c12) + triangle_solid_angle(p, c, c12, c2);
+        spherical_ok(omega).then_some(omega)
     }
 }

@@ -2,9 +2,9 @@
 //! (Arvo's spherical triangle, [`crate::sampling::SphericalTriangle`]).
 
 use super::{
-    Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode,
-    area_sample, diffuse_power, is_positive, planar_pdf_li, planar_radiance, sees_emitting_side,
-    solid_angle_sample, spherical_ok, triangle_solid_angle,
+    LightBounds, LightLiSample, LightSampleContext, LightSource, Planar, SamplingMode, area_sample,
+    diffuse_power, is_positive, sees_emitting_side, solid_angle_sample, spherical_ok,
+    triangle_solid_angle,
 };
 use crate::Rgb;
 use crate::sampling::{SphericalProjection, uniform_triangle_point};
@@ -39,24 +39,6 @@ impl TriangleLight {
             l,
             two_sided,
         })
-    }
-
-    /// Whether a receiver at `p` can see the emitting side at all (one-sided lights are dark
-    /// from behind; a receiver in the plane sees nothing).
-    #[inline]
-    fn faces(&self, p: Vec3) -> bool {
-        sees_emitting_side(self.n, self.p[0], self.two_sided, p)
-    }
-
-    /// Solid angle Ω to sample uniformly from `p` in solid-angle mode, or `None` where the rule
-    /// of [`spherical_ok`] says to sample by area. `sample_li` and `pdf_li` both decide through
-    /// this one function (and both use this Ω for the pdf), so the sample and its pdf agree.
-    fn spherical_omega(&self, p: Vec3, mode: SamplingMode) -> Option<f32> {
-        if mode != SamplingMode::SolidAngle {
-            return None;
-        }
-        let omega = triangle_solid_angle(p, self.p[0], self.p[1], self.p[2]);
-        spherical_ok(omega).then_some(omega)
     }
 }
 
@@ -119,26 +101,42 @@ impl LightSource for TriangleLight {
     }
 }
 
-impl Emitter for TriangleLight {
-    fn pdf_li(
-        &self,
-        ctx: &LightSampleContext,
-        _wi: Vec3,
-        p_light: Vec3,
-        _n_light: Vec3,
-        mode: SamplingMode,
-    ) -> f32 {
-        planar_pdf_li(
-            self.faces(ctx.p),
-            || self.spherical_omega(ctx.p, mode),
-            self.area,
-            ctx.p,
-            p_light,
-            self.n,
-        )
+impl Planar for TriangleLight {
+    #[inline]
+    fn normal(&self) -> Vec3 {
+        self.n
     }
 
-    fn radiance(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        planar_radiance(self.n, self.l, self.two_sided, w)
+    #[inline]
+    fn emitted(&self) -> Rgb {
+        self.l
+    }
+
+    #[inline]
+    fn is_two_sided(&self) -> bool {
+        self.two_sided
+    }
+
+    #[inline]
+    fn surface_area(&self) -> f32 {
+        self.area
+    }
+
+    /// Whether a receiver at `p` can see the emitting side at all (one-sided lights are dark
+    /// from behind; a receiver in the plane sees nothing).
+    #[inline]
+    fn faces(&self, p: Vec3) -> bool {
+        sees_emitting_side(self.n, self.p[0], self.two_sided, p)
+    }
+
+    /// Solid angle Ω to sample uniformly from `p` in solid-angle mode, or `None` where the rule
+    /// of [`spherical_ok`] says to sample by area. `sample_li` and `pdf_li` both decide through
+    /// this one function (and both use this Ω for the pdf), so the sample and its pdf agree.
+    fn spherical_omega(&self, p: Vec3, mode: SamplingMode) -> Option<f32> {
+        if mode != SamplingMode::SolidAngle {
+            return None;
+        }
+        let omega = triangle_solid_angle(p, self.p[0], self.p[1], self.p[2]);
+        spherical_ok(omega).then_some(omega)
     }
 }

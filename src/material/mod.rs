@@ -1,9 +1,13 @@
 //! Materials: what a surface is made of, turned into a [`Bsdf`] at each hit (textures resolved).
 //! The pbrt/OBJ/glTF loaders map onto exactly these variants.
 
+pub mod float_texture;
 pub mod texture;
+pub mod varying;
 
+pub use float_texture::FloatTexture;
 pub use texture::Texture;
+pub use varying::{AlphaOverride, NormalPerturbation, RoughnessTextures, VaryingMaterial};
 
 use crate::Rgb;
 use crate::bsdf::coated_conductor::{coated_conductor, layered_diffuse};
@@ -92,6 +96,8 @@ pub enum Material {
         /// Factor on both.
         scale: f32,
     },
+    /// A material whose roughness varies over the surface (float textures).
+    Varying(Box<VaryingMaterial>),
 }
 
 /// The Lambertian BSDF of a `diffuse` material (reflectance clamped to [0, 1]); inlined into the
@@ -121,6 +127,11 @@ impl Material {
     pub fn lambert(&self, hit: &SurfaceHit) -> Option<Lambert> {
         match self {
             Material::Diffuse { reflectance } => Some(diffuse(reflectance, hit)),
+            // Only the normal varies (the hit already carries it): still Lambertian, so the
+            // lane kernels shade it as they shade the plain material.
+            Material::Varying(v) if v.roughness.is_none() && v.coat_roughness.is_none() => {
+                v.base.lambert(hit)
+            }
             _ => None,
         }
     }
@@ -128,7 +139,19 @@ impl Material {
     /// [`Material::bsdf`] for every material (the out-of-line path).
     #[inline(never)]
     fn bsdf_general(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
+        self.bsdf_with(hit, front, AlphaOverride::default())
+    }
+
+    /// The BSDF at a hit with GGX widths `ov` replacing the material's constant ones.
+    fn bsdf_with(&self, hit: &SurfaceHit, front: bool, ov: AlphaOverride) -> Bsdf {
         match self {
+            Material::Varying(v) => {
+                let ov = AlphaOverride {
+                    alpha: v.roughness.as_ref().map(|r| r.alpha(hit.uv)),
+                    coat_alpha: v.coat_roughness.as_ref().map(|r| r.alpha(hit.uv)),
+                };
+                v.base.bsdf_with(hit, front, ov)
+            }
             Material::Diffuse { reflectance } => Bsdf::Lambert(diffuse(reflectance, hit)),
             Material::Phong { kd, ks, n } => Bsdf::Phong(Phong::clamped(kd.eval(hit.uv), *ks, *n)),
             Material::Conductor {
@@ -141,24 +164,29 @@ impl Material {
                     Some(r) => (Rgb::ONE, k_from_reflectance(r.eval(hit.uv))),
                     None => (*eta, *k),
                 };
-                Bsdf::Conductor(Conductor::new(eta, k, *alpha))
+                Bsdf::Conductor(Conductor::new(eta, k, ov.alpha.unwrap_or(*alpha)))
             }
             Material::CoatedDiffuse {
                 reflectance,
                 alpha,
                 eta,
                 layer,
-            } => match layer {
-                None => {
-                    Bsdf::CoatedDiffuse(CoatedDiffuse::new(reflectance.eval(hit.uv), *alpha, *eta))
+            } => {
+                let alpha = ov.alpha.unwrap_or(*alpha);
+                match layer {
+                    None => Bsdf::CoatedDiffuse(CoatedDiffuse::new(
+                        reflectance.eval(hit.uv),
+                        alpha,
+                        *eta,
+                    )),
+                    Some(p) => Bsdf::Layered(Box::new(layered_diffuse(
+                        reflectance.eval(hit.uv),
+                        *eta,
+                        alpha,
+                        *p,
+                    ))),
                 }
-                Some(p) => Bsdf::Layered(Box::new(layered_diffuse(
-                    reflectance.eval(hit.uv),
-                    *eta,
-                    *alpha,
-                    *p,
-                ))),
-            },
+            }
             Material::CoatedConductor {
                 coat_eta,
                 coat_alpha,
@@ -174,16 +202,16 @@ impl Material {
                 };
                 Bsdf::Layered(Box::new(coated_conductor(
                     *coat_eta,
-                    *coat_alpha,
+                    ov.coat_alpha.unwrap_or(*coat_alpha),
                     eta,
                     k,
-                    *alpha,
+                    ov.alpha.unwrap_or(*alpha),
                     *layer,
                 )))
             }
             Material::Dielectric { eta, alpha } => Bsdf::Dielectric(Dielectric {
                 eta: *eta,
-                alpha: *alpha,
+                alpha: ov.alpha.unwrap_or(*alpha),
                 entering: front,
             }),
             Material::Mirror => Bsdf::Mirror(Mirror { r: Rgb::ONE }),
@@ -198,9 +226,22 @@ impl Material {
         }
     }
 
+    /// The material's normal or bump map, if it has one.
+    #[inline]
+    pub fn normal_perturbation(&self) -> Option<&NormalPerturbation> {
+        match self {
+            Material::Varying(v) => v.normal.as_ref(),
+            _ => None,
+        }
+    }
+
     /// True if every BSDF of this material is a delta lobe (light sampling cannot help).
     pub fn is_delta_only(&self) -> bool {
         match self {
+            // A roughness texture may be zero in places and not in others.
+            Material::Varying(v) => {
+                v.roughness.is_none() && v.coat_roughness.is_none() && v.base.is_delta_only()
+            }
             Material::Mirror => true,
             Material::Conductor { alpha, .. } | Material::Dielectric { alpha, .. } => {
                 is_smooth(*alpha)

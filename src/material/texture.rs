@@ -1,5 +1,6 @@
 //! RGB textures over (u, v).
 
+use super::float_texture::FloatTexture;
 use crate::Rgb;
 use glam::Vec2;
 use std::sync::Arc;
@@ -13,6 +14,30 @@ pub struct ImageRgb {
     pub height: u32,
     /// Row-major pixels, top row first.
     pub pixels: Vec<Rgb>,
+}
+
+/// pbrt-v4's `UVMapping`: the texture is looked up at (su·u + du, sv·v + dv) (`uscale`,
+/// `vscale`, `udelta`, `vdelta`), so one image can tile a floor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvMap {
+    /// (uscale, vscale).
+    pub scale: Vec2,
+    /// (udelta, vdelta).
+    pub delta: Vec2,
+}
+
+impl UvMap {
+    /// The identity mapping.
+    pub const IDENTITY: UvMap = UvMap {
+        scale: Vec2::ONE,
+        delta: Vec2::ZERO,
+    };
+
+    /// Texture-space coordinates of surface coordinates `uv`.
+    #[inline]
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        uv * self.scale + self.delta
+    }
 }
 
 /// A colour that can vary over the surface.
@@ -36,6 +61,12 @@ pub enum Texture {
         /// Squares per unit uv (u, v).
         freq: Vec2,
     },
+    /// The product of two textures (pbrt's spectrum `scale` texture with a varying factor).
+    Product(Box<Texture>, Box<Texture>),
+    /// A scalar texture as a grey colour.
+    Float(FloatTexture),
+    /// A texture looked up through a uv mapping.
+    Mapped(UvMap, Box<Texture>),
 }
 
 impl Texture {
@@ -53,6 +84,9 @@ impl Texture {
                     *b
                 }
             }
+            Texture::Product(a, b) => a.eval(uv) * b.eval(uv),
+            Texture::Float(f) => Rgb::splat(f.eval(uv)),
+            Texture::Mapped(m, t) => t.eval(m.apply(uv)),
         }
     }
 }
@@ -74,9 +108,13 @@ impl ImageRgb {
             self.pixels[j * self.width as usize + i]
         };
         let (xi, yi) = (x0 as i64, y0 as i64);
-        at(xi, yi) * (1.0 - fx) * (1.0 - fy)
-            + at(xi + 1, yi) * fx * (1.0 - fy)
-            + at(xi, yi + 1) * (1.0 - fx) * fy
-            + at(xi + 1, yi + 1) * fx * fy
+        // Lerps rather than four weights: a region of equal texels returns exactly their
+        // value (the weights' products do not sum to exactly 1), so a flat normal map or a
+        // constant texture changes nothing.
+        let (a, b) = (at(xi, yi), at(xi + 1, yi));
+        let (c, d) = (at(xi, yi + 1), at(xi + 1, yi + 1));
+        let top = a + (b - a) * fx;
+        let bottom = c + (d - c) * fx;
+        top + (bottom - top) * fy
     }
 }

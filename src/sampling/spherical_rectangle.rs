@@ -5,6 +5,7 @@
 //! line, the conditional density in y is uniform in h = y/√(x² + y² + z²), which is inverted for
 //! y. The math runs in f64: the solid angle is an angle excess that cancels in f32.
 
+use super::warps::DIRECTION_SLACK;
 use glam::{DVec3, Vec2, Vec3};
 use std::f64::consts::TAU;
 
@@ -129,7 +130,9 @@ impl SphericalRectangle {
         (self.o + self.x * xu + self.y * yv + self.z * z0).as_vec3()
     }
 
-    /// Whether the ray from the viewpoint along `d` (any length) hits the rectangle.
+    /// Whether the ray from the viewpoint along `d` (any length) hits the rectangle, or passes
+    /// within [`DIRECTION_SLACK`] radians of it: samples drawn on an edge (ξ on the boundary of
+    /// the unit square) are rounded to f32 and may land a hair outside.
     pub fn contains(&self, d: Vec3) -> bool {
         let d = d.as_dvec3();
         let dz = d.dot(self.z);
@@ -138,7 +141,10 @@ impl SphericalRectangle {
         }
         let t = self.z0 / dz;
         let (hx, hy) = (t * d.dot(self.x), t * d.dot(self.y));
-        (self.x0..=self.x1).contains(&hx) && (self.y0..=self.y1).contains(&hy)
+        // An angle δ moves the hit point by at most δ·distance / cos, and the distance
+        // t·|d| ≥ |z0| bounds that from below: slack in the plane of the rectangle.
+        let e = DIRECTION_SLACK as f64 * t * d.length() * d.length() / -dz;
+        (self.x0 - e..=self.x1 + e).contains(&hx) && (self.y0 - e..=self.y1 + e).contains(&hy)
     }
 
     /// Solid-angle pdf of [`Self::sample`] in direction `d`: 1/solid_angle on the rectangle.

@@ -5,6 +5,7 @@
 //! (uniform in 1 − cos of the arc length from B). All the trigonometry runs in f64, because for
 //! small triangles it cancels catastrophically in f32.
 
+use super::warps::DIRECTION_SLACK;
 use glam::{DVec3, Vec2, Vec3};
 
 /// A triangle (a, b, c) seen from point `p`, precomputed for solid-angle sampling.
@@ -226,12 +227,18 @@ impl SphericalTriangle {
         Vec2::new(u0.clamp(0.0, 1.0) as f32, u1.clamp(0.0, 1.0) as f32)
     }
 
-    /// Whether direction `d` (any length) points into the triangle.
+    /// Whether direction `d` (any length) points into the triangle, or within
+    /// [`DIRECTION_SLACK`] radians of it: samples drawn on an edge (ξ on the boundary of the
+    /// unit square) are rounded to f32 and may land a hair outside.
     pub fn contains(&self, d: Vec3) -> bool {
         let d = d.as_dvec3() * self.orientation;
-        d.dot(self.da.cross(self.db)) >= 0.0
-            && d.dot(self.db.cross(self.dc)) >= 0.0
-            && d.dot(self.dc.cross(self.da)) >= 0.0
+        // d·(x × y) / |x × y| is the sine of d's angle above the plane of edge (x, y).
+        let slack = -(DIRECTION_SLACK as f64) * d.length();
+        let side = |x: DVec3, y: DVec3| {
+            let n = x.cross(y);
+            d.dot(n) >= slack * n.length()
+        };
+        side(self.da, self.db) && side(self.db, self.dc) && side(self.dc, self.da)
     }
 
     /// Solid-angle pdf of [`Self::sample`] at direction `d`: 1/area inside, 0 outside.

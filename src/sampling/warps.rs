@@ -237,10 +237,25 @@ fn azimuth(d: Vec3) -> f32 {
     if p >= TAU { 0.0 } else { p }
 }
 
-/// Uniform hemisphere: cos θ = ξ₁, φ = 2πξ₂ (marginal of θ is sin θ, conditional of φ uniform).
+/// The resolution of the samplers' inputs: the patterns and the test harness draw ξ on the
+/// grid k·2⁻²⁴, k < 2²⁴.
+pub const XI_MIN: f32 = 1.0 / (1u32 << 24) as f32;
+
+/// ξ ∈ [0, 1) clamped to [2⁻²⁴, 1) for the warps that map ξ = 0 to the edge of their
+/// support — the horizon (cos θ = 0), the rim of the tent — where the pdf is 0: ξ = 0 (and the
+/// finer values some patterns give below 2⁻²⁴) becomes 2⁻²⁴, the next point of the 24-bit
+/// grid, in the same stratum (a bias below 2⁻²⁴ of the mass). Every other input is returned as
+/// is, so the samples of every ξ ≥ 2⁻²⁴ are bit-identical to the plain map's.
+#[inline(always)]
+pub fn open_unit(xi: f32) -> f32 {
+    xi.max(XI_MIN)
+}
+
+/// Uniform hemisphere: cos θ = ξ₁, φ = 2πξ₂ (marginal of θ is sin θ, conditional of φ uniform),
+/// with ξ₁ ≥ 2⁻²⁴ ([`open_unit`]), so no sample lies on the horizon.
 #[inline]
 pub fn uniform_hemisphere(u: Vec2) -> Vec3 {
-    spherical_direction_turn(u.x, u.y)
+    spherical_direction_turn(open_unit(u.x), u.y)
 }
 
 /// Pdf of [`uniform_hemisphere`]: 1/(2π) on z ≥ 0.
@@ -255,10 +270,12 @@ pub fn uniform_hemisphere_inverse(d: Vec3) -> Vec2 {
     Vec2::new(d.z, azimuth(d) / TAU)
 }
 
-/// Cosine-weighted hemisphere: cos θ = √ξ₁, φ = 2πξ₂ (Malley's method by inversion).
+/// Cosine-weighted hemisphere: cos θ = √ξ₁, φ = 2πξ₂ (Malley's method by inversion), with
+/// ξ₁ ≥ 2⁻²⁴ ([`open_unit`]), so cos θ ≥ 2⁻¹²: no sample lies on the horizon, where the pdf
+/// is 0.
 #[inline]
 pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
-    spherical_direction_turn(u.x.sqrt(), u.y)
+    spherical_direction_turn(open_unit(u.x).sqrt(), u.y)
 }
 
 /// Pdf of [`cosine_hemisphere`]: cos θ / π on z ≥ 0.
@@ -275,11 +292,16 @@ pub fn cosine_hemisphere_inverse(d: Vec3) -> Vec2 {
 
 /// Cosine-power (Phong lobe) hemisphere, pdf ∝ cosⁿθ: the marginal cdf of θ is
 /// 1 − cos^(n+1)θ, so cos θ = ξ₁^(1/(n+1)); φ = 2πξ₂.
+///
+/// ξ₁ ≥ 2⁻²⁴ ([`open_unit`]) keeps ln ξ₁ ≥ −16.7, so cos θ ≥ 2^(−24/(n+1)) > 0. With
+/// ξ₁ = 0 itself, ln 0 = −∞ gave a direction exactly on the horizon with pdf 0 (issue 16:
+/// `penumbra warp cosine-power -p n=100` with seed 5 and 10⁶ samples rejected its own
+/// chi-square test).
 #[inline]
 pub fn cosine_power_hemisphere(u: Vec2, n: f32) -> Vec3 {
     // 1 − cos θ = −expm1(ln ξ₁ / (n+1)) stays accurate for very sharp lobes, where
     // ξ₁^(1/(n+1)) rounds to 1 in f32.
-    let one_minus_cos = -(u.x.ln() / (n + 1.0)).exp_m1();
+    let one_minus_cos = -(open_unit(u.x).ln() / (n + 1.0)).exp_m1();
     direction_from_one_minus_cos_turn(one_minus_cos, u.y)
 }
 
@@ -448,10 +470,18 @@ pub fn uniform_cone_sin2(u: Vec2, sin2_max: f32) -> Vec3 {
     direction_from_one_minus_cos_turn(u.x * cone_one_minus_cos(sin2_max), u.y)
 }
 
-/// Pdf of [`uniform_cone_sin2`]: 1/(2π(1 − cos θmax)) inside the cone.
+/// Angular slack (radians) of the inside tests of direction pdfs: 4 ulp of 1, about the
+/// rounding of an f32 unit vector that went through a frame and a normalisation. Without it a
+/// sample drawn on the rim of its support (ξ = 1 − 2⁻²⁴) can round to just outside and get
+/// pdf 0 from the very pdf that drew it.
+pub const DIRECTION_SLACK: f32 = 4.0 * f32::EPSILON;
+
+/// Pdf of [`uniform_cone_sin2`]: 1/(2π(1 − cos θmax)) inside the cone (widened by
+/// [`DIRECTION_SLACK`], so that rim samples rounded outside keep their density).
 #[inline]
 pub fn uniform_cone_sin2_pdf(d: Vec3, sin2_max: f32) -> f32 {
-    let inside = d.z > 0.0 && d.x * d.x + d.y * d.y <= sin2_max * d.length_squared();
+    let sin_slack = sin2_max.max(0.0).sqrt() + DIRECTION_SLACK;
+    let inside = d.z > 0.0 && d.x * d.x + d.y * d.y <= sin_slack * sin_slack * d.length_squared();
     if inside {
         1.0 / (TAU * cone_one_minus_cos(sin2_max))
     } else {
@@ -493,14 +523,20 @@ pub fn balance_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
 }
 
 /// 1D tent (triangle filter) of radius r centred at 0, by inverting its cdf on each half:
-/// pdf(x) = (r − |x|)/r².
+/// pdf(x) = (r − |x|)/r². The left half's w = 2u is clamped to ≥ 2⁻²⁴ ([`open_unit`]), so
+/// u = 0 lands at −r(1 − 2⁻¹²) instead of on the rim −r, where the pdf is 0 (the right half
+/// never reaches r).
 #[inline]
 pub fn tent(u: f32, r: f32) -> f32 {
     // Both halves as one computation with selects instead of a branch: the pixel filter draws
     // u uniformly, so a branch on u < 0.5 mispredicts half the time. Same values bit for bit:
     // w is 2u (left) or 1 − (2u − 1) (right), and −r·x = −(r·x) exactly.
     let left = u < 0.5;
-    let w = if left { 2.0 * u } else { 1.0 - (2.0 * u - 1.0) };
+    let w = if left {
+        open_unit(2.0 * u)
+    } else {
+        1.0 - (2.0 * u - 1.0)
+    };
     let m = r * (1.0 - w.sqrt());
     if left { -m } else { m }
 }

@@ -22,7 +22,7 @@ use crate::geometry::Transform;
 use crate::image::io::srgb_to_linear;
 use crate::lights::{DistantLight, Light, PointLight, SpotLight};
 use crate::material::texture::ImageRgb;
-use crate::material::{Material, Texture};
+use crate::material::{Material, NormalPerturbation, Texture, VaryingMaterial};
 use ::gltf::khr_lights_punctual::Kind;
 use anyhow::{Context, anyhow, bail, ensure};
 use glam::{Mat4, UVec2, Vec2, Vec3};
@@ -51,7 +51,7 @@ fn load_inner(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     let dir = path.parent().unwrap_or(Path::new(""));
     let buffers = load_buffers(&doc, dir, &file)?;
     let mut warnings = Vec::new();
-    let mut images: Vec<Option<Option<Arc<ImageRgb>>>> = vec![None; doc.images().len()];
+    let mut images: Vec<ImageSlot> = vec![[None, None]; doc.images().len()];
 
     let mut b = SceneBuilder::new();
     // Materials: one per glTF material (same index), plus the spec's default material.
@@ -167,7 +167,7 @@ struct Walk<'a> {
     /// The spec's default material, added when a primitive first needs it.
     default_id: Option<(u32, Option<AreaEmission>)>,
     dir: &'a Path,
-    images: &'a mut [Option<Option<Arc<ImageRgb>>>],
+    images: &'a mut [ImageSlot],
     b: &'a mut SceneBuilder,
     warnings: &'a mut Vec<String>,
     file: &'a str,
@@ -443,7 +443,7 @@ fn gltf_material(
     m: &::gltf::Material,
     buffers: &[Vec<u8>],
     dir: &Path,
-    images: &mut [Option<Option<Arc<ImageRgb>>>],
+    images: &mut [ImageSlot],
     file: &str,
     warnings: &mut Vec<String>,
 ) -> (Material, Option<AreaEmission>) {
@@ -459,25 +459,33 @@ fn gltf_material(
     } else {
         Rgb::ONE
     };
-    let base = match pbr.base_color_texture() {
-        Some(info) => {
-            let img = info.texture().source();
+    // Image `img` decoded (sRGB-linearised for colours, as stored for data), once per use.
+    let mut decoded_image =
+        |img: ::gltf::Image, srgb: bool, instead: &str, warnings: &mut Vec<String>| {
             let idx = img.index();
-            let entry = images.get_mut(idx);
-            let decoded = match entry {
-                Some(slot) => slot
-                    .get_or_insert_with(|| match decode_image(&img, buffers, dir) {
+            match images.get_mut(idx) {
+                Some(slot) => slot[srgb as usize]
+                    .get_or_insert_with(|| match decode_image(&img, buffers, dir, srgb) {
                         Ok(i) => Some(Arc::new(i)),
                         Err(e) => {
                             warnings.push(format!(
-                                "{file}: image {idx}: {e:#}; material '{name}' uses its base colour factor"
+                                "{file}: image {idx}: {e:#}; material '{name}' {instead}"
                             ));
                             None
                         }
                     })
                     .clone(),
                 None => None,
-            };
+            }
+        };
+    let base = match pbr.base_color_texture() {
+        Some(info) => {
+            let decoded = decoded_image(
+                info.texture().source(),
+                true,
+                "uses its base colour factor",
+                warnings,
+            );
             if info.tex_coord() != 0 {
                 warnings.push(format!(
                     "{file}: material '{name}': texture uses TEXCOORD_{}, only TEXCOORD_0 is read",
@@ -567,6 +575,48 @@ fn gltf_material(
             alpha,
             reflectance: Some(base),
         }
+    };
+    // The normal texture: tangent-space normals, x along ∂p/∂u, y on ∂p/∂v's side (the
+    // bitangent sign MikkTSpace stores in TANGENT.w), scaled in x and y by `scale`.
+    let material = match m.normal_texture() {
+        Some(info) => {
+            let decoded = decoded_image(
+                info.texture().source(),
+                false,
+                "has no normal map",
+                warnings,
+            );
+            if info.tex_coord() != 0 {
+                warnings.push(format!(
+                    "{file}: material '{name}': normalTexture uses TEXCOORD_{}, only TEXCOORD_0 is read",
+                    info.tex_coord()
+                ));
+            }
+            match decoded {
+                Some(image) => {
+                    warnings.push(format!(
+                        "{file}: material '{name}': normalTexture tangents are each triangle's ∂p/∂u (TANGENT attributes and MikkTSpace's per-vertex smoothing are not used)"
+                    ));
+                    let scale = if info.scale().is_finite() {
+                        info.scale()
+                    } else {
+                        1.0
+                    };
+                    Material::Varying(Box::new(VaryingMaterial {
+                        base: material,
+                        roughness: None,
+                        coat_roughness: None,
+                        normal: Some(NormalPerturbation::NormalMap {
+                            image,
+                            scale,
+                            uv_handed: true,
+                        }),
+                    }))
+                }
+                None => material,
+            }
+        }
+        None => material,
     };
     (material, emission)
 }
@@ -660,9 +710,19 @@ fn percent_decode(s: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-/// Decode a glTF image (PNG/JPEG from a buffer view or URI) into linear RGB. Base-colour
-/// textures are sRGB-encoded by the spec, so they are linearised here.
-fn decode_image(img: &::gltf::Image, buffers: &[Vec<u8>], dir: &Path) -> anyhow::Result<ImageRgb> {
+/// A glTF image decoded as data (`[0]`: normal maps) and as sRGB-linearised colour (`[1]`),
+/// each when first used (`Some(None)`: it failed, and said so once).
+type ImageSlot = [Option<Option<Arc<ImageRgb>>>; 2];
+
+/// Decode a glTF image (PNG/JPEG from a buffer view or URI) into RGB: linearised when `srgb`
+/// (base-colour textures are sRGB-encoded by the spec), code value / 255 otherwise (normal
+/// textures are linear data).
+fn decode_image(
+    img: &::gltf::Image,
+    buffers: &[Vec<u8>],
+    dir: &Path,
+    srgb: bool,
+) -> anyhow::Result<ImageRgb> {
     let owned;
     let bytes: &[u8] = match img.source() {
         ::gltf::image::Source::View { view, .. } => {
@@ -684,11 +744,8 @@ fn decode_image(img: &::gltf::Image, buffers: &[Vec<u8>], dir: &Path) -> anyhow:
     let pixels = rgb
         .pixels()
         .map(|p| {
-            Rgb::new(
-                srgb_to_linear(p[0]),
-                srgb_to_linear(p[1]),
-                srgb_to_linear(p[2]),
-            )
+            let f = |v: f32| if srgb { srgb_to_linear(v) } else { v };
+            Rgb::new(f(p[0]), f(p[1]), f(p[2]))
         })
         .collect();
     Ok(ImageRgb {

@@ -10,11 +10,13 @@ pub mod gltf;
 pub mod gltf_check;
 pub mod guard;
 pub mod load;
+pub mod loop_subdiv;
 pub mod mesh_repair;
 pub mod obj;
 pub mod obj_text;
 pub mod pbrt;
 pub mod polygon;
+pub mod shading_normals;
 pub mod view;
 
 pub use builder::SceneBuilder;
@@ -37,6 +39,30 @@ pub enum Filter {
     Triangle {
         /// Radius (x, y).
         radius: Vec2,
+    },
+    /// pbrt-v4's gaussian (its default filter): the Gaussian of standard deviation `sigma`
+    /// minus its value at the radius, per axis.
+    Gaussian {
+        /// Radius (x, y).
+        radius: Vec2,
+        /// Standard deviation in pixels.
+        sigma: f32,
+    },
+    /// Mitchell–Netravali cubic with parameters B and C, stretched to the radius.
+    Mitchell {
+        /// Radius (x, y).
+        radius: Vec2,
+        /// B.
+        b: f32,
+        /// C.
+        c: f32,
+    },
+    /// pbrt's "sinc": the Lanczos-windowed sinc, sinc(x)·sinc(x/τ) within the radius.
+    Sinc {
+        /// Radius (x, y).
+        radius: Vec2,
+        /// Window width τ.
+        tau: f32,
     },
 }
 
@@ -109,5 +135,5 @@ pub struct IntegratorSpec {
     /// `maxdepth` (pbrt-v4's default 5).
     pub max_depth: u32,
     /// `lightsampler` mapped to a selector name, when the file gives one.
-    pub light_selection: Option<String>,
+    pub light_selection: Option<crate::light_selection::SelectorKind>,
 }

@@ -16,7 +16,7 @@
 
 use crate::camera::Camera;
 use crate::geometry::interaction::NO_LIGHT;
-use crate::geometry::{PrimKind, Primitive, Ray, RayQuery, Transform};
+use crate::geometry::{PrimKind, Primitive, RayQuery, Transform};
 use crate::lights::{Emitter, LightSampleContext, LightSource, SamplingMode};
 use crate::scene::{FilmSpec, Filter, Scene};
 use anyhow::ensure;
@@ -110,8 +110,7 @@ fn look_at_with(
         .ok_or_else(|| anyhow::anyhow!("mirror transform is singular"))?;
     Ok(Camera {
         camera_to_world: lh.camera_to_world.then_apply_to(&m),
-        fov_deg,
-        screen_window: None,
+        ..lh
     })
 }
 
@@ -202,13 +201,7 @@ pub fn lit_rays(scene: &Scene, cam: &Camera) -> usize {
                     if !(s.pdf > 0.0 && s.li.max_element() > 0.0) || s.wi.dot(ctx.n) <= 0.0 {
                         return false;
                     }
-                    let o = hit.spawn_origin(s.wi);
-                    let shadow = Ray {
-                        o,
-                        d: s.p_light - o,
-                        t_max: 1.0 - 1e-4,
-                    };
-                    !scene.geometry.occluded(&shadow)
+                    !scene.geometry.occluded(&hit.spawn_ray_to(s.p_light))
                 })
             });
             lit += usize::from(reached);

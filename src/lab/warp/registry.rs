@@ -583,8 +583,15 @@ fn build_triangle(p: &Params) -> anyhow::Result<(Domain, SampleFn, PdfFn)> {
     }
     let inv_area = 2.0 / twice_area.abs();
     let sign = twice_area.signum();
+    // Points on an edge (ξ on the boundary of the unit square) are rounded to f32 and may land
+    // a few ulp outside: the inside test allows 4 ulp of the triangle's coordinates.
+    let extent = [da, db, dc]
+        .iter()
+        .map(|v| v.abs().max_element())
+        .fold(0.0, f64::max);
+    let slack = 4.0 * f32::EPSILON as f64 * extent;
     let inside = move |q: DVec2| {
-        let e = |u: DVec2, v: DVec2| sign * (v - u).perp_dot(q - u) >= 0.0;
+        let e = |u: DVec2, v: DVec2| sign * (v - u).perp_dot(q - u) >= -slack * (v - u).length();
         e(da, db) && e(db, dc) && e(dc, da)
     };
     let rect = [

@@ -22,6 +22,8 @@ pub fn cornell_camera() -> Camera {
         camera_to_world: cam_from_world.inverse(),
         fov_deg: 19.5,
         screen_window: None,
+        projection: crate::camera::Projection::Perspective,
+        lens: crate::camera::Lens::PINHOLE,
     }
 }
 

@@ -12,6 +12,7 @@ use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
 use crate::geometry::Transform;
 use crate::lights::Light;
+use crate::lights::envmap::EnvLayout;
 use glam::Vec3;
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
@@ -55,8 +56,10 @@ pub enum LightDesc {
     EnvMap {
         /// Image path (checked to exist).
         path: PathBuf,
-        /// Multiplier.
+        /// Multiplier (`scale`, times the `illuminance` normalisation).
         scale: f32,
+        /// Equal-area octahedral (square images, pbrt-v4) or lat-long (any other shape).
+        layout: EnvLayout,
         /// The CTM at the light.
         light_to_world: Transform,
     },
@@ -246,24 +249,39 @@ pub fn parse_light(
                             ),
                         );
                     }
-                    if img.width == img.height {
+                    let layout = if img.width == img.height {
+                        EnvLayout::EqualArea
+                    } else {
                         warn(
-                            "envmap-octahedral",
+                            "envmap-latlong",
                             loc,
-                            "square environment map: pbrt-v4 uses an equal-area octahedral layout, penumbra reads lat-long; it will look different".into(),
+                            format!(
+                                "environment map {} is {}x{}, not square: pbrt-v4 requires square equal-area maps and would refuse it; read as latitude-longitude (row 0 = +z)",
+                                path.display(),
+                                img.width,
+                                img.height
+                            ),
                         );
-                    }
-                    if params.has("illuminance") {
-                        let _ = params.find("illuminance");
-                        warn(
-                            "envmap-illuminance",
-                            loc,
-                            "'illuminance' of image infinite lights ignored".into(),
-                        );
+                        EnvLayout::LatLong
+                    };
+                    let mut scale = scale;
+                    if let Some(e) = positive_opt(params, "illuminance")? {
+                        let k = map_illuminance(&img, layout);
+                        if !(k > 0.0) {
+                            return Err(err_at(
+                                params.loc_of("illuminance").as_ref().unwrap_or(loc),
+                                format!(
+                                    "infinite light: 'illuminance' {e} asked of a map that sends no light to the upper hemisphere: {}",
+                                    path.display()
+                                ),
+                            ));
+                        }
+                        scale *= e / k;
                     }
                     LightDesc::EnvMap {
                         path,
                         scale,
+                        layout,
                         light_to_world: *ctm,
                     }
                 }
@@ -322,16 +340,54 @@ pub fn to_light(desc: &LightDesc, images: &ImageCache) -> anyhow::Result<Light> 
         LightDesc::EnvMap {
             path,
             scale,
+            layout,
             light_to_world,
         } => {
             let img = images
                 .get(path)
                 .cloned()
                 .ok_or_else(|| anyhow::anyhow!("{}: image not loaded", path.display()))?;
+            let make = match layout {
+                EnvLayout::EqualArea => EnvMapLight::equal_area,
+                EnvLayout::LatLong => EnvMapLight::new,
+            };
             Light::EnvMap(Box::new(
-                EnvMapLight::new(img, Rgb::splat(*scale), *light_to_world)
+                make(img, Rgb::splat(*scale), *light_to_world)
                     .map_err(|e| anyhow::anyhow!("{}: {e:#}", path.display()))?,
             ))
         }
     })
+}
+
+/// Illuminance at an upward-facing (light-space +z) patch from the map at scale 1:
+/// ∫ L(ω)·cos θ dω over z > 0, the luminance of each texel times its cosine and solid angle.
+/// (pbrt-v4's file format defines 'illuminance' so; its code sums with 2π/n² per texel where
+/// each equal-area texel covers 4π/n², which makes its maps twice as bright as asked.)
+pub fn map_illuminance(img: &crate::material::texture::ImageRgb, layout: EnvLayout) -> f32 {
+    let (w, h) = (img.width as usize, img.height as usize);
+    let mut e = 0.0f64;
+    for y in 0..h {
+        for x in 0..w {
+            let uv = glam::Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+            let (d, d_omega) = match layout {
+                EnvLayout::EqualArea => (
+                    crate::sampling::equal_area_square_to_sphere(uv),
+                    4.0 * std::f64::consts::PI / (w * h) as f64,
+                ),
+                EnvLayout::LatLong => {
+                    let (st, ct) = (uv.y * PI).sin_cos();
+                    let (sp, cp) = (uv.x * 2.0 * PI).sin_cos();
+                    (
+                        Vec3::new(st * cp, st * sp, ct),
+                        2.0 * std::f64::consts::PI.powi(2) * st as f64 / (w * h) as f64,
+                    )
+                }
+            };
+            if d.z > 0.0 {
+                let l = crate::luminance(img.pixels[y * w + x].max(Rgb::ZERO)) as f64;
+                e += l * d.z as f64 * d_omega;
+            }
+        }
+    }
+    e as f32
 }

@@ -6,11 +6,13 @@ use super::params::{ParamSet, SpecVal};
 use super::spectra::{
     SpectrumUse, conductor_rgb, named_glass_ior, sampled_at, spectrum_to_rgb, to_rgb,
 };
-use super::textures::{ImageCache, TextureDesc, TextureTable, Warn};
+use super::textures::{FloatTexDesc, ImageCache, TextureDesc, TextureTable, Warn};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
 use crate::bsdf::{LayerParams, roughness_to_alpha};
-use crate::material::{Material, Texture};
+use crate::material::{
+    FloatTexture, Material, NormalPerturbation, RoughnessTextures, Texture, VaryingMaterial,
+};
 use glam::Vec2;
 
 /// A metal's eta or k: RGB, or a spectrum (named `metal-*`, inline or from a `.spd` file).
@@ -97,6 +99,27 @@ pub enum MaterialDesc {
     },
     /// `interface` / `none`: the shape is a medium boundary and is not rendered.
     Interface,
+    /// A material whose roughness is a varying float texture (`base` keeps the constant
+    /// parts and `remaproughness`).
+    Varying {
+        /// The material.
+        base: Box<MaterialDesc>,
+        /// (u, v) roughness of the (only, or conductor) layer, when textured.
+        roughness: Option<[FloatTexDesc; 2]>,
+        /// (u, v) roughness of a coated conductor's interface, when textured.
+        coat_roughness: Option<[FloatTexDesc; 2]>,
+        /// Normal or bump map.
+        normal: Option<NormalDesc>,
+    },
+}
+
+/// A material's normal map (resolved path, loaded while parsing) or bump displacement.
+#[derive(Clone, Debug, PartialEq)]
+pub enum NormalDesc {
+    /// `"string normalmap"`.
+    Map(std::path::PathBuf),
+    /// `"texture displacement"` (varying; a constant displacement changes nothing).
+    Bump(FloatTexDesc),
 }
 
 impl MaterialDesc {
@@ -108,12 +131,16 @@ impl MaterialDesc {
     }
 }
 
+/// `roughness`/`uroughness`/`vroughness`: the constant part and, when either axis is a
+/// varying texture, both axes as textures.
+type Roughness = (Vec2, Option<[FloatTexDesc; 2]>);
+
 fn roughness(
     params: &ParamSet,
     tex: &TextureTable,
     default: f32,
     warn: &mut Warn,
-) -> anyhow::Result<Vec2> {
+) -> anyhow::Result<Roughness> {
     prefixed_roughness(params, tex, "", default, warn)
 }
 
@@ -124,24 +151,102 @@ fn prefixed_roughness(
     prefix: &str,
     default: f32,
     warn: &mut Warn,
-) -> anyhow::Result<Vec2> {
+) -> anyhow::Result<Roughness> {
     let (rn, un, vn) = (
         format!("{prefix}roughness"),
         format!("{prefix}uroughness"),
         format!("{prefix}vroughness"),
     );
-    let r = tex.float_param(params, &rn, default, warn)?;
-    let u = if params.has(&un) {
-        tex.float_param(params, &un, r, warn)?
-    } else {
-        r
+    let r = tex.float_texture_param(params, &rn, default, warn)?;
+    let axis = |name: &str, warn: &mut Warn| -> anyhow::Result<FloatTexDesc> {
+        if params.has(name) {
+            tex.float_texture_param(params, name, default, warn)
+        } else {
+            Ok(r.clone())
+        }
     };
-    let v = if params.has(&vn) {
-        tex.float_param(params, &vn, r, warn)?
-    } else {
-        r
+    let (u, v) = (axis(&un, warn)?, axis(&vn, warn)?);
+    Ok(match (u.constant(), v.constant()) {
+        (Some(a), Some(b)) => (Vec2::new(a, b).max(Vec2::ZERO), None),
+        // The constant part is unused where the texture applies; the texture's mean is not
+        // needed, 0 keeps `base` a valid material.
+        _ => (Vec2::ZERO, Some([u, v])),
+    })
+}
+
+/// Wrap `base` when a roughness is textured or the normal is perturbed.
+fn varying(
+    base: MaterialDesc,
+    roughness: Option<[FloatTexDesc; 2]>,
+    coat_roughness: Option<[FloatTexDesc; 2]>,
+    normal: Option<NormalDesc>,
+) -> MaterialDesc {
+    if roughness.is_none() && coat_roughness.is_none() && normal.is_none() {
+        return base;
+    }
+    // A material that is already varying (a `mix` component) keeps its own maps.
+    if let MaterialDesc::Varying {
+        base,
+        roughness: r0,
+        coat_roughness: c0,
+        normal: n0,
+    } = base
+    {
+        return MaterialDesc::Varying {
+            base,
+            roughness: roughness.or(r0),
+            coat_roughness: coat_roughness.or(c0),
+            normal: normal.or(n0),
+        };
+    }
+    MaterialDesc::Varying {
+        base: Box::new(base),
+        roughness,
+        coat_roughness,
+        normal,
+    }
+}
+
+/// pbrt-v4's `"string normalmap"` / `"texture displacement"` of a material.
+fn normal_desc(
+    params: &ParamSet,
+    ctx: &MaterialCtx,
+    loc: &Loc,
+    warn: &mut Warn,
+) -> anyhow::Result<Option<NormalDesc>> {
+    let map = match params.string("normalmap")? {
+        Some(f) if !f.is_empty() => Some(NormalDesc::Map(super::textures::resolve(ctx.dir, &f))),
+        _ => None,
     };
-    Ok(Vec2::new(u, v).max(Vec2::ZERO))
+    let bump = if params.has("displacement") {
+        match ctx
+            .textures
+            .float_texture_param(params, "displacement", 0.0, warn)?
+        {
+            FloatTexDesc::Constant(_) => None,
+            t => Some(NormalDesc::Bump(t)),
+        }
+    } else {
+        None
+    };
+    if map.is_some() && bump.is_some() {
+        warn(
+            "normalmap-and-bump",
+            loc,
+            "material has both 'normalmap' and 'displacement': the normal map is used".into(),
+        );
+    }
+    if map.is_none() && bump.is_some() {
+        warn(
+            "bump-approx",
+            loc,
+            format!(
+                "bump mapping: finite differences of {} in uv (no ray differentials) and without the displacement·∂n/∂u term of curved shading normals",
+                crate::material::varying::BUMP_DELTA
+            ),
+        );
+    }
+    Ok(map.or(bump))
 }
 
 /// pbrt-v4's layered-material parameters (`thickness`, `albedo`, `g`, `maxdepth`,
@@ -255,6 +360,8 @@ pub struct MaterialCtx<'a> {
     pub textures: &'a TextureTable,
     /// Looks up a named material's description (for `mix`).
     pub named: &'a dyn Fn(&str) -> Option<MaterialDesc>,
+    /// Directory of the file being parsed (normal maps are relative to it).
+    pub dir: &'a std::path::Path,
 }
 
 /// Parse a material of pbrt type `ty`.
@@ -265,13 +372,22 @@ pub fn parse_material(
     loc: &Loc,
     warn: &mut Warn,
 ) -> anyhow::Result<MaterialDesc> {
+    let normal = normal_desc(params, ctx, loc, warn)?;
+    let desc = material_body(ty, params, ctx, loc, warn)?;
+    Ok(match desc {
+        MaterialDesc::Interface => MaterialDesc::Interface,
+        d => varying(d, None, None, normal),
+    })
+}
+
+fn material_body(
+    ty: &str,
+    params: &ParamSet,
+    ctx: &MaterialCtx,
+    loc: &Loc,
+    warn: &mut Warn,
+) -> anyhow::Result<MaterialDesc> {
     let tex = ctx.textures;
-    for ignored in ["displacement", "normalmap"] {
-        if params.has(ignored) {
-            let _ = params.find(ignored);
-            warn(ignored, loc, format!("material '{ignored}' is ignored"));
-        }
-    }
     Ok(match ty {
         "diffuse" => MaterialDesc::Diffuse {
             reflectance: tex
@@ -294,32 +410,45 @@ pub fn parse_material(
                 scale,
             }
         }
-        "conductor" => MaterialDesc::Conductor {
-            eta: metal(params, "eta", "metal-Cu-eta")?,
-            k: metal(params, "k", "metal-Cu-k")?,
-            reflectance: tex.spectrum_param(params, "reflectance", None)?,
-            roughness: roughness(params, tex, 0.0, warn)?,
-            remap: params.bool("remaproughness", true)?,
-        },
-        "coateddiffuse" => MaterialDesc::CoatedDiffuse {
-            reflectance: tex
-                .spectrum_param(params, "reflectance", Some(Rgb::splat(0.5)))?
-                .unwrap_or(TextureDesc::Constant(Rgb::splat(0.5))),
-            roughness: roughness(params, tex, 0.0, warn)?,
-            eta: ior(params, "eta", loc, warn)?,
-            remap: params.bool("remaproughness", true)?,
-            layer: layer_params(params, tex, loc, warn)?,
-        },
-        "coatedconductor" => MaterialDesc::CoatedConductor {
-            coat_eta: ior(params, "interface.eta", loc, warn)?,
-            coat_roughness: prefixed_roughness(params, tex, "interface.", 0.0, warn)?,
-            eta: metal(params, "conductor.eta", "metal-Cu-eta")?,
-            k: metal(params, "conductor.k", "metal-Cu-k")?,
-            reflectance: tex.spectrum_param(params, "reflectance", None)?,
-            roughness: prefixed_roughness(params, tex, "conductor.", 0.0, warn)?,
-            remap: params.bool("remaproughness", true)?,
-            layer: layer_params(params, tex, loc, warn)?,
-        },
+        "conductor" => {
+            let (r, rt) = roughness(params, tex, 0.0, warn)?;
+            let base = MaterialDesc::Conductor {
+                eta: metal(params, "eta", "metal-Cu-eta")?,
+                k: metal(params, "k", "metal-Cu-k")?,
+                reflectance: tex.spectrum_param(params, "reflectance", None)?,
+                roughness: r,
+                remap: params.bool("remaproughness", true)?,
+            };
+            varying(base, rt, None, None)
+        }
+        "coateddiffuse" => {
+            let (r, rt) = roughness(params, tex, 0.0, warn)?;
+            let base = MaterialDesc::CoatedDiffuse {
+                reflectance: tex
+                    .spectrum_param(params, "reflectance", Some(Rgb::splat(0.5)))?
+                    .unwrap_or(TextureDesc::Constant(Rgb::splat(0.5))),
+                roughness: r,
+                eta: ior(params, "eta", loc, warn)?,
+                remap: params.bool("remaproughness", true)?,
+                layer: layer_params(params, tex, loc, warn)?,
+            };
+            varying(base, rt, None, None)
+        }
+        "coatedconductor" => {
+            let (cr, crt) = prefixed_roughness(params, tex, "interface.", 0.0, warn)?;
+            let (r, rt) = prefixed_roughness(params, tex, "conductor.", 0.0, warn)?;
+            let base = MaterialDesc::CoatedConductor {
+                coat_eta: ior(params, "interface.eta", loc, warn)?,
+                coat_roughness: cr,
+                eta: metal(params, "conductor.eta", "metal-Cu-eta")?,
+                k: metal(params, "conductor.k", "metal-Cu-k")?,
+                reflectance: tex.spectrum_param(params, "reflectance", None)?,
+                roughness: r,
+                remap: params.bool("remaproughness", true)?,
+                layer: layer_params(params, tex, loc, warn)?,
+            };
+            varying(base, rt, crt, None)
+        }
         "dielectric" | "thindielectric" => {
             let thin = ty == "thindielectric";
             if thin {
@@ -329,12 +458,14 @@ pub fn parse_material(
                     "material \"thindielectric\" approximated by a dielectric interface".into(),
                 );
             }
-            MaterialDesc::Dielectric {
+            let (r, rt) = roughness(params, tex, 0.0, warn)?;
+            let base = MaterialDesc::Dielectric {
                 eta: ior(params, "eta", loc, warn)?,
-                roughness: roughness(params, tex, 0.0, warn)?,
+                roughness: r,
                 remap: params.bool("remaproughness", true)?,
                 thin,
-            }
+            };
+            varying(base, rt, None, None)
         }
         "mix" => {
             let names = params.strings("materials")?.ok_or_else(|| {
@@ -372,6 +503,39 @@ pub fn parse_material(
     })
 }
 
+fn image(
+    path: &std::path::Path,
+    encoding: super::textures::Encoding,
+    images: &ImageCache,
+) -> anyhow::Result<std::sync::Arc<crate::material::texture::ImageRgb>> {
+    let img = images
+        .get(path)
+        .ok_or_else(|| anyhow::anyhow!("{}: image not loaded", path.display()))?;
+    Ok(encoding.apply(path, img))
+}
+
+/// A float texture description as a renderer texture.
+pub fn float_texture(t: &FloatTexDesc, images: &ImageCache) -> anyhow::Result<FloatTexture> {
+    Ok(match t {
+        FloatTexDesc::Constant(v) => FloatTexture::Constant(*v),
+        FloatTexDesc::Image {
+            path,
+            scale,
+            invert,
+            encoding,
+        } => FloatTexture::Image {
+            image: image(path, *encoding, images)?,
+            scale: *scale,
+            invert: *invert,
+        },
+        FloatTexDesc::Product(a, b) => FloatTexture::Product(
+            Box::new(float_texture(a, images)?),
+            Box::new(float_texture(b, images)?),
+        ),
+        FloatTexDesc::Mapped(m, t) => FloatTexture::Mapped(*m, Box::new(float_texture(t, images)?)),
+    })
+}
+
 fn texture(t: &TextureDesc, images: &ImageCache) -> anyhow::Result<Texture> {
     Ok(match t {
         TextureDesc::Constant(c) => Texture::Constant(*c),
@@ -384,25 +548,31 @@ fn texture(t: &TextureDesc, images: &ImageCache) -> anyhow::Result<Texture> {
             path,
             scale,
             invert,
+            encoding,
         } => {
-            let img = images
-                .get(path)
-                .cloned()
-                .ok_or_else(|| anyhow::anyhow!("{}: image not loaded", path.display()))?;
-            let image = if *invert {
+            let img = image(path, *encoding, images)?;
+            if *invert {
+                // pbrt-v4: max(0, 1 − scale·value), baked into a copy of the image.
                 let mut inv = (*img).clone();
                 for p in &mut inv.pixels {
-                    *p = (Rgb::ONE - *p).max(Rgb::ZERO);
+                    *p = (Rgb::ONE - *p * *scale).max(Rgb::ZERO);
                 }
-                std::sync::Arc::new(inv)
+                Texture::Image {
+                    image: std::sync::Arc::new(inv),
+                    scale: Rgb::ONE,
+                }
             } else {
-                img
-            };
-            Texture::Image {
-                image,
-                scale: *scale,
+                Texture::Image {
+                    image: img,
+                    scale: *scale,
+                }
             }
         }
+        TextureDesc::Product(a, b) => {
+            Texture::Product(Box::new(texture(a, images)?), Box::new(texture(b, images)?))
+        }
+        TextureDesc::Float(f) => Texture::Float(float_texture(f, images)?),
+        TextureDesc::Mapped(m, t) => Texture::Mapped(*m, Box::new(texture(t, images)?)),
     })
 }
 
@@ -524,6 +694,47 @@ pub fn to_material(
                 eta: *eta,
                 alpha: alpha(*roughness, *remap),
             }
+        }
+        MaterialDesc::Varying {
+            base,
+            roughness,
+            coat_roughness,
+            normal,
+        } => {
+            let remap = match **base {
+                MaterialDesc::Conductor { remap, .. }
+                | MaterialDesc::CoatedDiffuse { remap, .. }
+                | MaterialDesc::CoatedConductor { remap, .. }
+                | MaterialDesc::Dielectric { remap, .. } => remap,
+                _ => true,
+            };
+            let textures = |t: &Option<[FloatTexDesc; 2]>| -> anyhow::Result<_> {
+                Ok(match t {
+                    Some([u, v]) => Some(RoughnessTextures {
+                        uv: [float_texture(u, images)?, float_texture(v, images)?],
+                        remap,
+                    }),
+                    None => None,
+                })
+            };
+            let normal = match normal {
+                // pbrt-v4 reads normal maps with the linear encoding.
+                Some(NormalDesc::Map(path)) => Some(NormalPerturbation::NormalMap {
+                    image: image(path, super::textures::Encoding::Linear, images)?,
+                    scale: 1.0,
+                    uv_handed: false,
+                }),
+                Some(NormalDesc::Bump(t)) => {
+                    Some(NormalPerturbation::Bump(float_texture(t, images)?))
+                }
+                None => None,
+            };
+            Material::Varying(Box::new(VaryingMaterial {
+                base: to_material(base, images, warnings)?,
+                roughness: textures(roughness)?,
+                coat_roughness: textures(coat_roughness)?,
+                normal,
+            }))
         }
         MaterialDesc::Interface => {
             // Shapes with an interface material are skipped by the parser; never reached.

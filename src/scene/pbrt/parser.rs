@@ -9,7 +9,7 @@ use super::textures::{TextureTable, Warn};
 use super::tokenizer::{Loc, Tok, Token, Tokenizer, err_at};
 use super::upgrade;
 use super::{PbrtScene, ShapeCall};
-use crate::camera::Camera;
+use crate::camera::{Camera, Lens, Projection, SphericalMapping};
 use crate::geometry::Transform;
 use crate::scene::{AreaEmission, FilmSpec, Filter};
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
@@ -53,7 +53,7 @@ pub struct Parser {
     cur_object: Option<ObjectDef>,
     world_seen: Option<Loc>,
     warned: HashSet<String>,
-    camera: Option<(Transform, f32, Option<[f32; 4]>)>,
+    camera: Option<Camera>,
     /// Film sensor parameters and where the Film directive is.
     sensor: (super::film::SensorParams, Option<Loc>),
     /// `exposuretime` given on the Film (else the camera's shutter interval).
@@ -66,8 +66,10 @@ pub struct Parser {
 fn film_default() -> FilmSpec {
     FilmSpec {
         resolution: UVec2::new(1280, 720),
-        filter: Filter::Box {
-            radius: Vec2::splat(0.5),
+        // pbrt-v4's default filter.
+        filter: Filter::Gaussian {
+            radius: Vec2::splat(1.5),
+            sigma: 0.5,
         },
         filename: None,
         spp: None,
@@ -116,6 +118,8 @@ impl Parser {
                     camera_to_world: Transform::IDENTITY,
                     fov_deg: 90.0,
                     screen_window: None,
+                    projection: Projection::Perspective,
+                    lens: Lens::PINHOLE,
                 },
                 film: film_default(),
                 max_depth: None,
@@ -325,12 +329,8 @@ impl Parser {
             self.out.film.sensor = r;
         }
         self.out.images = std::mem::take(&mut self.textures.images);
-        if let Some((cam, fov, sw)) = self.camera.take() {
-            self.out.camera = Camera {
-                camera_to_world: cam,
-                fov_deg: fov,
-                screen_window: sw,
-            };
+        if let Some(cam) = self.camera.take() {
+            self.out.camera = cam;
         }
         Ok(self.out)
     }
@@ -388,9 +388,39 @@ impl Parser {
             .map(|(k, &i)| (k.clone(), self.descs[i].clone()))
             .collect();
         let lookup = |n: &str| named.get(n).cloned();
+        let dir = self.dir();
+        // A normal map is loaded (cached with the textures' images) before the material
+        // refers to it.
+        if let Some(f) = ps.string("normalmap")?
+            && !f.is_empty()
+        {
+            let path = super::textures::resolve(&dir, &f);
+            let floc = ps.loc_of("normalmap").unwrap_or(loc.clone());
+            if let Some(why) = crate::image::io::not_a_file(&path) {
+                return Err(err_at(
+                    &floc,
+                    format!("normalmap: {why}: {}", path.display()),
+                ));
+            }
+            // pbrt-v4 reads the three channels as a direction: a grey image is an error
+            // there too, not a normal map of (g, g, g).
+            let color = crate::image::io::has_color_channels(&path)
+                .map_err(|e| err_at(&floc, format!("normalmap: {e:#}")))?;
+            if !color {
+                return Err(err_at(
+                    &floc,
+                    format!(
+                        "normalmap: {} has one (grey) channel; a normal map needs R, G and B",
+                        path.display()
+                    ),
+                ));
+            }
+            super::textures::load_image(&mut self.textures.images, &path, &floc)?;
+        }
         let ctx = MaterialCtx {
             textures: &self.textures,
             named: &lookup,
+            dir: &dir,
         };
         let mut pending = Vec::new();
         let d = parse_material(ty, ps, &ctx, loc, &mut |k: &str, l: &Loc, m: String| {
@@ -524,15 +554,47 @@ impl Parser {
             "ReverseOrientation" => self.gs.reverse = !self.gs.reverse,
             "Camera" => {
                 self.require_world(name, &loc, false)?;
-                let (ty, _) = self.expect_string("a camera type")?;
+                let (ty, tloc) = self.expect_string("a camera type")?;
                 let ps = self.params()?;
-                if ty != "perspective" {
-                    self.warn(
-                        "camera-type",
-                        &loc,
-                        format!("camera \"{ty}\" approximated by a perspective camera"),
-                    );
-                }
+                let projection = match ty.as_str() {
+                    "perspective" => Projection::Perspective,
+                    "orthographic" => Projection::Orthographic,
+                    "spherical" => match ps.string("mapping")?.as_deref() {
+                        None | Some("equalarea") => {
+                            Projection::Spherical(SphericalMapping::EqualArea)
+                        }
+                        Some("equirectangular") => {
+                            Projection::Spherical(SphericalMapping::Equirectangular)
+                        }
+                        Some(m) => {
+                            return Err(err_at(
+                                &ps.loc_of("mapping").unwrap_or(loc.clone()),
+                                format!(
+                                    "spherical camera: unknown mapping \"{m}\" (expected \"equalarea\" or \"equirectangular\")"
+                                ),
+                            ));
+                        }
+                    },
+                    "realistic" => {
+                        self.warn(
+                            "camera-type",
+                            &loc,
+                            "camera \"realistic\" (lens system) approximated by a thin-lens perspective camera of the same 'lensradius'/'focaldistance' (fov 90)".into(),
+                        );
+                        for p in ["lensfile", "aperturediameter", "focusdistance", "aperture"] {
+                            let _ = ps.find(p);
+                        }
+                        Projection::Perspective
+                    }
+                    other => {
+                        return Err(err_at(
+                            &tloc,
+                            format!(
+                                "unknown camera \"{other}\" (expected perspective, orthographic, spherical or realistic)"
+                            ),
+                        ));
+                    }
+                };
                 let fov = ps.float("fov", 90.0)?;
                 if !(fov > 0.0 && fov < 180.0) {
                     return Err(err_at(
@@ -553,25 +615,68 @@ impl Parser {
                         ));
                     }
                 };
-                if ps.float("lensradius", 0.0)? > 0.0 {
-                    self.warn(
-                        "lensradius",
+                let lens = Lens {
+                    radius: ps.float("lensradius", 0.0)?,
+                    focal_distance: ps.float("focaldistance", 1e6)?,
+                };
+                if !(lens.radius >= 0.0 && lens.radius.is_finite()) {
+                    return Err(err_at(
                         &loc,
-                        "Camera 'lensradius' ignored (pinhole camera)".into(),
+                        format!("Camera: lensradius must be ≥ 0, found {}", lens.radius),
+                    ));
+                }
+                if lens.radius > 0.0
+                    && !(lens.focal_distance > 0.0 && lens.focal_distance.is_finite())
+                {
+                    return Err(err_at(
+                        &loc,
+                        format!(
+                            "Camera: focaldistance must be positive, found {}",
+                            lens.focal_distance
+                        ),
+                    ));
+                }
+                if matches!(projection, Projection::Spherical(_)) && lens.radius > 0.0 {
+                    self.warn(
+                        "spherical-lens",
+                        &loc,
+                        "spherical camera: 'lensradius' ignored (pbrt-v4 ignores it too)".into(),
                     );
                 }
+                // pbrt-v4: 'frameaspectratio' replaces the image's aspect ratio in the default
+                // screen window.
+                let sw = match (sw, ps.opt_float("frameaspectratio")?) {
+                    (None, Some(frame)) if frame > 0.0 && frame.is_finite() => {
+                        Some(if frame > 1.0 {
+                            [-frame, frame, -1.0, 1.0]
+                        } else {
+                            [-1.0, 1.0, -1.0 / frame, 1.0 / frame]
+                        })
+                    }
+                    (None, Some(frame)) => {
+                        return Err(err_at(
+                            &loc,
+                            format!("Camera: frameaspectratio must be positive, found {frame}"),
+                        ));
+                    }
+                    (sw, _) => sw,
+                };
                 let (open, close) = (
                     ps.float("shutteropen", 0.0)?,
                     ps.float("shutterclose", 1.0)?,
                 );
                 self.camera_exposure = close - open;
-                let _ = ps.find("focaldistance");
-                let _ = ps.find("frameaspectratio");
                 self.report_unused(&ps, "Camera");
                 // The CTM here is camera-from-world.
                 let world_from_camera = self.gs.ctm.inverse();
                 self.named_coords.insert("camera".into(), world_from_camera);
-                self.camera = Some((world_from_camera, fov, sw));
+                self.camera = Some(Camera {
+                    camera_to_world: world_from_camera,
+                    fov_deg: fov,
+                    screen_window: sw,
+                    projection,
+                    lens,
+                });
             }
             "Film" => {
                 self.require_world(name, &loc, false)?;
@@ -642,34 +747,63 @@ impl Parser {
             }
             "PixelFilter" => {
                 self.require_world(name, &loc, false)?;
-                let (ty, _) = self.expect_string("a filter type")?;
+                let (ty, tloc) = self.expect_string("a filter type")?;
                 let mut ps = self.params()?;
                 upgrade::filter(&ty, &mut ps);
                 let default_r = match ty.as_str() {
                     "box" => 0.5,
-                    "triangle" => 2.0,
                     "gaussian" => 1.5,
-                    "mitchell" => 2.0,
+                    "mitchell" | "triangle" => 2.0,
                     _ => 4.0,
                 };
                 let r = Vec2::new(
                     ps.float("xradius", default_r)?,
                     ps.float("yradius", default_r)?,
                 );
-                if !(r.x > 0.0 && r.y > 0.0) {
+                if !(r.x > 0.0 && r.y > 0.0 && r.is_finite()) {
                     return Err(err_at(&loc, "PixelFilter: radius must be positive"));
                 }
-                self.out.film.filter = match ty.as_str() {
-                    "box" => Filter::Box { radius: r },
-                    "triangle" => Filter::Triangle { radius: r },
-                    other => {
-                        self.warn("filter", &loc, format!("PixelFilter \"{other}\" approximated by a triangle filter of the same radius"));
-                        Filter::Triangle { radius: r }
+                let positive = |v: f32, what: &str| {
+                    if v > 0.0 && v.is_finite() {
+                        Ok(v)
+                    } else {
+                        Err(err_at(
+                            &loc,
+                            format!(
+                                "PixelFilter \"{ty}\": expected a positive '{what}', found {v}"
+                            ),
+                        ))
                     }
                 };
-                for p in ["sigma", "B", "C", "tau"] {
-                    let _ = ps.find(p);
-                }
+                let filter = match ty.as_str() {
+                    "box" => Filter::Box { radius: r },
+                    "triangle" => Filter::Triangle { radius: r },
+                    "gaussian" => Filter::Gaussian {
+                        radius: r,
+                        sigma: positive(ps.float("sigma", 0.5)?, "sigma")?,
+                    },
+                    "mitchell" => Filter::Mitchell {
+                        radius: r,
+                        b: ps.float("B", 1.0 / 3.0)?,
+                        c: ps.float("C", 1.0 / 3.0)?,
+                    },
+                    "sinc" => Filter::Sinc {
+                        radius: r,
+                        tau: positive(ps.float("tau", 3.0)?, "tau")?,
+                    },
+                    other => {
+                        return Err(err_at(
+                            &tloc,
+                            format!(
+                                "unknown PixelFilter \"{other}\" (expected box, gaussian, mitchell, sinc or triangle)"
+                            ),
+                        ));
+                    }
+                };
+                // A filter whose integral is not positive cannot normalise a pixel.
+                crate::integrator::film::FilterSampler::new(&filter)
+                    .map_err(|e| err_at(&loc, e))?;
+                self.out.film.filter = filter;
                 self.report_unused(&ps, "PixelFilter");
             }
             "Integrator" => {
@@ -681,7 +815,9 @@ impl Parser {
                 self.out.max_depth = Some(max_depth);
                 // pbrt-v4's light samplers are penumbra's selectors of the same names.
                 let light_selection = match ps.string("lightsampler")?.as_deref() {
-                    Some(s @ ("uniform" | "power" | "bvh")) => Some(s.to_string()),
+                    Some("uniform") => Some(crate::light_selection::SelectorKind::Uniform),
+                    Some("power") => Some(crate::light_selection::SelectorKind::Power),
+                    Some("bvh") => Some(crate::light_selection::SelectorKind::Bvh),
                     Some(other) => {
                         self.warn("lightsampler", &loc, format!("lightsampler \"{other}\" unknown: light selection by the --light-selection default"));
                         None
@@ -979,6 +1115,21 @@ impl Parser {
             );
             return Ok(());
         };
+        if !matches!(geom, super::shapes::ShapeGeom::Mesh(_))
+            && matches!(
+                self.out.materials.get(material as usize),
+                Some(MaterialDesc::Varying {
+                    normal: Some(_),
+                    ..
+                })
+            )
+        {
+            self.warn(
+                "normalmap-quadric",
+                loc,
+                format!("normal and bump maps on a \"{ty}\" are ignored (triangle meshes only)"),
+            );
+        }
         let emission = self.gs.area.as_ref().map(|a| AreaEmission {
             l: a.radiance_for_area(geom.area()),
             two_sided: a.two_sided,

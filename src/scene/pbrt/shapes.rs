@@ -285,6 +285,10 @@ pub fn make_shape(
                 None => return Ok(None),
             }
         }
+        "loopsubdiv" => match loop_subdiv_shape(params, ctx, warn)? {
+            Some(m) => ShapeGeom::Mesh(m),
+            None => return Ok(None),
+        },
         "bilinearmesh" => {
             let (p, n, uv) = mesh_attrs(params, loc)?;
             let quads = indices_param(params, "indices", p.len(), 4, loc)?;
@@ -411,6 +415,98 @@ pub fn make_shape(
             return Ok(None);
         }
     }))
+}
+
+/// Most triangles `loopsubdiv` may make (4^levels per control triangle): 2^24 (about 1.5 GB
+/// of mesh); more levels are reduced to fit, with a warning.
+const LOOP_MAX_TRIANGLES: usize = 1 << 24;
+
+/// pbrt-v4's `loopsubdiv`: `levels` (default 3) of Loop subdivision of `P`/`indices`, at the
+/// limit surface with its normals (uvs are dropped, as pbrt-v4 does). Triangles that repeat a
+/// vertex are dropped; a mesh the rules cannot subdivide (not a consistently oriented
+/// manifold) is rendered as its control mesh; both with a warning.
+fn loop_subdiv_shape(
+    params: &ParamSet,
+    ctx: &ShapeCtx,
+    warn: &mut Warn,
+) -> anyhow::Result<Option<TriangleMesh>> {
+    let loc = ctx.loc;
+    let p = params
+        .point3s("P")?
+        .ok_or_else(|| err_at(loc, "loopsubdiv: expected \"point3 P\", found none"))?;
+    let mut indices = indices_param(params, "indices", p.len(), 3, loc)?;
+    if !indices.len().is_multiple_of(3) {
+        return Err(err_at(
+            loc,
+            format!(
+                "loopsubdiv: expected a multiple of 3 indices, found {}",
+                indices.len()
+            ),
+        ));
+    }
+    let levels = params.int("levels", 3)?;
+    if levels < 0 {
+        return Err(err_at(
+            loc,
+            format!("loopsubdiv: 'levels' must be ≥ 0, found {levels}"),
+        ));
+    }
+    for ignored in ["uv", "st", "N"] {
+        let _ = params.find(ignored);
+    }
+    let before = indices.len();
+    let tris: Vec<u32> = indices
+        .chunks_exact(3)
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
+        .flatten()
+        .copied()
+        .collect();
+    if tris.len() != before {
+        warn(
+            &format!("loopsubdiv-degenerate@{}", loc.file_line()),
+            loc,
+            format!(
+                "loopsubdiv: {} triangles that repeat a vertex dropped",
+                (before - tris.len()) / 3
+            ),
+        );
+    }
+    indices = tris;
+    let mut levels = levels.min(16) as u32;
+    while levels > 0 && (indices.len() / 3) << (2 * levels) > LOOP_MAX_TRIANGLES {
+        levels -= 1;
+    }
+    if levels < params.int("levels", 3)?.min(16) as u32 {
+        warn(
+            &format!("loopsubdiv-levels@{}", loc.file_line()),
+            loc,
+            format!(
+                "loopsubdiv: 'levels' reduced to {levels} (at most {LOOP_MAX_TRIANGLES} triangles)"
+            ),
+        );
+    }
+    let raw = match crate::scene::loop_subdiv::loop_subdivide(&p, &indices, levels) {
+        Ok(m) => RawMesh {
+            positions: m.positions,
+            normals: Some(m.normals),
+            uvs: None,
+            indices: m.indices,
+        },
+        Err(why) => {
+            warn(
+                &format!("loopsubdiv-manifold@{}", loc.file_line()),
+                loc,
+                format!("loopsubdiv: {why}; rendered as the unsubdivided control mesh"),
+            );
+            RawMesh {
+                positions: p,
+                normals: None,
+                uvs: None,
+                indices,
+            }
+        }
+    };
+    finish_mesh(raw, ctx, "loopsubdiv", warn)
 }
 
 /// The shape's `"float alpha"` / `"texture alpha"` cut-out (pbrt-v4: none when the coverage is

@@ -1,10 +1,11 @@
-//! `Texture` directive: `imagemap`, `constant`, `scale`, `checkerboard` (spectrum and float).
+//! `Texture` directive: `imagemap`, `constant`, `scale`, `checkerboard` (spectrum) and
+//! `imagemap`, `constant`, `scale` (float), with pbrt-v4's `encoding`, `scale` and `invert`.
 
 use super::params::{ParamSet, ParamType};
 use super::spectra::{SpectrumUse, to_rgb};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
-use crate::material::texture::ImageRgb;
+use crate::material::texture::{ImageRgb, UvMap};
 use glam::Vec2;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -28,12 +29,115 @@ pub fn load_image(cache: &mut ImageCache, path: &Path, loc: &Loc) -> anyhow::Res
     Ok(rgb)
 }
 
+/// How an 8-bit image's code values become texture values (pbrt-v4's `encoding`; float
+/// formats — EXR, PFM, HDR — are linear whatever it says).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Encoding {
+    /// The sRGB transfer curve (pbrt-v4's default for PNG).
+    SRgb,
+    /// Code value / 255 (pbrt-v4's default for other 8-bit formats).
+    Linear,
+    /// (code value / 255)^γ.
+    Gamma(f32),
+}
+
+impl Encoding {
+    /// pbrt-v4's `"string encoding"` of an image texture, defaulting by file type.
+    pub fn parse(params: &ParamSet, path: &Path, loc: &Loc) -> anyhow::Result<Self> {
+        let png = crate::image::io::extension(path) == "png";
+        let Some(e) = params.string("encoding")? else {
+            return Ok(if png { Self::SRgb } else { Self::Linear });
+        };
+        let eloc = params.loc_of("encoding").unwrap_or(loc.clone());
+        if e == "sRGB" {
+            return Ok(Self::SRgb);
+        }
+        if e == "linear" {
+            return Ok(Self::Linear);
+        }
+        if let Some(g) = e.strip_prefix("gamma ")
+            && let Ok(g) = g.trim().parse::<f32>()
+            && g > 0.0
+            && g.is_finite()
+        {
+            return Ok(Self::Gamma(g));
+        }
+        Err(err_at(
+            &eloc,
+            format!(
+                "unknown encoding \"{e}\" (expected \"sRGB\", \"linear\" or \"gamma <positive γ>\")"
+            ),
+        ))
+    }
+
+    /// Re-encode an image that the reader decoded as sRGB (8-bit formats) or read as linear
+    /// (float formats) so its values follow this encoding.
+    pub fn apply(self, path: &Path, img: &Arc<ImageRgb>) -> Arc<ImageRgb> {
+        let ext = crate::image::io::extension(path);
+        if self == Self::SRgb || matches!(ext.as_str(), "exr" | "pfm" | "hdr") {
+            return img.clone();
+        }
+        let code = |v: f32| crate::image::io::linear_to_srgb(v.clamp(0.0, 1.0));
+        let f = |v: f32| match self {
+            Self::Gamma(g) => code(v).powf(g),
+            _ => code(v),
+        };
+        let mut out = (**img).clone();
+        for p in &mut out.pixels {
+            *p = Rgb::new(f(p.x), f(p.y), f(p.z));
+        }
+        Arc::new(out)
+    }
+}
+
+/// A float texture as the scene describes it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FloatTexDesc {
+    /// The same value everywhere.
+    Constant(f32),
+    /// An image's first channel times `scale`, optionally inverted (max(0, 1 − v)).
+    Image {
+        /// Resolved path (loaded while parsing).
+        path: PathBuf,
+        /// Multiplier (before the inversion).
+        scale: f32,
+        /// pbrt's `invert`.
+        invert: bool,
+        /// pbrt's `encoding`.
+        encoding: Encoding,
+    },
+    /// Product (pbrt's float `scale` texture with a varying factor).
+    Product(Box<FloatTexDesc>, Box<FloatTexDesc>),
+    /// Looked up through a uv mapping.
+    Mapped(UvMap, Box<FloatTexDesc>),
+}
+
+impl FloatTexDesc {
+    /// The value if it is the same everywhere.
+    pub fn constant(&self) -> Option<f32> {
+        match self {
+            Self::Constant(v) => Some(*v),
+            Self::Product(a, b) => Some(a.constant()? * b.constant()?),
+            Self::Image { .. } => None,
+            Self::Mapped(_, t) => t.constant(),
+        }
+    }
+
+    /// The product of two float textures, folded when both are constant.
+    pub fn times(self, other: Self) -> Self {
+        match (self.constant(), other.constant()) {
+            (Some(a), Some(b)) => Self::Constant(a * b),
+            _ => Self::Product(Box::new(self), Box::new(other)),
+        }
+    }
+}
+
 /// A spectrum texture as the scene describes it (images are loaded at conversion).
 #[derive(Clone, Debug, PartialEq)]
 pub enum TextureDesc {
     /// The same colour everywhere.
     Constant(Rgb),
-    /// An image file times `scale` (optionally inverted: 1 − value).
+    /// An image file times `scale` (optionally inverted: max(0, 1 − scale·value)).
     Image {
         /// Resolved path (checked to exist while parsing).
         path: PathBuf,
@@ -41,7 +145,13 @@ pub enum TextureDesc {
         scale: Rgb,
         /// pbrt's `invert`.
         invert: bool,
+        /// pbrt's `encoding`.
+        encoding: Encoding,
     },
+    /// The product of two textures.
+    Product(Box<TextureDesc>, Box<TextureDesc>),
+    /// A float texture as a grey colour.
+    Float(FloatTexDesc),
     /// pbrt's 2D checkerboard: `a` where ⌊u·fu⌋ + ⌊v·fv⌋ is even.
     Checkerboard {
         /// tex1
@@ -51,26 +161,37 @@ pub enum TextureDesc {
         /// (uscale, vscale)
         freq: Vec2,
     },
+    /// Looked up through a uv mapping.
+    Mapped(UvMap, Box<TextureDesc>),
 }
 
 impl TextureDesc {
     fn scaled(self, s: Rgb) -> Self {
         match self {
             Self::Constant(c) => Self::Constant(c * s),
+            // pbrt-v4 inverts after scaling: an inverted map's outer scale cannot fold in.
             Self::Image {
                 path,
                 scale,
-                invert,
+                invert: false,
+                encoding,
             } => Self::Image {
                 path,
                 scale: scale * s,
-                invert,
+                invert: false,
+                encoding,
             },
+            t if s == Rgb::ONE => t,
+            t @ (Self::Image { .. } | Self::Float(_)) => {
+                Self::Product(Box::new(t), Box::new(Self::Constant(s)))
+            }
+            Self::Product(a, b) => Self::Product(Box::new(a.scaled(s)), b),
             Self::Checkerboard { a, b, freq } => Self::Checkerboard {
                 a: a * s,
                 b: b * s,
                 freq,
             },
+            Self::Mapped(m, t) => Self::Mapped(m, Box::new(t.scaled(s))),
         }
     }
 }
@@ -80,8 +201,9 @@ impl TextureDesc {
 pub struct TextureTable {
     /// Spectrum textures.
     pub spectrum: HashMap<String, TextureDesc>,
-    /// Float textures: `Some(v)` when constant, `None` when varying (unsupported for floats).
-    pub float: HashMap<String, Option<f32>>,
+    /// Float textures: `None` for a class penumbra does not implement (warned at definition;
+    /// a parameter naming it takes its default).
+    pub float: HashMap<String, Option<FloatTexDesc>>,
     /// Every image loaded so far (textures and environment maps).
     pub images: ImageCache,
 }
@@ -117,8 +239,8 @@ impl TextureTable {
         }
     }
 
-    /// A float param that may be a texture reference; varying float textures warn and use
-    /// `default`.
+    /// A float param that may be a texture reference, where penumbra needs one value: varying
+    /// textures warn and use `default`.
     pub fn float_param(
         &self,
         params: &ParamSet,
@@ -126,28 +248,103 @@ impl TextureTable {
         default: f32,
         warn: &mut Warn,
     ) -> anyhow::Result<f32> {
+        let t = self.float_texture_param(params, name, default, warn)?;
+        match t.constant() {
+            Some(v) => Ok(v),
+            None => {
+                let loc = params.loc_of(name).expect("a varying texture was named");
+                warn(
+                    &format!("float-texture-{name}"),
+                    &loc,
+                    format!(
+                        "varying float texture for '{name}' is not supported there; using {default}"
+                    ),
+                );
+                Ok(default)
+            }
+        }
+    }
+
+    /// A float param that may be a texture reference (constant or varying).
+    pub fn float_texture_param(
+        &self,
+        params: &ParamSet,
+        name: &str,
+        default: f32,
+        warn: &mut Warn,
+    ) -> anyhow::Result<FloatTexDesc> {
         if params.type_of(name) == Some(ParamType::Texture) {
             let tex = params.texture(name)?.unwrap_or_default();
             let loc = params.loc_of(name).expect("present");
             return match self.float.get(&tex) {
-                Some(Some(v)) => Ok(*v),
+                Some(Some(t)) => Ok(t.clone()),
                 Some(None) => {
                     warn(
-                        "float-texture",
+                        "float-texture-class",
                         &loc,
                         format!(
-                            "varying float texture \"{tex}\" for '{name}' is not supported; using {default}"
+                            "float texture \"{tex}\" for '{name}' is of an unsupported class; using {default}"
                         ),
                     );
-                    Ok(default)
+                    Ok(FloatTexDesc::Constant(default))
                 }
+                None if self.spectrum.contains_key(&tex) => Err(err_at(
+                    &loc,
+                    format!("'{name}': expected a float texture, found spectrum texture \"{tex}\""),
+                )),
                 None => Err(err_at(
                     &loc,
                     format!("'{name}': unknown float texture \"{tex}\""),
                 )),
             };
         }
-        params.float(name, default)
+        Ok(FloatTexDesc::Constant(params.float(name, default)?))
+    }
+
+    /// Load an `imagemap` texture's file (cached): its path and encoding.
+    fn image_file(
+        &mut self,
+        params: &ParamSet,
+        dir: &Path,
+        loc: &Loc,
+        warn: &mut Warn,
+    ) -> anyhow::Result<(PathBuf, Encoding)> {
+        let file = params.string("filename")?.ok_or_else(|| {
+            err_at(
+                loc,
+                "imagemap texture: expected \"string filename\", found none",
+            )
+        })?;
+        let path = resolve(dir, &file);
+        if let Some(why) = crate::image::io::not_a_file(&path) {
+            return Err(err_at(
+                params.loc_of("filename").as_ref().unwrap_or(loc),
+                format!("imagemap texture: {why}: {}", path.display()),
+            ));
+        }
+        let floc = params.loc_of("filename").unwrap_or(loc.clone());
+        load_image(&mut self.images, &path, &floc)?;
+        if let Some(w) = params.string("wrap")?
+            && w != "repeat"
+        {
+            warn(
+                "texture-wrap",
+                params.loc_of("wrap").as_ref().unwrap_or(loc),
+                format!("image texture wrap mode \"{w}\" approximated by \"repeat\""),
+            );
+        }
+        if let Some(f) = params.string("filter")?
+            && f != "bilinear"
+        {
+            warn(
+                "texture-filter",
+                params.loc_of("filter").as_ref().unwrap_or(loc),
+                format!(
+                    "image texture filter \"{f}\" approximated by \"bilinear\" (no MIP-mapping)"
+                ),
+            );
+        }
+        Ok((path, Encoding::parse(params, &resolve(dir, &file), loc)?))
     }
 
     /// Parse a `Texture "name" "spectrum"|"float" "class" params` directive and store it.
@@ -172,29 +369,55 @@ impl TextureTable {
                 format!("texture mapping \"{m}\" approximated by uv"),
             );
         }
-        for ignored in [
-            "filter",
-            "wrap",
-            "encoding",
-            "maxanisotropy",
-            "udelta",
-            "vdelta",
-            "dimension",
-        ] {
+        for ignored in ["maxanisotropy", "dimension"] {
             let _ = params.find(ignored);
         }
+        // pbrt-v4's uv mapping of the classes that have one (checkerboard's scale is its
+        // square frequency below; its offset is mapped here).
+        let mapped = matches!(class, "imagemap" | "checkerboard");
+        let map = if mapped {
+            let scale = Vec2::new(params.float("uscale", 1.0)?, params.float("vscale", 1.0)?);
+            let delta = Vec2::new(params.float("udelta", 0.0)?, params.float("vdelta", 0.0)?);
+            if class == "checkerboard" {
+                // floor(s·u + d) = floor(s·(u + d/s)): the offset goes before the squares'
+                // frequency (a zero frequency makes one square whatever the offset).
+                let d = |d: f32, s: f32| if s == 0.0 { 0.0 } else { d / s };
+                UvMap {
+                    scale: Vec2::ONE,
+                    delta: Vec2::new(d(delta.x, scale.x), d(delta.y, scale.y)),
+                }
+            } else {
+                UvMap { scale, delta }
+            }
+        } else {
+            UvMap::IDENTITY
+        };
         match ty {
             "spectrum" | "color" => {
                 let d = self.spectrum_texture(class, params, dir, loc, warn)?;
+                let d = if map == UvMap::IDENTITY {
+                    d
+                } else {
+                    TextureDesc::Mapped(map, Box::new(d))
+                };
                 self.spectrum.insert(name.to_string(), d);
             }
             "float" => {
                 let v = match class {
-                    "constant" => Some(params.float("value", 1.0)?),
+                    "constant" => Some(FloatTexDesc::Constant(params.float("value", 1.0)?)),
                     "scale" => {
-                        let t = self.float_param(params, "tex", 1.0, warn)?;
-                        let s = self.float_param(params, "scale", 1.0, warn)?;
-                        Some(t * s)
+                        let t = self.float_texture_param(params, "tex", 1.0, warn)?;
+                        let s = self.float_texture_param(params, "scale", 1.0, warn)?;
+                        Some(t.times(s))
+                    }
+                    "imagemap" => {
+                        let (path, encoding) = self.image_file(params, dir, loc, warn)?;
+                        Some(FloatTexDesc::Image {
+                            path,
+                            scale: params.float("scale", 1.0)?,
+                            invert: params.bool("invert", false)?,
+                            encoding,
+                        })
                     }
                     _ => {
                         warn(
@@ -204,6 +427,12 @@ impl TextureTable {
                         );
                         None
                     }
+                };
+                let v = match v {
+                    Some(t) if map != UvMap::IDENTITY => {
+                        Some(FloatTexDesc::Mapped(map, Box::new(t)))
+                    }
+                    v => v,
                 };
                 self.float.insert(name.to_string(), v);
             }
@@ -251,34 +480,23 @@ impl TextureTable {
                 TextureDesc::Constant(self.const_spectrum(params, "value", Rgb::ONE, loc, warn)?)
             }
             "imagemap" => {
-                let file = params.string("filename")?.ok_or_else(|| {
-                    err_at(
-                        loc,
-                        "imagemap texture: expected \"string filename\", found none",
-                    )
-                })?;
-                let path = resolve(dir, &file);
-                if let Some(why) = crate::image::io::not_a_file(&path) {
-                    return Err(err_at(
-                        params.loc_of("filename").as_ref().unwrap_or(loc),
-                        format!("imagemap texture: {why}: {}", path.display()),
-                    ));
-                }
-                let floc = params.loc_of("filename").unwrap_or(loc.clone());
-                load_image(&mut self.images, &path, &floc)?;
+                let (path, encoding) = self.image_file(params, dir, loc, warn)?;
                 let scale = params.float("scale", 1.0)?;
                 TextureDesc::Image {
                     path,
                     scale: Rgb::splat(scale),
                     invert: params.bool("invert", false)?,
+                    encoding,
                 }
             }
             "scale" => {
                 let base = self
                     .spectrum_param(params, "tex", Some(Rgb::ONE))?
                     .unwrap_or(TextureDesc::Constant(Rgb::ONE));
-                let s = self.float_param(params, "scale", 1.0, warn)?;
-                base.scaled(Rgb::splat(s))
+                match self.float_texture_param(params, "scale", 1.0, warn)? {
+                    FloatTexDesc::Constant(s) => base.scaled(Rgb::splat(s)),
+                    by => TextureDesc::Product(Box::new(base), Box::new(TextureDesc::Float(by))),
+                }
             }
             "checkerboard" => {
                 if params.int("dimension", 2)? != 2 {

@@ -1,0 +1,72 @@
+//! Normal and bump maps at camera-ray hits: the shading normal of a hit whose material has one
+//! is replaced before the shading frame is built (pbrt-v4's `NormalMap` / `BumpMap`), from the
+//! hit triangle's ∂p/∂u, ∂p/∂v. Hits on spheres and disks keep their normal (the parser warns).
+
+use super::Scene;
+use crate::geometry::{HitColumns, PrimKind, SurfaceHit};
+use glam::{Vec2, Vec3};
+
+/// ∂p/∂u and ∂p/∂v of triangle `p` with texture coordinates `uv` (pbrt-v4's triangle
+/// derivatives, made perpendicular to the shading normal `ns` when the mesh has vertex
+/// normals); `None` when the uvs are degenerate.
+fn triangle_derivatives(
+    p: [Vec3; 3],
+    uv: [Vec2; 3],
+    ns: Vec3,
+    smooth: bool,
+) -> Option<(Vec3, Vec3)> {
+    let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
+    let (dp02, dp12) = (p[0] - p[2], p[1] - p[2]);
+    let det = duv02.x * duv12.y - duv02.y * duv12.x;
+    if !(det.abs() > 1e-12) {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let dpdu = (dp02 * duv12.y - dp12 * duv02.y) * inv;
+    let dpdv = (dp12 * duv02.x - dp02 * duv12.x) * inv;
+    if !smooth {
+        return Some((dpdu, dpdv));
+    }
+    // pbrt-v4's shading frame of a mesh with normals: ts = ns × ∂p/∂u, ss = ts × ns.
+    let ts = ns.cross(dpdu);
+    if ts.length_squared() == 0.0 {
+        return None;
+    }
+    Some((ts.cross(ns), ts))
+}
+
+/// Replace the shading normals of the hits (and their packet columns) whose material has a
+/// normal or bump map.
+pub fn perturb_hits(scene: &Scene, hits: &mut [Option<SurfaceHit>], cols: &mut HitColumns) {
+    for (k, h) in hits.iter_mut().enumerate() {
+        let Some(hit) = h else { continue };
+        let Some(pert) = scene
+            .materials
+            .get(hit.material as usize)
+            .and_then(|m| m.normal_perturbation())
+        else {
+            continue;
+        };
+        let Some(prim) = scene.geometry.primitive(hit.prim) else {
+            continue;
+        };
+        let PrimKind::Triangle { mesh, v } = prim.kind else {
+            continue;
+        };
+        let m = &scene.geometry.meshes[mesh as usize];
+        let uv = match &m.uvs {
+            Some(uv) => v.map(|i| uv[i as usize]),
+            // pbrt-v4's default parameterisation.
+            None => [Vec2::ZERO, Vec2::new(1.0, 0.0), Vec2::ONE],
+        };
+        let Some((dpdu, dpdv)) = triangle_derivatives(prim.p, uv, hit.ns, m.normals.is_some())
+        else {
+            continue;
+        };
+        let ns = pert.shading_normal(hit.uv, hit.ns, hit.ng, dpdu, dpdv);
+        hit.ns = ns;
+        for a in 0..3 {
+            cols.ns[a][k] = ns[a];
+        }
+    }
+}
