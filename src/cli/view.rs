@@ -29,7 +29,7 @@ use penumbra::image::Image;
 use penumbra::image::colormap::viridis;
 use penumbra::image::io::{encode_png, read_image, srgb_to_linear, to_rgb8};
 use penumbra::image::metrics::{compare, error_image};
-use penumbra::integrator::{MisHeuristic, RenderOptions, Strategy};
+use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy};
 use penumbra::light_selection::{SelectorKind, ShadingPoint, make_selector};
 use penumbra::progressive::{Accumulator, PassPolicy, render_passes};
 use penumbra::sampling::PatternKind;
@@ -77,6 +77,9 @@ struct Settings {
     bsdf_sampling: LobeSampling,
     spp: u32,
     shadow_rays: u32,
+    integrator: IntegratorKind,
+    max_depth: u32,
+    roulette: bool,
 }
 
 impl Settings {
@@ -90,6 +93,8 @@ impl Settings {
             "bsdf_sampling": lobe_name(self.bsdf_sampling),
             "spp": self.spp,
             "shadow_rays": self.shadow_rays,
+            "integrator": self.integrator.name(),
+            "max_depth": self.max_depth,
         })
     }
 
@@ -118,6 +123,15 @@ impl Settings {
                 return Err(format!("spp must be between 1 and {MAX_SPP}, got {n}"));
             }
             self.spp = n;
+        }
+        if let Some(s) = &body.integrator {
+            self.integrator = s.parse()?;
+        }
+        if let Some(n) = body.max_depth {
+            if !(1..=1024).contains(&n) {
+                return Err(format!("max_depth must be between 1 and 1024, got {n}"));
+            }
+            self.max_depth = n;
         }
         if let Some(n) = body.shadow_rays {
             if !(1..=1024).contains(&n) {
@@ -152,6 +166,8 @@ struct Change {
     bsdf_sampling: Option<String>,
     spp: Option<u32>,
     shadow_rays: Option<u32>,
+    integrator: Option<String>,
+    max_depth: Option<u32>,
 }
 
 /// The latest completed pass of a channel.
@@ -210,13 +226,23 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     );
     anyhow::ensure!(r.spp != Some(0), "--spp must be at least 1");
     anyhow::ensure!(r.threads != Some(0), "--threads must be at least 1");
-    // `render`'s default: a scene file's lightsampler, else the default selector.
-    let light_selection = r.light_selection.unwrap_or(SelectorKind::DEFAULT);
     let loaded = load(&r.scene, &load_options(r))?;
     for w in &loaded.warnings {
         eprintln!("{}", messages::format_warning(w));
     }
     let scene = loaded.scene;
+    // `render`'s defaults: the flags, else the scene file's `Integrator`, else direct lighting
+    // with the default selector.
+    let file = scene.integrator.as_ref();
+    let light_selection = r
+        .light_selection
+        .or_else(|| file.and_then(|i| i.light_selection))
+        .unwrap_or(SelectorKind::DEFAULT);
+    let integrator = r
+        .integrator
+        .or(file.map(|i| i.kind))
+        .unwrap_or(IntegratorKind::Direct);
+    let max_depth = r.max_depth.or(file.map(|i| i.max_depth)).unwrap_or(5);
     let res = r.res.unwrap_or(scene.film.resolution);
     let reference = match &args.reference {
         Some(p) => {
@@ -246,6 +272,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bsdf_sampling: r.bsdf_sampling,
         spp,
         shadow_rays: r.shadow_rays,
+        integrator,
+        max_depth,
+        roulette: !r.no_roulette,
     };
     let pool = match r.threads {
         Some(t) => Some(
@@ -323,6 +352,9 @@ fn restart(shared: &Arc<Shared>, ch: usize) {
             pattern: s.pattern,
             light_selection: s.light_selection,
             bsdf_sampling: s.bsdf_sampling,
+            integrator: s.integrator,
+            max_depth: s.max_depth,
+            roulette: s.roulette,
             ..RenderOptions::default()
         };
         (opts, c.generation, Arc::clone(&c.cancel))
@@ -555,6 +587,7 @@ fn state(shared: &Shared) -> serde_json::Value {
             "pattern": PatternKind::ALL.iter().map(|p| p.name()).collect::<Vec<_>>(),
             "mis": ["power", "balance"],
             "bsdf_sampling": ["importance", "cosine", "uniform"],
+            "integrator": ["direct", "path"],
         },
     })
 }
