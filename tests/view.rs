@@ -101,13 +101,15 @@ fn endpoints_answer_and_bad_requests_are_400_with_a_reason() {
     let r = post(
         &v.addr,
         "/api/render",
-        r#"{"channel":"b","strategy":"bsdf","light_selection":"power","spp":64}"#,
+        r#"{"channel":"b","strategy":"bsdf","light_selection":"power","spp":64,"integrator":"path","max_depth":2}"#,
     );
     assert_eq!(r.status, 200, "{}", r.text());
     let b = &r.json()["channels"]["b"];
     assert_eq!(b["enabled"], true);
     assert_eq!(b["settings"]["strategy"], "bsdf");
     assert_eq!(b["settings"]["light_selection"], "power");
+    assert_eq!(b["settings"]["integrator"], "path");
+    assert_eq!(b["settings"]["max_depth"], 2);
     let done = wait_state(&v.addr, LIMIT, "B done", |s| {
         s["channels"]["b"]["done"] == true
     });
@@ -174,6 +176,18 @@ fn endpoints_answer_and_bad_requests_are_400_with_a_reason() {
             "/api/render",
             r#"{"channel":"a","light_selection":"x"}"#,
             "unknown light selection 'x'",
+        ),
+        (
+            "POST",
+            "/api/render",
+            r#"{"channel":"a","integrator":"x"}"#,
+            "x",
+        ),
+        (
+            "POST",
+            "/api/render",
+            r#"{"channel":"a","max_depth":0}"#,
+            "max_depth must be between 1 and 1024",
         ),
         (
             "POST",
