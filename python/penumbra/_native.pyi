@@ -38,7 +38,7 @@ class Scene:
         shadow_rays: int = 1,
         strategy: str = "mis",
         mis: str = "power",
-        light_selection: str = "uniform",
+        light_selection: str = "bvh",
         pattern: str = "stratified",
         integrator: str = "direct",
         max_depth: Optional[int] = None,

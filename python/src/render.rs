@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use penumbra::bsdf::LobeSampling;
 use penumbra::image::Image;
 use penumbra::integrator::{MisHeuristic, RenderOptions, Strategy, render};
-use penumbra::light_selection::SELECTORS;
+use penumbra::light_selection::SelectorKind;
 use penumbra::lights::SamplingMode;
 use penumbra::sampling::PatternKind;
 use penumbra::scene::builtin::{self, BuiltinOptions};
@@ -156,8 +156,8 @@ impl Scene {
     ///
     /// Arguments are the CLI's `render` flags: `spp` eye rays per pixel (default: the
     /// scene's, else 64), `shadow_rays` per eye ray, `strategy` (bsdf, light-area,
-    /// light-solid-angle, mis), `mis` (power, balance), `light_selection` (uniform, power,
-    /// spatial, adaptive, wald, bvh, exhaustive), `pattern` (fixed, random, grid, stratified,
+    /// light-solid-angle, mis), `mis` (power, balance), `light_selection` (bvh, the
+    /// default, uniform, power, spatial, adaptive, wald, exhaustive), `pattern` (fixed, random, grid, stratified,
     /// lhs, sobol), `integrator` (direct), `max_depth` (path integrator only), `res` ((w, h)
     /// or "WxH"; default: the scene's), `seed`, `threads` (the image does not depend on it),
     /// `mis_light` (solid-angle, area), `bsdf_sampling` (importance, cosine, uniform).
@@ -168,7 +168,7 @@ impl Scene {
     /// The GIL is released while rendering; Ctrl-C stops the render and raises
     /// `KeyboardInterrupt`. A bad value raises `ValueError` listing the valid ones.
     #[pyo3(signature = (spp=None, shadow_rays=1, strategy="mis", mis="power",
-                        light_selection="uniform", pattern="stratified", integrator="direct",
+                        light_selection="bvh", pattern="stratified", integrator="direct",
                         max_depth=None, res=None, seed=0, threads=None, spp_range=None,
                         mis_light="solid-angle", bsdf_sampling="importance"))]
     #[allow(clippy::too_many_arguments)]
@@ -197,7 +197,6 @@ impl Scene {
                  this version)"
             )));
         }
-        one_of("light_selection", light_selection, SELECTORS)?;
         let spp = spp.or(self.scene.film.spp).unwrap_or(64);
         if spp == 0 || shadow_rays == 0 || threads == Some(0) {
             return Err(PyValueError::new_err(format!(
@@ -233,7 +232,7 @@ impl Scene {
             strategy: choice::<Strategy>("strategy", strategy)?,
             mis: choice::<MisHeuristic>("mis", mis)?,
             pattern: choice::<PatternKind>("pattern", pattern)?,
-            light_selection: light_selection.to_string(),
+            light_selection: choice::<SelectorKind>("light_selection", light_selection)?,
             mis_light,
             bsdf_sampling: choice::<LobeSampling>("bsdf_sampling", bsdf_sampling)?,
             progress: false,
