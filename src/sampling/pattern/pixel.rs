@@ -1,0 +1,379 @@
+//! The per-pixel cache: [`PixelSamples`] hashes the keys of one pixel's first [`CACHED_DIMS`]
+//! dimensions once, then evaluates each of those sample sets 16 consecutive indices at a time
+//! (integrators walk a pixel's indices in order), so most samples cost one compare and a load.
+//! Values are bit-identical to the pattern's `sample_1d` / `sample_2d` (tests/pat_golden.rs).
+
+use glam::{UVec2, Vec2};
+use std::cell::Cell;
+
+use super::avx512::RawSets;
+use super::fast::FastStrata;
+use super::sets::{SetKeys, Strata};
+use super::{CACHED_DIMS, Pattern, PatternKind, SamplePattern};
+use crate::isa::Isa;
+
+impl Pattern {
+    /// Whether [`PixelSamples`] of this pattern hold raw keys (see `PixelSamples::raw_mode`).
+    fn raw_mode(&self) -> bool {
+        cfg!(target_arch = "x86_64")
+            && self.kind == PatternKind::Stratified
+            && self.cpu.isa() == Isa::Avx512
+    }
+
+    /// The [`PixelSamples`] of `pixel` with these sets' keys and empty caches.
+    #[inline(always)]
+    pub(super) fn pixel_of_sets(
+        &self,
+        pixel: UVec2,
+        sets_1d: [SetKeys; CACHED_DIMS],
+        sets_2d: [SetKeys; CACHED_DIMS],
+    ) -> PixelSamples {
+        PixelSamples {
+            pattern: *self,
+            pixel,
+            sets_1d,
+            sets_2d,
+            raw_mode: self.raw_mode(),
+            raw: Default::default(),
+            learned: Default::default(),
+            strata: Cell::default(),
+            fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
+            chunks_1d: Default::default(),
+            chunks_2d: Default::default(),
+        }
+    }
+}
+
+/// Indices per [`Chunk`]: a sample set's values are computed this many at a time.
+pub(super) const CHUNK: usize = 16;
+
+/// Precomputed values of consecutive indices [base, base + len) of one sample set for one
+/// count: integrators walk a pixel's indices in order, so a batch evaluated in one tight loop
+/// (keys in registers, no per-call lookups) serves the next `len` requests with one compare.
+#[derive(Clone, Debug)]
+pub(super) struct Chunk<T: Copy> {
+    /// The count the values belong to.
+    count: Cell<u32>,
+    /// First index.
+    base: Cell<u32>,
+    /// Number of valid values (0 = empty).
+    len: Cell<u32>,
+    /// The values of indices base..base + len.
+    v: [Cell<T>; CHUNK],
+}
+
+impl<T: Copy + Default> Default for Chunk<T> {
+    fn default() -> Self {
+        Self {
+            count: Cell::new(0),
+            base: Cell::new(0),
+            len: Cell::new(0),
+            v: Default::default(),
+        }
+    }
+}
+
+impl<T: Copy> Chunk<T> {
+    /// The value of `index` of `count`, if this chunk holds it (hot path).
+    #[inline(always)]
+    fn get(&self, index: u32, count: u32) -> Option<T> {
+        let off = index.wrapping_sub(self.base.get());
+        if self.count.get() == count && off < self.len.get() {
+            return Some(self.v[off as usize % CHUNK].get());
+        }
+        None
+    }
+
+    /// Store the values `v` of the chunk of `index` (< count) and return `index`'s value.
+    #[inline(always)]
+    fn store(&self, index: u32, count: u32, v: &[T; CHUNK]) -> T {
+        let base = index & !(CHUNK as u32 - 1);
+        let len = (count - base).min(CHUNK as u32);
+        for (c, &x) in self.v.iter().zip(v) {
+            c.set(x);
+        }
+        self.count.set(count);
+        self.base.set(base);
+        self.len.set(len);
+        v[(index - base) as usize % CHUNK]
+    }
+
+    /// Whether this chunk holds the values of the chunk at `base` of `count`.
+    #[inline(always)]
+    pub(super) fn holds(&self, base: u32, count: u32) -> bool {
+        self.count.get() == count && self.base.get() == base && self.len.get() != 0
+    }
+
+    /// Where the values go: `v` as plain `T`s, for vector stores.
+    #[inline(always)]
+    pub(super) fn values_ptr(&self) -> *mut T {
+        // `Cell<T>` has the layout of `T`, and a `Cell` may be written through a shared
+        // reference: this pointer may be written while no reference to a value is live.
+        self.v.as_ptr().cast::<T>().cast_mut()
+    }
+
+    /// Mark the values (written through [`Chunk::values_ptr`]) as those of the chunk at
+    /// `base` (a multiple of [`CHUNK`], < count) of `count`.
+    #[inline(always)]
+    pub(super) fn mark(&self, base: u32, count: u32) {
+        self.count.set(count);
+        self.base.set(base);
+        self.len.set((count - base).min(CHUNK as u32));
+    }
+}
+
+/// One pixel's sample sets with the keys of the first [`CACHED_DIMS`] dimensions precomputed;
+/// returns exactly what the pattern's `sample_1d` / `sample_2d` return for this pixel.
+#[derive(Clone, Debug)]
+pub struct PixelSamples {
+    pub(super) pattern: Pattern,
+    pixel: UVec2,
+    pub(super) sets_1d: [SetKeys; CACHED_DIMS],
+    pub(super) sets_2d: [SetKeys; CACHED_DIMS],
+    /// The `stratified` AVX-512 form: `raw` holds the keys instead of `sets_1d` / `sets_2d`
+    /// (which are then unused), and a miss fills a whole group of chunks (see `learned`).
+    pub(super) raw_mode: bool,
+    /// Raw keys of the 1D and 2D sets (raw mode).
+    pub(super) raw: [RawSets; 2],
+    /// Per 1D / 2D cached dimension: the count of its last chunk fill (0: never), kept from
+    /// pixel to pixel. In raw mode a miss at (base, count) (count a multiple of 16) fills the
+    /// chunks at (base, count) of every dimension whose last count was `count`: an integrator draws the same
+    /// dimensions for each sample index, so the chunks of one 16-index block are computed
+    /// together, their independent hash chains overlapping, with one call and one setup.
+    pub(super) learned: [[Cell<u32>; CACHED_DIMS]; 2],
+    /// The two most recently used sample counts' [`Strata`] (an integrator asks for two: N for
+    /// the pixel filter, N·M for the shading dimensions).
+    strata: Cell<[Strata; 2]>,
+    /// The same in the `stratified` fast form: two slots, most recent first.
+    fast: [Cell<FastStrata>; 2],
+    /// Batches of precomputed `stratified` values per cached 1D / 2D dimension.
+    pub(super) chunks_1d: [Chunk<f32>; CACHED_DIMS],
+    pub(super) chunks_2d: [Chunk<Vec2>; CACHED_DIMS],
+}
+
+impl PixelSamples {
+    /// Make these the samples of `pixel` under `pattern` except for the set keys (which the
+    /// caller writes next): every chunk emptied, the per-count caches kept (they depend on
+    /// the count only).
+    #[inline]
+    pub(super) fn reset(&mut self, pattern: Pattern, pixel: UVec2) {
+        self.pattern = pattern;
+        self.pixel = pixel;
+        self.raw_mode = pattern.raw_mode();
+        for c in &self.chunks_1d {
+            c.len.set(0);
+        }
+        for c in &self.chunks_2d {
+            c.len.set(0);
+        }
+    }
+
+    /// The pixel these samples belong to.
+    #[inline]
+    pub fn pixel(&self) -> UVec2 {
+        self.pixel
+    }
+
+    /// The [`Strata`] of `count`, from the two-entry cache.
+    #[inline]
+    fn strata(&self, count: u32) -> Strata {
+        let count = count.max(1);
+        let mut c = self.strata.get();
+        if c[0].count == count {
+            return c[0];
+        }
+        if c[1].count != count {
+            c[1] = Strata::new(count);
+        }
+        c.swap(0, 1);
+        self.strata.set(c);
+        c[0]
+    }
+
+    /// The [`FastStrata`] of `count`, from the two-slot cache (most recent first).
+    #[inline]
+    pub(super) fn fast(&self, count: u32) -> FastStrata {
+        let a = self.fast[0].get();
+        if a.key == count as u64 {
+            return a;
+        }
+        let b = self.fast[1].get();
+        if b.key == count as u64 {
+            return b;
+        }
+        let f = FastStrata::new(count);
+        self.fast[1].set(a);
+        self.fast[0].set(f);
+        f
+    }
+
+    /// The 1D sample `index` of `count` for `dim`.
+    #[inline(always)]
+    pub fn sample_1d(&self, dim: u32, index: u32, count: u32) -> f32 {
+        if let Some(c) = self.chunks_1d.get(dim as usize)
+            && let Some(v) = c.get(index, count)
+        {
+            return v;
+        }
+        self.sample_1d_miss(dim, index, count)
+    }
+
+    /// [`PixelSamples::sample_1d`] when no chunk holds the value (see [`PixelSamples::miss`]).
+    #[inline(never)]
+    fn sample_1d_miss(&self, dim: u32, index: u32, count: u32) -> f32 {
+        #[cfg(target_arch = "x86_64")]
+        if self.raw_mode
+            && let Some(v) = self.miss_raw(0, dim, index, count)
+        {
+            // SAFETY: the 1D chunk of `dim` holds `index` now; it stores f32s.
+            return unsafe {
+                *self.chunks_1d[dim as usize]
+                    .values_ptr()
+                    .cast::<f32>()
+                    .add(v)
+            };
+        }
+        self.miss(
+            self.set_keys(0, dim),
+            &self.chunks_1d,
+            Arity {
+                dim,
+                index,
+                count,
+                general: |p: &Pattern| p.sample_1d(self.pixel, dim, index, count),
+                eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_1d(kind, i, st),
+                fast: |f: &FastStrata, set: &SetKeys, base| {
+                    f.chunk_1d_on(self.pattern.cpu, set, base)
+                },
+            },
+        )
+    }
+
+    /// The 2D sample `index` of `count` for `dim`.
+    #[inline(always)]
+    pub fn sample_2d(&self, dim: u32, index: u32, count: u32) -> Vec2 {
+        if let Some(c) = self.chunks_2d.get(dim as usize)
+            && let Some(v) = c.get(index, count)
+        {
+            return v;
+        }
+        self.sample_2d_miss(dim, index, count)
+    }
+
+    /// [`PixelSamples::sample_2d`] when no chunk holds the value (see [`PixelSamples::miss`]).
+    #[inline(never)]
+    fn sample_2d_miss(&self, dim: u32, index: u32, count: u32) -> Vec2 {
+        #[cfg(target_arch = "x86_64")]
+        if self.raw_mode
+            && let Some(v) = self.miss_raw(1, dim, index, count)
+        {
+            // SAFETY: the 2D chunk of `dim` holds `index` now.
+            return unsafe { *self.chunks_2d[dim as usize].values_ptr().add(v) };
+        }
+        self.miss(
+            self.set_keys(1, dim),
+            &self.chunks_2d,
+            Arity {
+                dim,
+                index,
+                count,
+                general: |p: &Pattern| p.sample_2d(self.pixel, dim, index, count),
+                eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_2d(kind, i, st),
+                fast: |f: &FastStrata, set: &SetKeys, base| {
+                    f.chunk_2d_on(self.pattern.cpu, set, base)
+                },
+            },
+        )
+    }
+
+    /// The keys of the 1D (`arity` 0) or 2D (1) set of `dim`, if it is a cached dimension.
+    #[inline]
+    fn set_keys(&self, arity: usize, dim: u32) -> Option<SetKeys> {
+        let d = dim as usize;
+        if d >= CACHED_DIMS {
+            return None;
+        }
+        Some(if self.raw_mode {
+            self.raw[arity].set(d)
+        } else if arity == 0 {
+            self.sets_1d[d]
+        } else {
+            self.sets_2d[d]
+        })
+    }
+
+    /// A value no chunk holds: refill the chunk of `index` (< count; the `stratified` fast form
+    /// where it applies) or evaluate the general way (uncached dimension, wrapped index).
+    /// Written once for 1D and 2D; inlined into each so that every loop is specialised.
+    #[inline(always)]
+    fn miss<T, G, E, F>(
+        &self,
+        set: Option<SetKeys>,
+        chunks: &[Chunk<T>; CACHED_DIMS],
+        a: Arity<G, E, F>,
+    ) -> T
+    where
+        T: Copy + Default,
+        G: Fn(&Pattern) -> T,
+        E: Fn(&SetKeys, PatternKind, u32, &Strata) -> T,
+        F: Fn(&FastStrata, &SetKeys, u32) -> [T; CHUNK],
+    {
+        let Arity {
+            dim,
+            index,
+            count,
+            general,
+            eval,
+            fast,
+        } = a;
+        let Some(set) = set else {
+            return general(&self.pattern);
+        };
+        let set = &set;
+        let kind = self.pattern.kind;
+        if index >= count {
+            return eval(set, kind, index, &self.strata(count));
+        }
+        let base = index & !(CHUNK as u32 - 1);
+        let f = if kind == PatternKind::Stratified {
+            self.fast(count)
+        } else {
+            FastStrata::NONE
+        };
+        let v = if f.valid {
+            fast(&f, set, base)
+        } else {
+            // Every other pattern and count: the general evaluation, batched the same way.
+            let st = self.strata(count);
+            let len = (count - base).min(CHUNK as u32) as usize;
+            let batch = |kind| {
+                let mut v = [T::default(); CHUNK];
+                for (k, o) in v.iter_mut().enumerate().take(len) {
+                    *o = eval(set, kind, base + k as u32, &st);
+                }
+                v
+            };
+            // One loop per kind, so that each loop body is that kind's arithmetic only.
+            match kind {
+                PatternKind::Fixed => batch(PatternKind::Fixed),
+                PatternKind::Random => batch(PatternKind::Random),
+                PatternKind::Grid => batch(PatternKind::Grid),
+                PatternKind::Stratified => batch(PatternKind::Stratified),
+                PatternKind::Lhs => batch(PatternKind::Lhs),
+                PatternKind::Sobol => batch(PatternKind::Sobol),
+            }
+        };
+        chunks[dim as usize].store(index, count, &v)
+    }
+}
+
+/// What [`PixelSamples::miss`] needs of one request and of its dimension count (1D or 2D):
+/// the request, the uncached evaluation, the per-index evaluation and the fast chunk.
+struct Arity<G, E, F> {
+    dim: u32,
+    index: u32,
+    count: u32,
+    general: G,
+    eval: E,
+    fast: F,
+}
