@@ -351,7 +351,12 @@ impl<'a> Integrator<'a> {
             0
         };
         // Normal and bump maps replace the shading normals before the frames are built.
-        crate::scene::shading_normals::perturb_hits(self.scene, &mut q.hits[..], &mut q.rx.cols);
+        crate::scene::shading_normals::perturb_hits(
+            self.scene,
+            active,
+            &mut q.hits[..],
+            &mut q.rx.cols,
+        );
         counted
     }
 

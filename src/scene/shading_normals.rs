@@ -1,5 +1,5 @@
-//! Normal and bump maps at camera-ray hits: the shading normal of a hit whose material has one
-//! is replaced before the shading frame is built (pbrt-v4's `NormalMap` / `BumpMap`), from the
+//! Normal and bump maps at closest hits (every path vertex): the shading normal of a hit whose
+//! material has one is replaced before the shading frame is built (pbrt-v4's `NormalMap` / `BumpMap`), from the
 //! hit triangle's ∂p/∂u, ∂p/∂v. Hits on spheres and disks keep their normal (the parser warns).
 
 use super::Scene;
@@ -35,11 +35,17 @@ fn triangle_derivatives(
     Some((ts.cross(ns), ts))
 }
 
-/// Replace the shading normals of the hits (and their packet columns) whose material has a
-/// normal or bump map.
-pub fn perturb_hits(scene: &Scene, hits: &mut [Option<SurfaceHit>], cols: &mut HitColumns) {
-    for (k, h) in hits.iter_mut().enumerate() {
-        let Some(hit) = h else { continue };
+/// Replace the shading normals of the active lanes' hits (and their packet columns) whose
+/// material has a normal or bump map. Only `active` lanes: the others hold an earlier vertex's
+/// hit, already perturbed, which a second pass would tilt again.
+pub fn perturb_hits(
+    scene: &Scene,
+    active: u32,
+    hits: &mut [Option<SurfaceHit>],
+    cols: &mut HitColumns,
+) {
+    for k in crate::geometry::packet::bits(active) {
+        let Some(hit) = &mut hits[k] else { continue };
         let Some(pert) = scene
             .materials
             .get(hit.material as usize)
