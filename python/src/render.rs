@@ -181,23 +181,20 @@ impl Scene {
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         // As the CLI: the arguments override the scene file's `Integrator`; without either,
         // direct lighting with the default selector.
-        let file = self.scene.integrator.as_ref();
-        let integrator = match integrator {
-            Some(s) => choice::<IntegratorKind>("integrator", s)?,
-            None => file.map_or(IntegratorKind::Direct, |i| i.kind),
-        };
-        let light_selection = match light_selection {
-            Some(s) => choice::<SelectorKind>("light_selection", s)?,
-            None => file
-                .and_then(|i| i.light_selection)
-                .unwrap_or(SelectorKind::DEFAULT),
-        };
-        if integrator == IntegratorKind::Direct && max_depth.is_some_and(|d| d != 1) {
+        let integrator = integrator
+            .map(|s| choice::<IntegratorKind>("integrator", s))
+            .transpose()?;
+        let light_selection = light_selection
+            .map(|s| choice::<SelectorKind>("light_selection", s))
+            .transpose()?;
+        let chosen = self
+            .scene
+            .integrator_choice(integrator, max_depth, light_selection);
+        if chosen.kind == IntegratorKind::Direct && max_depth.is_some_and(|d| d != 1) {
             return Err(PyValueError::new_err(
                 "max_depth: the 'direct' integrator is one bounce; use integrator='path'",
             ));
         }
-        let max_depth = max_depth.or(file.map(|i| i.max_depth));
         let spp = spp.or(self.scene.film.spp).unwrap_or(64);
         if spp == 0 || shadow_rays == 0 || threads == Some(0) {
             return Err(PyValueError::new_err(format!(
@@ -233,14 +230,14 @@ impl Scene {
             strategy: choice::<Strategy>("strategy", strategy)?,
             mis: choice::<MisHeuristic>("mis", mis)?,
             pattern: choice::<PatternKind>("pattern", pattern)?,
-            light_selection,
+            light_selection: chosen.light_selection,
             mis_light,
             bsdf_sampling: choice::<LobeSampling>("bsdf_sampling", bsdf_sampling)?,
             progress: false,
             sample_range: spp_range.map(|(a, b)| a..b),
             cancel: Some(Arc::clone(&cancel)),
-            integrator,
-            max_depth: max_depth.unwrap_or(5),
+            integrator: chosen.kind,
+            max_depth: chosen.max_depth,
             ..RenderOptions::default()
         };
         opts.samples()

@@ -243,7 +243,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // The loaders build the BVHs (scene and emitters) as their last step and time them.
     let bvh_time = scene.geometry.build_time + scene.emitters.build_time;
     let res = args.res.unwrap_or(scene.film.resolution);
-    let file = scene.integrator.as_ref();
+    let choice = scene.integrator_choice(args.integrator, args.max_depth, args.light_selection);
     let spp = match args.time {
         Some(_) => args.spp.unwrap_or(TIME_SPP),
         None => args.spp.or(scene.film.spp).unwrap_or(64),
@@ -255,18 +255,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         strategy: args.strategy,
         mis: args.mis,
         pattern: args.pattern,
-        light_selection: args
-            .light_selection
-            .or_else(|| file.and_then(|i| i.light_selection))
-            .unwrap_or(SelectorKind::DEFAULT),
+        light_selection: choice.light_selection,
         bsdf_sampling: args.bsdf_sampling,
         mis_light: args.mis_light,
-        // The flags override the file's `Integrator`; without either, direct lighting.
-        integrator: args
-            .integrator
-            .or(file.map(|i| i.kind))
-            .unwrap_or(IntegratorKind::Direct),
-        max_depth: args.max_depth.or(file.map(|i| i.max_depth)).unwrap_or(5),
+        integrator: choice.kind,
+        max_depth: choice.max_depth,
         roulette: !args.no_roulette,
         progress: !args.quiet,
         sample_range: args.spp_range.clone(),

@@ -233,16 +233,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let scene = loaded.scene;
     // `render`'s defaults: the flags, else the scene file's `Integrator`, else direct lighting
     // with the default selector.
-    let file = scene.integrator.as_ref();
-    let light_selection = r
-        .light_selection
-        .or_else(|| file.and_then(|i| i.light_selection))
-        .unwrap_or(SelectorKind::DEFAULT);
-    let integrator = r
-        .integrator
-        .or(file.map(|i| i.kind))
-        .unwrap_or(IntegratorKind::Direct);
-    let max_depth = r.max_depth.or(file.map(|i| i.max_depth)).unwrap_or(5);
+    let choice = scene.integrator_choice(r.integrator, r.max_depth, r.light_selection);
     let res = r.res.unwrap_or(scene.film.resolution);
     let reference = match &args.reference {
         Some(p) => {
@@ -266,14 +257,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let settings = Settings {
         strategy: r.strategy,
-        light_selection,
+        light_selection: choice.light_selection,
         pattern: r.pattern,
         mis: r.mis,
         bsdf_sampling: r.bsdf_sampling,
         spp,
         shadow_rays: r.shadow_rays,
-        integrator,
-        max_depth,
+        integrator: choice.kind,
+        max_depth: choice.max_depth,
         roulette: !r.no_roulette,
     };
     let pool = match r.threads {

@@ -126,6 +126,41 @@ pub struct Scene {
     pub integrator: Option<IntegratorSpec>,
 }
 
+/// The integrator settings of a render: each explicit choice (a CLI flag, a viewer or Python
+/// argument), else the scene file's `Integrator`, else direct lighting, depth 5 and the default
+/// light selection.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IntegratorChoice {
+    /// Direct lighting or path tracing.
+    pub kind: crate::integrator::IntegratorKind,
+    /// Bounces (pbrt-v4's `maxdepth`).
+    pub max_depth: u32,
+    /// Light selection at every vertex.
+    pub light_selection: crate::light_selection::SelectorKind,
+}
+
+impl Scene {
+    /// What a render of this scene uses, given the caller's explicit choices (`None`: not
+    /// chosen); the one place where flags, the file's `Integrator` and the defaults meet.
+    pub fn integrator_choice(
+        &self,
+        kind: Option<crate::integrator::IntegratorKind>,
+        max_depth: Option<u32>,
+        light_selection: Option<crate::light_selection::SelectorKind>,
+    ) -> IntegratorChoice {
+        let file = self.integrator.as_ref();
+        IntegratorChoice {
+            kind: kind
+                .or(file.map(|i| i.kind))
+                .unwrap_or(crate::integrator::IntegratorKind::Direct),
+            max_depth: max_depth.or(file.map(|i| i.max_depth)).unwrap_or(5),
+            light_selection: light_selection
+                .or_else(|| file.and_then(|i| i.light_selection))
+                .unwrap_or(crate::light_selection::SelectorKind::DEFAULT),
+        }
+    }
+}
+
 /// A scene file's `Integrator` directive as penumbra renders it: the CLI's `--integrator`,
 /// `--max-depth` and `--light-selection` override it.
 #[derive(Clone, Debug, PartialEq, Eq)]
