@@ -26,8 +26,6 @@ use penumbra::scene::view::ViewOptions;
 
 use crate::errors::{Kind, not_found, to_py, warn_all};
 
-/// Integrators this build renders with (`staged` adds `path`; until then only `direct`).
-
 /// Add `load` and `Scene`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
