@@ -463,23 +463,34 @@ fn selector_cost(args: &Args) -> anyhow::Result<()> {
         }
         for _ in 0..args.repeats.max(1) {
             for (_, s, _, ts, tp) in built.iter_mut() {
-                let mut picked = Vec::with_capacity(points.len());
-                let t0 = cpu_ns();
-                for &(sp, u) in &points {
-                    picked.push(std::hint::black_box(s.sample(&sp, u)));
+                // Passes over all points until 0.2 s of CPU time: the per-thread clock only
+                // advances at scheduler events, so short loops would read zero.
+                let picked: Vec<_> = points.iter().map(|&(sp, u)| s.sample(&sp, u)).collect();
+                let (mut calls, t0) = (0usize, cpu_ns());
+                let mut t1 = t0;
+                while t1 - t0 < 0.2 {
+                    for &(sp, u) in &points {
+                        std::hint::black_box(s.sample(&sp, std::hint::black_box(u)));
+                    }
+                    calls += points.len();
+                    t1 = cpu_ns();
                 }
-                let t1 = cpu_ns();
-                let mut acc = 0.0f32;
-                let mut calls = 0usize;
-                for (&(sp, _), p) in points.iter().zip(&picked) {
-                    if let Some(p) = p {
-                        acc += s.pmf(&sp, p.index);
-                        calls += 1;
+                ts.push((t1 - t0) * 1e9 / calls.max(1) as f64);
+                let (mut calls, mut acc) = (0usize, 0.0f32);
+                let mut t2 = t1;
+                while t2 - t1 < 0.2 {
+                    for (&(sp, _), p) in points.iter().zip(&picked) {
+                        if let Some(p) = p {
+                            acc += s.pmf(&sp, std::hint::black_box(p.index));
+                            calls += 1;
+                        }
+                    }
+                    t2 = cpu_ns();
+                    if calls == 0 {
+                        break;
                     }
                 }
-                let t2 = cpu_ns();
                 std::hint::black_box(acc);
-                ts.push((t1 - t0) * 1e9 / points.len().max(1) as f64);
                 tp.push((t2 - t1) * 1e9 / calls.max(1) as f64);
             }
         }
