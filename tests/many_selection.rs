@@ -382,7 +382,11 @@ fn bvh_is_compact() {
     let bvh = BvhSelector::new(&bounds);
     // 8-wide: log8(5000) = 4.1 levels; the collapse leaves small subtrees in partly filled
     // nodes (about 2.8 children per node here, 150 B per light).
-    assert!(bvh.node_count() <= bounds.len() / 2, "{} nodes", bvh.node_count());
+    assert!(
+        bvh.node_count() <= bounds.len() / 2,
+        "{} nodes",
+        bvh.node_count()
+    );
     assert!(bvh.depth() <= 7, "depth {}", bvh.depth());
     assert!(
         bvh.bytes_per_light() <= 200.0,

@@ -132,7 +132,10 @@ fn ris_variance_falls_with_k() {
     };
     let v: Vec<f64> = [1, 4, 16, 64].iter().map(|&k| rel_var(k)).collect();
     eprintln!("relative variance over K = 1, 4, 16, 64: {v:?}");
-    assert!(v[0] > 2.0 * v[1] && v[1] > 2.0 * v[2] && v[2] > 2.0 * v[3], "{v:?}");
+    assert!(
+        v[0] > 2.0 * v[1] && v[1] > 2.0 * v[2] && v[2] > 2.0 * v[3],
+        "{v:?}"
+    );
     // Exhaustive has none (up to rounding).
     let (l, p) = ex.sample(&sp, 0.3).unwrap();
     assert!((g[l as usize] / p as f64 / exact - 1.0).abs() < 1e-4);

@@ -214,7 +214,11 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
     );
     println!(
         "|---|---|---|---|---|---|---|---|{}",
-        if args.time.is_some() { "---|---|---|" } else { "" }
+        if args.time.is_some() {
+            "---|---|---|"
+        } else {
+            ""
+        }
     );
     for name in &names {
         let scene = load(name, &lopts)?.scene;
@@ -242,8 +246,14 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
                 }
             }
         }
-        let build: Vec<f64> = times.iter().map(|t| median(t.iter().map(|x| x.0))).collect();
-        let render_t: Vec<f64> = times.iter().map(|t| median(t.iter().map(|x| x.1))).collect();
+        let build: Vec<f64> = times
+            .iter()
+            .map(|t| median(t.iter().map(|x| x.0)))
+            .collect();
+        let render_t: Vec<f64> = times
+            .iter()
+            .map(|t| median(t.iter().map(|x| x.1)))
+            .collect();
         // Equal time: the spp that fits the budget at the measured time per sample.
         let mut at_time: Vec<Option<(u32, f64, f64)>> = vec![None; runnable.len()];
         if let Some(budget) = args.time {
@@ -281,7 +291,9 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
                 (Some((s, r2, _)), None) => format!(" {s} | {r2:.4e} | – |"),
                 _ => String::new(),
             };
-            println!("| {name} | {n} | {ref_name} | {sel} | {b:.3} | {t:.3} | {r:.4e} | {e} |{extra}");
+            println!(
+                "| {name} | {n} | {ref_name} | {sel} | {b:.3} | {t:.3} | {r:.4e} | {e} |{extra}"
+            );
         }
     }
     bvh_build_benchmark(100_000)
@@ -413,9 +425,14 @@ fn selector_cost(args: &Args) -> anyhow::Result<()> {
     use penumbra::light_selection::estimate::{eye_hit, pixel_rng};
     use penumbra::sampling::hash::next_f32;
     let mut cases: Vec<(String, Option<u32>)> = if args.scenes.is_empty() {
-        MANY.iter().map(|s| (s.to_string(), args.light_count)).collect()
+        MANY.iter()
+            .map(|s| (s.to_string(), args.light_count))
+            .collect()
     } else {
-        args.scenes.iter().map(|s| (s.clone(), args.light_count)).collect()
+        args.scenes
+            .iter()
+            .map(|s| (s.clone(), args.light_count))
+            .collect()
     };
     for &c in &args.light_counts {
         cases.push(("many-open".to_string(), Some(c)));
@@ -436,7 +453,9 @@ fn selector_cost(args: &Args) -> anyhow::Result<()> {
         load_average()
     );
     println!();
-    println!("| scene | lights | strategy | build (s) | sample (ns) | pmf (ns) | sample / power's |");
+    println!(
+        "| scene | lights | strategy | build (s) | sample (ns) | pmf (ns) | sample / power's |"
+    );
     println!("|---|---|---|---|---|---|---|");
     for (name, count) in cases {
         let mut lopts = many_load_options(args);

@@ -136,7 +136,11 @@ impl WideNode {
                 (0.0, 0.0, 1.0)
             };
             let cw = self.wx[k] * wix + self.wy[k] * wiy + self.wz[k] * wiz;
-            let cos_w = if self.two_sided[k] > 0.5 { cw.abs() } else { cw };
+            let cos_w = if self.two_sided[k] > 0.5 {
+                cw.abs()
+            } else {
+                cw
+            };
             let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
             let (cos_o, sin_o) = (self.cos_o[k], self.sin_o[k]);
             // θx = max(0, θw − θo), θ′ = max(0, θx − θb), as (sin, cos) pairs.
@@ -228,7 +232,6 @@ struct Item {
     light: u32,
 }
 
-
 /// A node of the binary build tree (indices relative to its subtree's first node while built).
 #[derive(Clone, Copy)]
 struct BNode {
@@ -254,9 +257,15 @@ fn build_binary(items: &mut [Item], depth: u32) -> Vec<BNode> {
     let mid = split(items, depth);
     let (left, right) = items.split_at_mut(mid);
     let (l, r) = if left.len() + right.len() > PARALLEL_MIN {
-        rayon::join(|| build_binary(left, depth + 1), || build_binary(right, depth + 1))
+        rayon::join(
+            || build_binary(left, depth + 1),
+            || build_binary(right, depth + 1),
+        )
     } else {
-        (build_binary(left, depth + 1), build_binary(right, depth + 1))
+        (
+            build_binary(left, depth + 1),
+            build_binary(right, depth + 1),
+        )
     };
     let second = 1 + l.len() as u32;
     let mut nodes = Vec::with_capacity(1 + l.len() + r.len());
@@ -615,7 +624,11 @@ mod tests {
             node.importance(p, n, &mut imp);
             let s = importance(p, n, &b);
             assert_eq!(imp[0] > 0.0, s > 0.0, "{p} {n}: {} vs {s}", imp[0]);
-            assert!((imp[0] - s).abs() <= 1e-4 * s.abs(), "{p} {n}: {} vs {s}", imp[0]);
+            assert!(
+                (imp[0] - s).abs() <= 1e-4 * s.abs(),
+                "{p} {n}: {} vs {s}",
+                imp[0]
+            );
             assert!(imp[1..].iter().all(|&x| x == 0.0));
         }
     }
