@@ -1,9 +1,10 @@
 //! Light BVH (Conty Estevez & Kulla 2018; importance as in pbrt-v4's `BVHLightSampler`), laid
 //! out for speed: an **8-wide** tree over the finite lights whose nodes hold their children's
 //! bounds (centre, bounding radius, emission axis, cos/sin θo, cos θe, power) as f32 lanes, so
-//! one pass of straight-line code scores all eight children at once (AVX2 when the CPU has it,
-//! the same code compiled for SSE2 otherwise — both round identically: no FMA contraction, and
-//! sqrt/div are exact IEEE operations, so the choice of ISA never changes a sample).
+//! one pass of straight-line code scores all eight children at once (compiled per instruction
+//! set through [`Cpu::dispatch`]: AVX2/AVX-512 when the CPU has them, SSE2 otherwise — all round
+//! identically: no FMA contraction, and sqrt/div are exact IEEE operations, so the choice of
+//! ISA never changes a sample).
 //!
 //! Sampling walks from the root, choosing a child ∝ its importance at the shading point:
 //! ⌈log₈ N⌉ levels (5 for 10k lights, 7 for 1M) instead of the binary tree's log₂ N levels of
@@ -26,6 +27,7 @@
 
 use super::importance::union;
 use super::{FiniteSelector, ShadingPoint};
+use crate::isa::{Cpu, Kernel, Token};
 use crate::lights::LightBounds;
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -197,8 +199,8 @@ pub struct BvhSelector {
     parent: Vec<u32>,
     /// Per light: `node << 3 | slot` of its leaf slot.
     slot: Vec<u32>,
-    /// Whether the CPU runs the AVX2 build of the traversal.
-    avx2: bool,
+    /// The instruction set the traversal runs on ([`Cpu::dispatch`]).
+    cpu: Cpu,
 }
 
 /// Cost of a child with bounds `b` of a node of extent `parent` split along `dim` (pbrt-v4's
@@ -331,7 +333,7 @@ impl BvhSelector {
             nodes: Vec::new(),
             parent: Vec::new(),
             slot: vec![u32::MAX; bounds.len()],
-            avx2: has_avx2(),
+            cpu: Cpu::detect(),
         };
         if bounds.is_empty() {
             return s;
@@ -451,18 +453,6 @@ impl BvhSelector {
         pmf as f32
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn sample_avx2(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
-        self.sample_impl(ctx, u)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn pmf_avx2(&self, ctx: &ShadingPoint, light: u32) -> f32 {
-        self.pmf_impl(ctx, light)
-    }
-
     /// Importance of the eight children of node `i` (for tests and diagnostics).
     pub fn child_importance(&self, ctx: &ShadingPoint, i: usize) -> [f32; WIDTH] {
         let mut imp = [0.0; WIDTH];
@@ -471,14 +461,33 @@ impl BvhSelector {
     }
 }
 
-fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2")
+/// `sample` as a [`Kernel`]: compiled once per instruction set.
+struct SampleKernel<'a> {
+    bvh: &'a BvhSelector,
+    ctx: &'a ShadingPoint,
+    u: f32,
+}
+
+impl Kernel for SampleKernel<'_> {
+    type Output = Option<(u32, f32)>;
+    #[inline(always)]
+    fn run<T: Token>(self, _t: T) -> Self::Output {
+        self.bvh.sample_impl(self.ctx, self.u)
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
+}
+
+/// `pmf` as a [`Kernel`].
+struct PmfKernel<'a> {
+    bvh: &'a BvhSelector,
+    ctx: &'a ShadingPoint,
+    light: u32,
+}
+
+impl Kernel for PmfKernel<'_> {
+    type Output = f32;
+    #[inline(always)]
+    fn run<T: Token>(self, _t: T) -> Self::Output {
+        self.bvh.pmf_impl(self.ctx, self.light)
     }
 }
 
@@ -576,21 +585,15 @@ fn partition(items: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
 
 impl FiniteSelector for BvhSelector {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: the CPU has AVX2 (checked when the selector was built).
-            return unsafe { self.sample_avx2(ctx, u) };
-        }
-        self.sample_impl(ctx, u)
+        self.cpu.dispatch(SampleKernel { bvh: self, ctx, u })
     }
 
     fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32 {
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: as in `sample`.
-            return unsafe { self.pmf_avx2(ctx, light) };
-        }
-        self.pmf_impl(ctx, light)
+        self.cpu.dispatch(PmfKernel {
+            bvh: self,
+            ctx,
+            light,
+        })
     }
 }
 
@@ -634,7 +637,7 @@ mod tests {
     }
 
     #[test]
-    fn avx2_and_portable_paths_agree_bitwise() {
+    fn vector_and_portable_paths_agree_bitwise() {
         let bounds: Vec<LightBounds> = (0..300)
             .map(|i| {
                 let f = i as f32;
@@ -659,7 +662,7 @@ mod tests {
         };
         let fast: Vec<_> = (0..64).map(|j| bvh.sample(&ctx, j as f32 / 64.0)).collect();
         let fast_pmf: Vec<_> = (0..300).map(|l| bvh.pmf(&ctx, l)).collect();
-        bvh.avx2 = false;
+        bvh.cpu = crate::isa::Isa::Portable.cpu();
         let slow: Vec<_> = (0..64).map(|j| bvh.sample(&ctx, j as f32 / 64.0)).collect();
         let slow_pmf: Vec<_> = (0..300).map(|l| bvh.pmf(&ctx, l)).collect();
         assert_eq!(fast, slow);
