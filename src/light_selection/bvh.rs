@@ -112,6 +112,8 @@ impl WideNode {
     /// when unknown): the formula of [`super::importance::importance`] (Φ·cos θ′/d², times
     /// cos θ′ᵢ), lane by lane, branch-free so the loop vectorises.
     #[inline(always)]
+    // One index walks thirteen lane arrays: the loop the vectoriser wants.
+    #[allow(clippy::needless_range_loop)]
     fn importance(&self, p: Vec3, n: Vec3, out: &mut [f32; WIDTH]) {
         let has_n = n != Vec3::ZERO;
         for k in 0..WIDTH {
