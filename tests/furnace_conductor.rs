@@ -145,7 +145,12 @@ fn penumbra_conductor_is_the_ggx_written_here() {
         Vec3::splat(1000.0),
         glam::Vec2::splat(ALPHA as f32),
     );
-    for (mo, mi, phi) in [(0.9, 0.8, 0.3), (0.5, 0.7, 2.0), (0.2, 0.95, 3.0), (0.6, 0.1, 0.0)] {
+    for (mo, mi, phi) in [
+        (0.9, 0.8, 0.3),
+        (0.5, 0.7, 2.0),
+        (0.2, 0.95, 3.0),
+        (0.6, 0.1, 0.0),
+    ] {
         let wo = wo_at(mo);
         let wi = [
             (1.0f64 - mi * mi).sqrt() * f64::cos(phi),
@@ -216,7 +221,11 @@ Shape "trianglemesh" "point3 P" [ -1000 -1000 0  1000 -1000 0  1000 1000 0  -100
                 strategy,
                 mis,
                 integrator,
-                max_depth: if integrator == IntegratorKind::Path { 5 } else { 1 },
+                max_depth: if integrator == IntegratorKind::Path {
+                    5
+                } else {
+                    1
+                },
                 ..RenderOptions::default()
             };
             let (img, stats) = render(&s, UVec2::new(16, 16), &opts).unwrap();
@@ -260,9 +269,7 @@ fn cavity(a: f64, mu_o: f64, depth: u32, (n, sub, np): (usize, usize, usize)) ->
             })
             .collect()
     };
-    let k: Vec<Vec<f64>> = (0..n)
-        .map(|i| row(((i as f64 + 0.5) * dt).cos()))
-        .collect();
+    let k: Vec<Vec<f64>> = (0..n).map(|i| row(((i as f64 + 0.5) * dt).cos())).collect();
     let mut l = vec![1.0; n];
     for _ in 1..depth {
         l = k

@@ -152,7 +152,10 @@ fn white_base_under_a_lossless_coat_has_albedo_one() {
             assert!((want - 1.0).abs() < 1e-4, "model {want}");
             let (got, se) = sampled_albedo(&b, mu, 200_000, 7);
             let ok = (got - 1.0).abs() <= 5.0 * se + 2e-3;
-            eprintln!("white furnace α {alpha} μo {mu}: {got:.5} ± {se:.1e} {}", if ok { "ok" } else { "FAIL" });
+            eprintln!(
+                "white furnace α {alpha} μo {mu}: {got:.5} ± {se:.1e} {}",
+                if ok { "ok" } else { "FAIL" }
+            );
             if !ok {
                 failures.push(format!("α {alpha} μo {mu}: {got} ± {se}"));
             }
@@ -184,11 +187,7 @@ fn coffee_maker_coateddiffuse_matches_pbrt_v4s_definition() {
         for (mo, mi, phi) in [(0.9f64, 0.8f64, 0.7f64), (0.5, 0.95, 2.5), (0.3, 0.6, 1.5)] {
             let wo = wo_at(mo);
             let si = (1.0 - mi * mi).sqrt();
-            let wi = Vec3::new(
-                (si * phi.cos()) as f32,
-                (si * phi.sin()) as f32,
-                mi as f32,
-            );
+            let wi = Vec3::new((si * phi.cos()) as f32, (si * phi.sin()) as f32, mi as f32);
             let n = 20_000u64;
             let (mut s, mut s2) = (0.0f64, 0.0f64);
             for seed in 0..n {

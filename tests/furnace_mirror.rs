@@ -42,8 +42,8 @@ Shape "trianglemesh" "point3 P" [ -1000 -1000 0  1000 -1000 0  1000 1000 0  -100
         y = -10.0 * theta.sin(),
         z = 10.0 * theta.cos(),
     );
-    let parsed = penumbra::scene::pbrt::parse_pbrt_str("mirror.pbrt", &src, Path::new("."))
-        .expect("parses");
+    let parsed =
+        penumbra::scene::pbrt::parse_pbrt_str("mirror.pbrt", &src, Path::new(".")).expect("parses");
     let (b, cam, film, _) = parsed.into_builder().unwrap();
     b.build(cam, film).unwrap()
 }
@@ -56,7 +56,12 @@ fn mean_se(img: &Image) -> (f64, f64) {
     (mean, (var / n).sqrt())
 }
 
-fn opts(strategy: Strategy, mis: MisHeuristic, integrator: IntegratorKind, depth: u32) -> RenderOptions {
+fn opts(
+    strategy: Strategy,
+    mis: MisHeuristic,
+    integrator: IntegratorKind,
+    depth: u32,
+) -> RenderOptions {
     RenderOptions {
         spp: 16,
         seed: 2,
@@ -82,8 +87,12 @@ fn a_mirror_shows_the_sky_under_every_strategy_and_depth() {
             (IntegratorKind::Path, 1),
             (IntegratorKind::Path, 3),
         ] {
-            let (img, stats) =
-                render(&s, UVec2::new(8, 8), &opts(strategy, mis, integrator, depth)).unwrap();
+            let (img, stats) = render(
+                &s,
+                UVec2::new(8, 8),
+                &opts(strategy, mis, integrator, depth),
+            )
+            .unwrap();
             assert_eq!(stats.non_finite, 0);
             let (mean, _) = mean_se(&img);
             // Every sample sees the sky through the mirror with weight F ≥ 1 − 4·10⁻⁶.
@@ -93,7 +102,9 @@ fn a_mirror_shows_the_sky_under_every_strategy_and_depth() {
                 if ok { "ok" } else { "FAIL" }
             );
             if !ok {
-                failures.push(format!("{strategy} {mis:?} {integrator} depth {depth}: {mean}"));
+                failures.push(format!(
+                    "{strategy} {mis:?} {integrator} depth {depth}: {mean}"
+                ));
             }
         }
     }
@@ -111,7 +122,12 @@ fn a_smooth_glass_slab_agrees_across_strategies_at_every_depth() {
                 UVec2::new(8, 8),
                 &RenderOptions {
                     spp: 256,
-                    ..opts(Strategy::Bsdf, MisHeuristic::Power, IntegratorKind::Path, depth)
+                    ..opts(
+                        Strategy::Bsdf,
+                        MisHeuristic::Power,
+                        IntegratorKind::Path,
+                        depth,
+                    )
                 },
             )
             .unwrap();
@@ -139,7 +155,10 @@ fn a_smooth_glass_slab_agrees_across_strategies_at_every_depth() {
                 if ok { "ok" } else { "FAIL" }
             );
             if !ok {
-                failures.push(format!("depth {depth} {strategy} {mis:?}: {mean} vs {}", base.0));
+                failures.push(format!(
+                    "depth {depth} {strategy} {mis:?}: {mean} vs {}",
+                    base.0
+                ));
             }
         }
     }

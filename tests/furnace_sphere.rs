@@ -104,8 +104,8 @@ AttributeBegin
 AttributeEnd
 "#
     );
-    let parsed = penumbra::scene::pbrt::parse_pbrt_str("sphere.pbrt", &src, Path::new("."))
-        .expect("parses");
+    let parsed =
+        penumbra::scene::pbrt::parse_pbrt_str("sphere.pbrt", &src, Path::new(".")).expect("parses");
     let (b, cam, film, _) = parsed.into_builder().unwrap();
     let scene = b.build(cam, film).unwrap();
     let mut failures = Vec::new();
