@@ -164,9 +164,12 @@ fn shading_points(n: usize, seed: u64) -> Vec<ShadingPoint> {
         .collect()
 }
 
+/// Every strategy whose `pmf` is the exact probability of `sample`'s choice (all but `ris`,
+/// tested in `tests/ris_selection.rs`).
 fn selectors(scene: &Scene) -> Vec<Box<dyn LightSelector>> {
     SelectorKind::ALL
         .iter()
+        .filter(|k| k.exact_pmf())
         .map(|&kind| make_selector(kind, scene, 1))
         .collect()
 }
@@ -377,9 +380,16 @@ fn bvh_is_compact() {
     let lights = random_lights(&mut rng, 5000);
     let bounds: Vec<LightBounds> = lights.iter().map(|l| l.bounds().unwrap()).collect();
     let bvh = BvhSelector::new(&bounds);
-    assert_eq!(bvh.node_count(), 2 * bounds.len() - 1);
+    // 8-wide: log8(5000) = 4.1 levels; the collapse leaves small subtrees in partly filled
+    // nodes (about 2.8 children per node here, 150 B per light).
     assert!(
-        bvh.bytes_per_light() <= 64.0,
+        bvh.node_count() <= bounds.len() / 2,
+        "{} nodes",
+        bvh.node_count()
+    );
+    assert!(bvh.depth() <= 7, "depth {}", bvh.depth());
+    assert!(
+        bvh.bytes_per_light() <= 200.0,
         "{} B/light",
         bvh.bytes_per_light()
     );

@@ -42,6 +42,21 @@ pub struct Args {
     /// Rooms per side of `many-rooms`.
     #[arg(long)]
     pub rooms: Option<u32>,
+    /// With --many-lights: also compare at equal time: every strategy renders as many samples
+    /// per pixel as fit in SECONDS of CPU time (its time per sample from the equal-spp run).
+    #[arg(long, value_name = "SECONDS")]
+    pub time: Option<f64>,
+    /// With --many-lights: instead of rendering, time each strategy's `sample` and `pmf` per
+    /// call on eye-ray shading points (one thread), on the scenes and on `many-open` with each
+    /// of --light-counts lights.
+    #[arg(long)]
+    pub selector_cost: bool,
+    /// With --selector-cost: `many-open` light counts to add (comma separated).
+    #[arg(long, value_delimiter = ',')]
+    pub light_counts: Vec<u32>,
+    /// With --many-lights: interleaved repetitions of every timing (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    pub repeats: u32,
 }
 
 /// The scenes benchmarked by default.
@@ -49,6 +64,9 @@ const STANDARD: &[&str] = &["cornell", "dense"];
 
 /// Run the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if args.many_lights && args.selector_cost {
+        return selector_cost(&args);
+    }
     if args.many_lights {
         return run_many(&args);
     }
@@ -133,13 +151,17 @@ fn bvh_section(names: &[String]) -> anyhow::Result<()> {
 /// The scenes of `--many-lights`.
 const MANY: &[&str] = &["many-open", "many-rooms", "many-mesh"];
 
-/// The strategy the reference of `scene` is rendered with (the best one there, at high spp).
-fn reference_selector(scene: &str) -> SelectorKind {
-    if scene == "many-rooms" {
-        SelectorKind::Adaptive
+/// The strategies whose high-spp renders are averaged into a scene's reference: three
+/// unrelated unbiased estimators (the O(N) `exhaustive` where the scene has few enough lights,
+/// else `power`; the `spatial` grid; the light BVH), each with its own seed, so no measured
+/// render shares more than a third of its reference's estimator and none its noise.
+fn reference_selectors(lights: usize, max_exhaustive: usize) -> [SelectorKind; 3] {
+    let first = if lights <= max_exhaustive {
+        SelectorKind::Exhaustive
     } else {
-        SelectorKind::Bvh
-    }
+        SelectorKind::Power
+    };
+    [first, SelectorKind::Spatial, SelectorKind::Bvh]
 }
 
 /// Where references are cached: `target/many-bench/` next to the executable's target dir when
@@ -160,15 +182,7 @@ fn cache_dir() -> PathBuf {
 fn run_many(args: &Args) -> anyhow::Result<()> {
     let spp = args.spp.unwrap_or(8);
     let res = args.res.unwrap_or(UVec2::new(160, 120));
-    let bopts = BuiltinOptions {
-        light_count: args.light_count,
-        rooms: args.rooms,
-        triangles: None,
-    };
-    let lopts = LoadOptions {
-        builtin: bopts.clone(),
-        ..LoadOptions::default()
-    };
+    let lopts = many_load_options(args);
     let names: Vec<String> = if args.scenes.is_empty() {
         MANY.iter().map(|s| s.to_string()).collect()
     } else {
@@ -181,80 +195,336 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
     };
     let dir = cache_dir();
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     println!(
-        "{}x{}, {spp} spp, MIS, reference {}x spp",
-        res.x, res.y, args.reference_factor
+        "{}x{}, {spp} spp, MIS, one thread, CPU time (median of {} interleaved runs), load average {}",
+        res.x,
+        res.y,
+        args.repeats.max(1),
+        load_average()
     );
     println!();
+    let time_cols = if let Some(t) = args.time {
+        format!(" spp in {t} s | relMSE at {t} s | equal-time efficiency vs power |")
+    } else {
+        String::new()
+    };
     println!(
-        "| scene | lights | strategy | build (s) | render (s) | relMSE | efficiency vs power |"
+        "| scene | lights | reference | strategy | build (s) | render (s) | relMSE | equal-spp efficiency vs power |{time_cols}"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!(
+        "|---|---|---|---|---|---|---|---|{}",
+        if args.time.is_some() {
+            "---|---|---|"
+        } else {
+            ""
+        }
+    );
     for name in &names {
         let scene = load(name, &lopts)?.scene;
         let n = scene.lights.len();
-        let ref_sel = reference_selector(name);
-        let ref_path = dir.join(format!(
-            "{name}-{}x{}-{}spp-{ref_sel}-{:?}-{:?}.pfm",
-            res.x,
-            res.y,
-            spp * args.reference_factor,
-            args.light_count,
-            args.rooms
-        ));
-        let reference = match read_image(&ref_path) {
-            Ok(img) if img.width == res.x && img.height == res.y => img,
-            _ => {
+        let (reference, ref_name) = many_reference(args, &scene, name, res, spp, &dir)?;
+        // Equal spp: every strategy `repeats` times, interleaved; the median CPU time.
+        let runnable: Vec<SelectorKind> = selectors
+            .iter()
+            .copied()
+            .filter(|&s| s != SelectorKind::Exhaustive || n <= args.max_exhaustive_lights)
+            .collect();
+        let mut times: Vec<Vec<(f64, f64)>> = vec![Vec::new(); runnable.len()];
+        let mut rel = vec![0.0; runnable.len()];
+        for rep in 0..args.repeats.max(1) {
+            for (j, &sel) in runnable.iter().enumerate() {
                 let opts = RenderOptions {
-                    spp: spp * args.reference_factor,
-                    seed: 0x05ee_d4ef,
-                    light_selection: ref_sel,
+                    spp,
+                    light_selection: sel,
                     ..RenderOptions::default()
                 };
-                let (img, _) = render(&scene, res, &opts)?;
-                write_image(&img, &ref_path, 0.0)?;
-                img
+                let (img, build, t) = pool.install(|| timed_render(&scene, res, &opts))?;
+                times[j].push((build, t));
+                if rep == 0 {
+                    rel[j] = compare(&img, &reference)?.rel_mse;
+                }
             }
-        };
-        let mut rows = Vec::new();
-        for &sel in &selectors {
-            if sel == SelectorKind::Exhaustive && n > args.max_exhaustive_lights {
-                rows.push((sel, None));
-                continue;
+        }
+        let build: Vec<f64> = times
+            .iter()
+            .map(|t| median(t.iter().map(|x| x.0)))
+            .collect();
+        let render_t: Vec<f64> = times
+            .iter()
+            .map(|t| median(t.iter().map(|x| x.1)))
+            .collect();
+        // Equal time: the spp that fits the budget at the measured time per sample.
+        let mut at_time: Vec<Option<(u32, f64, f64)>> = vec![None; runnable.len()];
+        if let Some(budget) = args.time {
+            for (j, &sel) in runnable.iter().enumerate() {
+                let per_spp = render_t[j] / spp as f64;
+                let n_spp = (((budget - build[j]) / per_spp).floor() as u32).max(1);
+                let opts = RenderOptions {
+                    spp: n_spp,
+                    seed: 0x7173_0001,
+                    light_selection: sel,
+                    ..RenderOptions::default()
+                };
+                let (img, b, t) = pool.install(|| timed_render(&scene, res, &opts))?;
+                at_time[j] = Some((n_spp, compare(&img, &reference)?.rel_mse, b + t));
             }
-            let t0 = Instant::now();
-            make_selector(sel, &scene, 0);
-            let build = t0.elapsed().as_secs_f64();
-            let opts = RenderOptions {
-                spp,
-                light_selection: sel,
-                ..RenderOptions::default()
-            };
-            let (img, stats) = render(&scene, res, &opts)?;
-            let rel = compare(&img, &reference)?.rel_mse;
-            rows.push((sel, Some((build, stats.time.as_secs_f64(), rel))));
         }
         let eff = |b: f64, t: f64, r: f64| 1.0 / (r * (b + t)).max(1e-300);
-        let power = rows
-            .iter()
-            .find(|(s, _)| *s == SelectorKind::Power)
-            .and_then(|(_, r)| *r)
-            .map(|(b, t, r)| eff(b, t, r));
-        for (sel, r) in rows {
-            match r {
-                None => println!(
-                    "| {name} | {n} | {sel} | – | – | – | skipped (> {} lights) |",
+        let pj = runnable.iter().position(|&s| s == SelectorKind::Power);
+        let power = pj.map(|j| eff(build[j], render_t[j], rel[j]));
+        let power_t = pj.and_then(|j| at_time[j]).map(|(_, r, t)| eff(0.0, t, r));
+        for &sel in &selectors {
+            let Some(j) = runnable.iter().position(|&s| s == sel) else {
+                println!(
+                    "| {name} | {n} | {ref_name} | {sel} | – | – | – | skipped (> {} lights) |",
                     args.max_exhaustive_lights
-                ),
-                Some((b, t, rel)) => {
-                    let e =
-                        power.map_or("–".to_string(), |p| format!("{:.2}", eff(b, t, rel) / p));
-                    println!("| {name} | {n} | {sel} | {b:.3} | {t:.3} | {rel:.4e} | {e} |");
+                );
+                continue;
+            };
+            let (b, t, r) = (build[j], render_t[j], rel[j]);
+            let e = power.map_or("–".to_string(), |p| format!("{:.2}", eff(b, t, r) / p));
+            let extra = match (at_time[j], power_t) {
+                (Some((s, r2, t2)), Some(p)) => {
+                    format!(" {s} | {r2:.4e} | {:.2} |", eff(0.0, t2, r2) / p)
+                }
+                (Some((s, r2, _)), None) => format!(" {s} | {r2:.4e} | – |"),
+                _ => String::new(),
+            };
+            println!(
+                "| {name} | {n} | {ref_name} | {sel} | {b:.3} | {t:.3} | {r:.4e} | {e} |{extra}"
+            );
+        }
+    }
+    bvh_build_benchmark(100_000)
+}
+
+/// The built-in options of `--many-lights`.
+fn many_load_options(args: &Args) -> LoadOptions {
+    LoadOptions {
+        builtin: BuiltinOptions {
+            light_count: args.light_count,
+            rooms: args.rooms,
+            triangles: None,
+        },
+        ..LoadOptions::default()
+    }
+}
+
+/// The reference of `scene` (cached): the mean of [`reference_selectors`]' renders at
+/// `reference_factor × spp` each, with seeds no measured render uses.
+fn many_reference(
+    args: &Args,
+    scene: &penumbra::scene::Scene,
+    name: &str,
+    res: UVec2,
+    spp: u32,
+    dir: &std::path::Path,
+) -> anyhow::Result<(penumbra::image::Image, String)> {
+    let sels = reference_selectors(scene.lights.len(), args.max_exhaustive_lights);
+    let ref_spp = spp * args.reference_factor;
+    let label = format!(
+        "mean of {} at {ref_spp} spp",
+        sels.map(|s| s.to_string()).join("+")
+    );
+    let path = dir.join(format!(
+        "{name}-{}x{}-{ref_spp}spp-mix3-{:?}-{:?}.pfm",
+        res.x, res.y, args.light_count, args.rooms
+    ));
+    if let Ok(img) = read_image(&path)
+        && img.width == res.x
+        && img.height == res.y
+    {
+        return Ok((img, label));
+    }
+    let mut acc: Option<penumbra::image::Image> = None;
+    for (i, &sel) in sels.iter().enumerate() {
+        let opts = RenderOptions {
+            spp: ref_spp,
+            seed: 0x05ee_d4ef + i as u64,
+            light_selection: sel,
+            ..RenderOptions::default()
+        };
+        let (img, _) = render(scene, res, &opts)?;
+        match &mut acc {
+            None => acc = Some(img),
+            Some(a) => {
+                for (x, y) in a.pixels.iter_mut().zip(&img.pixels) {
+                    *x += *y;
                 }
             }
         }
     }
-    bvh_build_benchmark(100_000)
+    let mut img = acc.expect("three references");
+    for x in img.pixels.iter_mut() {
+        *x /= sels.len() as f32;
+    }
+    write_image(&img, &path, 0.0)?;
+    Ok((img, label))
+}
+
+/// Render on the current (one-thread) pool: the image, the selector's build CPU seconds and
+/// the render's CPU seconds (all threads of the process, from /proc, nanosecond resolution).
+fn timed_render(
+    scene: &penumbra::scene::Scene,
+    res: UVec2,
+    opts: &RenderOptions,
+) -> anyhow::Result<(penumbra::image::Image, f64, f64)> {
+    let c0 = cpu_ns();
+    drop(make_selector(opts.light_selection, scene, opts.seed));
+    let c1 = cpu_ns();
+    let (img, _) = render(scene, res, opts)?;
+    let c2 = cpu_ns();
+    // `render` builds its own selector again: subtract that build from its time.
+    let build = c1 - c0;
+    Ok((img, build, (c2 - c1 - build).max(0.0)))
+}
+
+/// Median of some numbers.
+fn median(v: impl Iterator<Item = f64>) -> f64 {
+    let mut v: Vec<f64> = v.collect();
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let m = v.len() / 2;
+    if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    }
+}
+
+/// CPU seconds of every thread of this process (sum of /proc/self/task/*/schedstat run times;
+/// nanosecond resolution), falling back to [`cpu_seconds`].
+fn cpu_ns() -> f64 {
+    let sum = std::fs::read_dir("/proc/self/task").ok().map(|d| {
+        d.flatten()
+            .filter_map(|e| std::fs::read_to_string(e.path().join("schedstat")).ok())
+            .filter_map(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+            .sum::<f64>()
+    });
+    match sum {
+        Some(ns) if ns > 0.0 => ns * 1e-9,
+        _ => cpu_seconds().unwrap_or(0.0),
+    }
+}
+
+/// The 1-minute load average (Linux), for the report.
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "?".into())
+}
+
+/// `penumbra bench --many-lights --selector-cost`: nanoseconds per `sample` and per `pmf`
+/// call of every strategy on the shading points of a 128×96 grid of eye rays (4 jittered
+/// passes), one thread, median of `--repeats` interleaved runs.
+fn selector_cost(args: &Args) -> anyhow::Result<()> {
+    use penumbra::light_selection::estimate::{eye_hit, pixel_rng};
+    use penumbra::sampling::hash::next_f32;
+    let mut cases: Vec<(String, Option<u32>)> = if args.scenes.is_empty() {
+        MANY.iter()
+            .map(|s| (s.to_string(), args.light_count))
+            .collect()
+    } else {
+        args.scenes
+            .iter()
+            .map(|s| (s.clone(), args.light_count))
+            .collect()
+    };
+    for &c in &args.light_counts {
+        cases.push(("many-open".to_string(), Some(c)));
+    }
+    let selectors: Vec<SelectorKind> = if args.selectors.is_empty() {
+        vec![
+            SelectorKind::Uniform,
+            SelectorKind::Power,
+            SelectorKind::Bvh,
+            SelectorKind::RIS,
+        ]
+    } else {
+        args.selectors.clone()
+    };
+    println!(
+        "selector cost: ns per call on eye-ray shading points, one thread, median of {} interleaved runs, load average {}",
+        args.repeats.max(1),
+        load_average()
+    );
+    println!();
+    println!(
+        "| scene | lights | strategy | build (s) | sample (ns) | pmf (ns) | sample / power's |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for (name, count) in cases {
+        let mut lopts = many_load_options(args);
+        lopts.builtin.light_count = count;
+        let scene = load(&name, &lopts)?.scene;
+        let res = UVec2::new(128, 96);
+        let mut points = Vec::new();
+        for pass in 0..4 {
+            for px in 0..res.x * res.y {
+                let mut rng = pixel_rng(7, 0x5e1c, pass, px);
+                if let Some(h) = eye_hit(&scene, res, px, &mut rng) {
+                    points.push((h.sp, next_f32(&mut rng)));
+                }
+            }
+        }
+        let mut built = Vec::new();
+        for &sel in &selectors {
+            if sel == SelectorKind::Exhaustive && scene.lights.len() > args.max_exhaustive_lights {
+                continue;
+            }
+            let c0 = cpu_ns();
+            let s = make_selector(sel, &scene, 0);
+            built.push((sel, s, cpu_ns() - c0, Vec::new(), Vec::new()));
+        }
+        for _ in 0..args.repeats.max(1) {
+            for (_, s, _, ts, tp) in built.iter_mut() {
+                // Passes over all points until 0.2 s of CPU time: the per-thread clock only
+                // advances at scheduler events, so short loops would read zero.
+                let picked: Vec<_> = points.iter().map(|&(sp, u)| s.sample(&sp, u)).collect();
+                let (mut calls, t0) = (0usize, cpu_ns());
+                let mut t1 = t0;
+                while t1 - t0 < 0.2 {
+                    for &(sp, u) in &points {
+                        std::hint::black_box(s.sample(&sp, std::hint::black_box(u)));
+                    }
+                    calls += points.len();
+                    t1 = cpu_ns();
+                }
+                ts.push((t1 - t0) * 1e9 / calls.max(1) as f64);
+                let (mut calls, mut acc) = (0usize, 0.0f32);
+                let mut t2 = t1;
+                while t2 - t1 < 0.2 {
+                    for (&(sp, _), p) in points.iter().zip(&picked) {
+                        if let Some(p) = p {
+                            acc += s.pmf(&sp, std::hint::black_box(p.index));
+                            calls += 1;
+                        }
+                    }
+                    t2 = cpu_ns();
+                    if calls == 0 {
+                        break;
+                    }
+                }
+                std::hint::black_box(acc);
+                tp.push((t2 - t1) * 1e9 / calls.max(1) as f64);
+            }
+        }
+        let n = scene.lights.len();
+        let power = built
+            .iter()
+            .find(|b| b.0 == SelectorKind::Power)
+            .map(|b| median(b.3.iter().copied()));
+        for (sel, _, build, ts, tp) in &built {
+            let (a, b) = (median(ts.iter().copied()), median(tp.iter().copied()));
+            let r = power.map_or("–".into(), |p| format!("{:.2}", a / p));
+            println!("| {name} | {n} | {sel} | {build:.3} | {a:.0} | {b:.0} | {r} |");
+        }
+    }
+    Ok(())
 }
 
 /// Build time and memory of the light BVH over the lights of `many-open` with `count` lights.

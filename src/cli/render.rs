@@ -67,9 +67,10 @@ pub struct Args {
     /// Sample pattern: fixed, random, grid, stratified, lhs or sobol.
     #[arg(long, default_value = "stratified")]
     pub pattern: PatternKind,
-    /// Light selection at every path vertex: uniform, power, spatial, adaptive, wald, bvh or
-    /// exhaustive. Default: the scene file's `lightsampler`, else bvh (the most efficient on
-    /// average over the built-in scenes, docs/many-lights.md).
+    /// Light selection at every path vertex: uniform, power, spatial, adaptive, wald, bvh,
+    /// exhaustive or ris (ris:K for K candidates, default 8). Default: the scene file's
+    /// `lightsampler`, else bvh (the most efficient on average over the built-in scenes,
+    /// docs/many-lights.md).
     #[arg(long)]
     pub light_selection: Option<SelectorKind>,
     /// Light sampling technique inside `mis`: solid-angle (default) or area.

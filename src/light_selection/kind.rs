@@ -21,11 +21,16 @@ pub enum SelectorKind {
     Bvh,
     /// Every light's importance at every shading point, O(N): the yardstick.
     Exhaustive,
+    /// Resampled importance sampling of K power-sampled candidates (`ris` or `ris:K`).
+    Ris {
+        /// K, the candidates per selection.
+        candidates: u32,
+    },
 }
 
 impl SelectorKind {
     /// Every strategy, in CLI order.
-    pub const ALL: [SelectorKind; 7] = [
+    pub const ALL: [SelectorKind; 8] = [
         SelectorKind::Uniform,
         SelectorKind::Power,
         SelectorKind::Spatial,
@@ -33,7 +38,19 @@ impl SelectorKind {
         SelectorKind::Wald,
         SelectorKind::Bvh,
         SelectorKind::Exhaustive,
+        SelectorKind::RIS,
     ];
+
+    /// `ris` with its default K.
+    pub const RIS: SelectorKind = SelectorKind::Ris {
+        candidates: super::ris::DEFAULT_CANDIDATES,
+    };
+
+    /// Whether `pmf` is the exact probability of `sample`'s choice (all but `ris`, whose
+    /// `pmf` is an estimate: see `ris.rs`).
+    pub fn exact_pmf(self) -> bool {
+        !matches!(self, SelectorKind::Ris { .. })
+    }
 
     /// The selector used wherever none is named (`penumbra render`, `bench`, the lab,
     /// `RenderOptions::default()`, pbrt files): the light BVH, as in pbrt-v4. Over the built-in
@@ -52,6 +69,7 @@ impl SelectorKind {
             SelectorKind::Wald => "wald",
             SelectorKind::Bvh => "bvh",
             SelectorKind::Exhaustive => "exhaustive",
+            SelectorKind::Ris { .. } => "ris",
         }
     }
 }
@@ -64,13 +82,29 @@ impl Default for SelectorKind {
 
 impl fmt::Display for SelectorKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+        match *self {
+            SelectorKind::Ris { candidates } if candidates != super::ris::DEFAULT_CANDIDATES => {
+                write!(f, "ris:{candidates}")
+            }
+            k => f.write_str(k.name()),
+        }
     }
 }
 
 impl FromStr for SelectorKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if let Some(k) = s.trim().strip_prefix("ris:") {
+            return match k.parse::<u32>() {
+                Ok(candidates) if (1..=super::ris::MAX_CANDIDATES).contains(&candidates) => {
+                    Ok(SelectorKind::Ris { candidates })
+                }
+                _ => Err(format!(
+                    "bad light selection '{s}': ris:K needs 1 <= K <= {}",
+                    super::ris::MAX_CANDIDATES
+                )),
+            };
+        }
         Self::ALL
             .into_iter()
             .find(|k| k.name() == s.trim())

@@ -6,7 +6,9 @@
 //! (importance of every light per shading point, O(N): the yardstick), [`bvh`] (light BVH à la
 //! Conty Estevez & Kulla 2018 / pbrt-v4), [`wald`] (Wald et al. 2003: one global distribution
 //! estimated from low-resolution eye rays), [`spatial`] (a grid of per-cell tables built from
-//! conservative bounds) and [`adaptive`] (the spatial grid, trained per cell by eye rays).
+//! conservative bounds), [`adaptive`] (the spatial grid, trained per cell by eye rays) and
+//! [`ris`] (resampled importance sampling of K power-sampled candidates; its `pmf` is RIS's
+//! contribution weight, not an exact probability: [`SelectorKind::exact_pmf`]).
 //!
 //! Every strategy except `uniform` works on the *finite* lights (those with [`LightBounds`]);
 //! [`Selector`] wraps it and gives lights without bounds (environment, sky, distant) a fixed
@@ -19,6 +21,7 @@ pub mod exhaustive;
 pub mod importance;
 pub mod kind;
 pub mod power;
+pub mod ris;
 pub mod spatial;
 pub mod uniform;
 pub mod wald;
@@ -29,6 +32,7 @@ pub use exhaustive::ExhaustiveSelector;
 pub use importance::importance;
 pub use kind::SelectorKind;
 pub use power::PowerSelector;
+pub use ris::RisSelector;
 pub use spatial::SpatialSelector;
 pub use uniform::UniformSelector;
 pub use wald::WaldSelector;
@@ -227,6 +231,9 @@ pub fn make_selector(
         SelectorKind::Power => wrap(&|set| Box::new(PowerSelector::new(&set.bounds))),
         SelectorKind::Exhaustive => wrap(&|set| Box::new(ExhaustiveSelector::new(&set.bounds))),
         SelectorKind::Bvh => wrap(&|set| Box::new(BvhSelector::new(&set.bounds))),
+        SelectorKind::Ris { candidates } => {
+            wrap(&|set| Box::new(RisSelector::new(&set.bounds, candidates, seed)))
+        }
         SelectorKind::Wald => {
             wrap(&|set| Box::new(WaldSelector::new(scene, set, &wald::WaldConfig::new(seed))))
         }

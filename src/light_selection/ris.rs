@@ -1,0 +1,136 @@
+//! Resampled importance sampling of lights (Talbot et al. 2005; the light-selection half of
+//! ReSTIR, Bitterli et al. 2020): draw K candidate lights from a cheap source (the power alias
+//! table), weight each by its target p̂ over its source probability, w = p̂/q, and keep one
+//! ∝ w. The target is the light's unshadowed contribution as its bounds predict it — the
+//! [`importance`] Φ·cos θ′/d²·cos θ′ᵢ, i.e. Le·G with a Lambertian f (the selector does not see
+//! the BSDF) — so as K grows the choice approaches `exhaustive` at O(K) per sample.
+//!
+//! **The pmf.** The probability that RIS returns a light is an expectation over the other
+//! candidates and has no closed form. `sample` therefore returns, as its `pmf`, the inverse of
+//! RIS's *contribution weight* W = (1/p̂(y))·(1/K)·Σᵢ wᵢ: with it the light estimator
+//! f(y)·W is exactly unbiased (E[g(Y)·W] = Σₗ g(l) for every g that is zero where p̂ is;
+//! `tests/ris_selection.rs` checks this against the exhaustive sum). `pmf(ctx, l)` — which MIS
+//! asks for when a BSDF ray hits light l — cannot know the candidates of the light sample at
+//! the same vertex, so it returns the same form for a fresh candidate set conditioned to hold
+//! l: K·p̂(l) / (w(l) + Σ of K − 1 other candidates' w), the candidates drawn from a hash of the
+//! shading point (deterministic). That is an *estimate*: the two MIS weights of a path then
+//! sum to 1 only on average, so `ris` under MIS is consistent but not exactly unbiased (the
+//! test measures the bias; with `--strategy light` there is none). Exact MIS would need the
+//! integrator to weight the light sample with a deterministic pmf (e.g. the source's) while it
+//! divides by 1/W — a second number in `SelectedLight`.
+//!
+//! Lights whose importance is zero (cannot reach the receiver's upper hemisphere) are never
+//! chosen; every other light keeps a positive probability (its source probability is > 0).
+//! K is part of the name: `ris` (K = [`DEFAULT_CANDIDATES`]) or `ris:K`.
+
+use super::power::PowerSelector;
+use super::{FiniteSelector, ShadingPoint, importance};
+use crate::lights::LightBounds;
+use crate::sampling::hash::{hash_keys, hash_step, u32_to_unit};
+
+/// Candidates per selection unless `ris:K` says otherwise.
+pub const DEFAULT_CANDIDATES: u32 = 8;
+/// Most candidates accepted (a stack array holds them).
+pub const MAX_CANDIDATES: u32 = 256;
+
+/// RIS over power-sampled candidates.
+#[derive(Clone, Debug)]
+pub struct RisSelector {
+    source: PowerSelector,
+    bounds: Vec<LightBounds>,
+    k: u32,
+    seed: u64,
+}
+
+#[inline]
+fn unit(h: u64) -> f32 {
+    u32_to_unit((h >> 32) as u32)
+}
+
+impl RisSelector {
+    /// `k` candidates per selection from power sampling over `bounds`.
+    pub fn new(bounds: &[LightBounds], k: u32, seed: u64) -> Self {
+        Self {
+            source: PowerSelector::new(bounds),
+            bounds: bounds.to_vec(),
+            k: k.clamp(1, MAX_CANDIDATES),
+            seed,
+        }
+    }
+
+    /// Candidates per selection.
+    pub fn candidates(&self) -> u32 {
+        self.k
+    }
+
+    /// Target p̂ of local light `l` at `ctx`.
+    #[inline]
+    fn target(&self, ctx: &ShadingPoint, l: u32) -> f32 {
+        importance(ctx.p, ctx.n, &self.bounds[l as usize])
+    }
+
+    /// Key of a shading point's candidate stream.
+    fn point_key(&self, ctx: &ShadingPoint, salt: u64) -> u64 {
+        hash_keys(&[
+            self.seed,
+            salt,
+            ctx.p.x.to_bits() as u64 | (ctx.p.y.to_bits() as u64) << 32,
+            ctx.p.z.to_bits() as u64 | (ctx.n.x.to_bits() as u64) << 32,
+            ctx.n.y.to_bits() as u64 | (ctx.n.z.to_bits() as u64) << 32,
+        ])
+    }
+
+    /// Draw candidate `i` of stream `key`: (light, p̂, w = p̂/q).
+    #[inline]
+    fn candidate(&self, ctx: &ShadingPoint, key: u64, i: u32) -> Option<(u32, f32, f64)> {
+        let (l, q) = self.source.pick(unit(hash_step(key, i as u64)))?;
+        let t = self.target(ctx, l);
+        let w = if q > 0.0 { t as f64 / q as f64 } else { 0.0 };
+        Some((l, t, w))
+    }
+}
+
+impl FiniteSelector for RisSelector {
+    fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
+        // The candidates come from u (and the point); the final choice from a further number
+        // of the same stream.
+        let key = hash_step(self.point_key(ctx, 1), u.to_bits() as u64);
+        let mut chosen: Option<(u32, f32)> = None;
+        let mut sum = 0.0f64;
+        for i in 0..self.k {
+            let (l, t, w) = self.candidate(ctx, key, i)?;
+            if w <= 0.0 {
+                continue;
+            }
+            sum += w;
+            // Weighted reservoir: replace with probability w / sum.
+            let v = unit(hash_step(key, (MAX_CANDIDATES + i) as u64)) as f64;
+            if v * sum < w {
+                chosen = Some((l, t));
+            }
+        }
+        let (l, t) = chosen?;
+        let pmf = (self.k as f64 * t as f64 / sum) as f32;
+        (pmf > 0.0 && pmf.is_finite()).then_some((l, pmf))
+    }
+
+    fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32 {
+        if light as usize >= self.bounds.len() {
+            return 0.0;
+        }
+        let t = self.target(ctx, light);
+        let q = self.source.prob(light);
+        if t <= 0.0 || q <= 0.0 {
+            return 0.0;
+        }
+        let w = t as f64 / q as f64;
+        let key = self.point_key(ctx, 2);
+        let mut sum = w;
+        for i in 1..self.k {
+            if let Some((_, _, wi)) = self.candidate(ctx, key, i) {
+                sum += wi;
+            }
+        }
+        (self.k as f64 * t as f64 / sum) as f32
+    }
+}
