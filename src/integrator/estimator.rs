@@ -218,10 +218,15 @@ impl Techniques {
         !matches!(self, Techniques::Bsdf)
     }
 
-    /// Whether BSDF samples gather emission.
+    /// Whether BSDF samples are drawn and gather emission: under every strategy, at every
+    /// vertex (the path's last too). Under light sampling alone only what they reach through
+    /// a delta lobe counts ([`emission_weight`]): no light sample can produce that direction,
+    /// so without them a light seen in a mirror or through glass at a path's last vertex was
+    /// lost (tests/furnace_mirror.rs). Their other values are 0 and trace nothing
+    /// ([`emitter_hit_value`]).
     #[inline(always)]
     pub(super) fn bsdf(self) -> bool {
-        !matches!(self, Techniques::Light)
+        true
     }
 
     /// The MIS heuristic, if the techniques are combined.
@@ -274,7 +279,12 @@ pub(super) fn emitter_hit_value(
     if le == Rgb::ZERO {
         return None;
     }
-    Some(weight * le * w())
+    // A zero weight (light sampling alone, not after a delta lobe) needs no shadow ray.
+    let w = w();
+    if w == 0.0 {
+        return None;
+    }
+    Some(weight * le * w)
 }
 
 /// Radiance arriving along unit direction `wi` that escaped the scene: every infinite light's

@@ -13,6 +13,10 @@ use crate::{Rgb, luminance};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
+/// Relative slack on r² within which a receiver counts as on (so inside) an inward sphere:
+/// far above the rounding of a hit on the sphere (~1e-6), far below any gap a scene models.
+const ON_SPHERE: f32 = 1e-4;
+
 /// A sphere emitting constant radiance `l` outward (or inward, into its interior).
 #[derive(Clone, Copy, Debug)]
 pub struct SphereLight {
@@ -55,7 +59,14 @@ impl SphereLight {
     fn view(&self, p: Vec3, mode: SamplingMode) -> View {
         let to_c = self.center - p;
         let d2 = to_c.length_squared();
-        let outside = d2 > self.radius * self.radius;
+        let r2 = self.radius * self.radius;
+        // A receiver on an inward sphere (a hit on the light's own surface, its rounding on
+        // either side) sees the interior: it used to count as outside half the time.
+        let outside = if self.inward {
+            d2 > r2 * (1.0 + ON_SPHERE)
+        } else {
+            d2 > r2
+        };
         match (outside, self.inward) {
             (true, false) if mode == SamplingMode::SolidAngle => View::Cone {
                 frame: Frame::from_normal(to_c / d2.sqrt()),
@@ -80,8 +91,14 @@ impl SphereLight {
         }
         let s = disc.sqrt();
         let c = oc.length_squared() - self.radius * self.radius;
-        // Roots −b ± s; the near one from outside (c > 0), the far one from inside.
-        let t = if c > 0.0 { -b - s } else { -b + s };
+        // Roots −b ± s; the near one from outside (c > 0), the far one from inside. An inward
+        // sphere is seen from inside (or from its own surface, `view`): always the far one,
+        // else a receiver on the sphere rounded outside found itself (t ≈ 0).
+        let t = if c > 0.0 && !self.inward {
+            -b - s
+        } else {
+            -b + s
+        };
         if !is_positive(t) {
             return None;
         }
