@@ -531,6 +531,7 @@ Material "conductor" "texture roughness" "r"
             scale: Rgb::splat(0.5),
             invert: false,
             encoding: penumbra::scene::pbrt::textures::Encoding::SRgb,
+            sampling: Default::default(),
         }
     );
     assert!(
