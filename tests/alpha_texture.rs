@@ -30,7 +30,7 @@ enum Roof {
 
 /// A diffuse ground at z = 0 under a roof at z = 1 (uv = world xy), a distant light from
 /// straight above; the camera below the roof (`above: false`, sees only the ground) or above
-/// it looking down through it (`above: true`; the roof is black).
+/// it looking down through it (`above: true`; the roof is black). `Roof::Open`: no roof.
 fn scene(roof: Roof, above: bool) -> String {
     let alpha = match roof {
         Roof::Open => "",
@@ -38,7 +38,7 @@ fn scene(roof: Roof, above: bool) -> String {
         Roof::Image => "\"texture alpha\" \"img\"",
     };
     let roof = match roof {
-        Roof::Open if !above => String::new(),
+        Roof::Open => String::new(),
         _ => format!(
             "Material \"diffuse\" \"rgb reflectance\" [0 0 0]\n\
              Shape \"trianglemesh\" {alpha} \"integer indices\" [0 1 2 0 2 3] \
@@ -118,6 +118,7 @@ fn check(what: &str, roof: Roof, above: bool, want: f64, dir: &Path) {
 #[test]
 fn checkerboard_alpha_passes_one_minus_its_mean_coverage() {
     let dir = tmpdir("checker");
+    write_coverage(&dir);
     check("checker, shadow rays", Roof::Checker, false, 0.6, &dir);
     check("checker, camera + shadow rays", Roof::Checker, true, 0.36, &dir);
 }
@@ -136,6 +137,7 @@ fn image_alpha_passes_one_minus_its_mean_coverage() {
 #[test]
 fn coarse_checker_alpha_cuts_where_it_is_zero() {
     let dir = tmpdir("coarse");
+    write_coverage(&dir);
     let src = scene(Roof::Checker, false)
         .replace("\"float uscale\" 1000 \"float vscale\" 1000", "\"float uscale\" 10 \"float vscale\" 10")
         .replace("\"float tex1\" 0.7 \"float tex2\" 0.1", "\"float tex1\" 1 \"float tex2\" 0");
