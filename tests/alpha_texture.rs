@@ -120,7 +120,13 @@ fn checkerboard_alpha_passes_one_minus_its_mean_coverage() {
     let dir = tmpdir("checker");
     write_coverage(&dir);
     check("checker, shadow rays", Roof::Checker, false, 0.6, &dir);
-    check("checker, camera + shadow rays", Roof::Checker, true, 0.36, &dir);
+    check(
+        "checker, camera + shadow rays",
+        Roof::Checker,
+        true,
+        0.36,
+        &dir,
+    );
 }
 
 #[test]
@@ -129,7 +135,13 @@ fn image_alpha_passes_one_minus_its_mean_coverage() {
     write_coverage(&dir);
     let c: f64 = 0.425;
     check("image, shadow rays", Roof::Image, false, 1.0 - c, &dir);
-    check("image, camera + shadow rays", Roof::Image, true, (1.0 - c).powi(2), &dir);
+    check(
+        "image, camera + shadow rays",
+        Roof::Image,
+        true,
+        (1.0 - c).powi(2),
+        &dir,
+    );
 }
 
 /// A coarse checker (one square per unit) is opaque exactly where tex1 = 1 and open where
@@ -139,8 +151,14 @@ fn coarse_checker_alpha_cuts_where_it_is_zero() {
     let dir = tmpdir("coarse");
     write_coverage(&dir);
     let src = scene(Roof::Checker, false)
-        .replace("\"float uscale\" 1000 \"float vscale\" 1000", "\"float uscale\" 10 \"float vscale\" 10")
-        .replace("\"float tex1\" 0.7 \"float tex2\" 0.1", "\"float tex1\" 1 \"float tex2\" 0");
+        .replace(
+            "\"float uscale\" 1000 \"float vscale\" 1000",
+            "\"float uscale\" 10 \"float vscale\" 10",
+        )
+        .replace(
+            "\"float tex1\" 0.7 \"float tex2\" 0.1",
+            "\"float tex1\" 1 \"float tex2\" 0",
+        );
     let parsed = penumbra::scene::pbrt::parse_pbrt_str("roof.pbrt", &src, &dir).unwrap();
     let (b, cam, film, _) = parsed.into_builder().unwrap();
     let scene = b.build(cam, film).unwrap();
@@ -158,6 +176,9 @@ fn coarse_checker_alpha_cuts_where_it_is_zero() {
     let (a, b) = ((at(6, 6), at(17, 17)), (at(17, 6), at(6, 17)));
     eprintln!("even squares {a:?}, odd squares {b:?}");
     let (dark, lit) = if a.0 < b.0 { (a, b) } else { (b, a) };
-    assert!(dark.0 < 1e-6 && dark.1 < 1e-6, "opaque squares let light through: {dark:?}");
+    assert!(
+        dark.0 < 1e-6 && dark.1 < 1e-6,
+        "opaque squares let light through: {dark:?}"
+    );
     assert!(lit.0 > 0.1 && lit.1 > 0.1, "open squares are dark: {lit:?}");
 }

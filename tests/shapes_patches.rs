@@ -51,7 +51,10 @@ fn cylinder_rays_hit_their_analytic_points() {
          Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" -1 \"float zmax\" 2 \"float phimax\" 270\n\
          AttributeEnd",
     );
-    assert!(!warnings.iter().any(|w| w.contains("cylinder")), "{warnings:?}");
+    assert!(
+        !warnings.iter().any(|w| w.contains("cylinder")),
+        "{warnings:?}"
+    );
     let rot = glam::Mat3::from_rotation_x(30f32.to_radians());
     let t = Vec3::new(0.3, -0.2, 0.1);
     let world = |q: Vec3| rot * q + t;
@@ -63,9 +66,9 @@ fn cylinder_rays_hit_their_analytic_points() {
         let q = Vec3::new(r * phi.cos(), r * phi.sin(), z);
         // An origin on the point's outward side (visible: the cylinder is convex from
         // there along this ray), then the ray toward the point.
-        let dir_out = (n_obj + Vec3::new(0.0, 0.0, 2.0 * c - 1.0) * 0.8
-            + n_obj.cross(Vec3::Z) * (d - 0.5))
-            .normalize();
+        let dir_out =
+            (n_obj + Vec3::new(0.0, 0.0, 2.0 * c - 1.0) * 0.8 + n_obj.cross(Vec3::Z) * (d - 0.5))
+                .normalize();
         if dir_out.dot(n_obj) < 0.2 {
             continue;
         }
@@ -108,7 +111,10 @@ fn cylinder_rays_hit_their_analytic_points() {
     assert!(
         scene
             .geometry
-            .intersect(&Ray::new(o, (world(Vec3::new(0.0, 0.0, 2.5)) - o).normalize()))
+            .intersect(&Ray::new(
+                o,
+                (world(Vec3::new(0.0, 0.0, 2.5)) - o).normalize()
+            ))
             .is_none()
     );
 }
@@ -152,7 +158,11 @@ fn bilinear_patch_rays_hit_the_true_patch() {
             .geometry
             .intersect(&Ray::new(o, dir))
             .unwrap_or_else(|| panic!("ray toward {p} missed"));
-        assert!((h.p - p).length() < 2e-5, "hit {} vs {p} (u {u} v {v})", h.p);
+        assert!(
+            (h.p - p).length() < 2e-5,
+            "hit {} vs {p} (u {u} v {v})",
+            h.p
+        );
         assert!((h.ng - n).length() < 1e-4, "normal {} vs {n}", h.ng);
         assert!((h.uv - uv).length() < 1e-4, "uv {} vs {uv}", h.uv);
         // Where the two triangles would have been hit.
@@ -247,7 +257,11 @@ fn bump_map_includes_the_displacement_times_dndu_term() {
         let disp = |u: f64, v: f64| {
             let phi = 2.0 * std::f64::consts::PI * u;
             let hh = h(u as f32) as f64;
-            glam::DVec3::new(phi.cos() * (radius as f64 + hh), phi.sin() * (radius as f64 + hh), v)
+            glam::DVec3::new(
+                phi.cos() * (radius as f64 + hh),
+                phi.sin() * (radius as f64 + hh),
+                v,
+            )
         };
         let e = 1e-4;
         let (u64_, v64) = (u as f64, v as f64);
@@ -291,6 +305,9 @@ fn triangle_dndu_matches_the_cylinders() {
     let um = 0.5 * (u0 + u1);
     let phi = 2.0 * PI * um;
     let want = Vec3::new(-phi.sin(), phi.cos(), 0.0) * 2.0 * PI;
-    assert!((dndu - want).length() < 1e-3 * want.length(), "{dndu} vs {want}");
+    assert!(
+        (dndu - want).length() < 1e-3 * want.length(),
+        "{dndu} vs {want}"
+    );
     assert!(dndv.length() < 1e-6, "{dndv}");
 }

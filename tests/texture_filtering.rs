@@ -34,7 +34,9 @@ fn numbered() -> ImageRgb {
     ImageRgb {
         width: 4,
         height: 4,
-        pixels: (0..16).map(|i| Rgb::splat((10 * (i / 4) + i % 4) as f32)).collect(),
+        pixels: (0..16)
+            .map(|i| Rgb::splat((10 * (i / 4) + i % 4) as f32))
+            .collect(),
     }
 }
 
@@ -43,7 +45,12 @@ fn wrap_modes_read_pbrts_texels() {
     let img = numbered();
     let v = |x: i64, y: i64, w: Wrap| img.texel(x, y, w).x;
     // Inside, every mode reads the texel itself.
-    for w in [Wrap::Repeat, Wrap::Black, Wrap::Clamp, Wrap::OctahedralSphere] {
+    for w in [
+        Wrap::Repeat,
+        Wrap::Black,
+        Wrap::Clamp,
+        Wrap::OctahedralSphere,
+    ] {
         assert_eq!(v(2, 1, w), 12.0);
     }
     // repeat: modulo; clamp: the edge; black: zero.
@@ -124,8 +131,14 @@ fn pyramid_levels_are_box_means_and_lookups_pick_pbrts_level() {
 #[test]
 fn filtered_checkerboard_is_the_triangle_filtered_square_wave() {
     // Without footprint: 0 on even squares, 1 on odd.
-    assert_eq!(checkerboard_weight(&TexCoord::point(Vec2::new(0.5, 0.5))), 0.0);
-    assert_eq!(checkerboard_weight(&TexCoord::point(Vec2::new(1.5, 0.5))), 1.0);
+    assert_eq!(
+        checkerboard_weight(&TexCoord::point(Vec2::new(0.5, 0.5))),
+        0.0
+    );
+    assert_eq!(
+        checkerboard_weight(&TexCoord::point(Vec2::new(1.5, 0.5))),
+        1.0
+    );
     // A wide footprint: the mean ½ (the triangle filter spans many squares).
     let wide = TexCoord {
         uv: Vec2::new(0.37, 0.81),
@@ -216,11 +229,8 @@ fn render_stats(src: &str, dir: &Path, filtering: bool) -> (f64, f64) {
 fn far_checkers_converge_to_their_mean_with_less_variance() {
     let dir = tmpdir("far");
     write_checker(&dir);
-    let (flat, flat_var) = render_stats(
-        &far_plane("\"rgb reflectance\" [0.5 0.5 0.5]"),
-        &dir,
-        true,
-    );
+    let (flat, flat_var) =
+        render_stats(&far_plane("\"rgb reflectance\" [0.5 0.5 0.5]"), &dir, true);
     assert!((flat - 0.5).abs() < 1e-3, "E = π, ρ = 0.5 renders {flat}");
     assert!(flat_var < 1e-8, "{flat_var}");
     for (what, refl) in [
@@ -237,8 +247,14 @@ fn far_checkers_converge_to_their_mean_with_less_variance() {
             "{what}: point lookups mean {point_mean:.4} var {point_var:.2e}; filtered mean \
              {mip_mean:.5} var {mip_var:.2e}"
         );
-        assert!(point_var > 1e-3, "{what}: the point lookups did not alias: {point_var}");
-        assert!((point_mean - 0.5).abs() < 5.0 * se, "{what}: point mean {point_mean}");
+        assert!(
+            point_var > 1e-3,
+            "{what}: the point lookups did not alias: {point_var}"
+        );
+        assert!(
+            (point_mean - 0.5).abs() < 5.0 * se,
+            "{what}: point mean {point_mean}"
+        );
         assert!(
             mip_var < 0.01 * point_var,
             "{what}: filtered variance {mip_var} is not ≪ {point_var}"
@@ -268,13 +284,19 @@ fn wrap_and_filter_are_parsed_and_unknown_ones_rejected() {
     ] {
         let s = parse_pbrt_str("t.pbrt", &with(ok), &dir).unwrap();
         assert!(
-            !s.warnings.iter().any(|w| w.contains("wrap") || w.contains("filter")),
+            !s.warnings
+                .iter()
+                .any(|w| w.contains("wrap") || w.contains("filter")),
             "{ok}: {:?}",
             s.warnings
         );
     }
     let s = parse_pbrt_str("t.pbrt", &with("\"string filter\" \"ewa\""), &dir).unwrap();
-    assert!(s.warnings.iter().any(|w| w.contains("ewa")), "{:?}", s.warnings);
+    assert!(
+        s.warnings.iter().any(|w| w.contains("ewa")),
+        "{:?}",
+        s.warnings
+    );
     for bad in ["\"string wrap\" \"mirror\"", "\"string filter\" \"gauss\""] {
         let e = parse_pbrt_str("t.pbrt", &with(bad), &dir).unwrap_err();
         assert!(format!("{e:#}").contains("t.pbrt:2"), "{e:#}");
@@ -330,7 +352,9 @@ fn textured_layer_parameters_are_the_constant_ones_of_each_half() {
     }
     let s = parse_pbrt_str("t.pbrt", &src2, &dir).unwrap_or_else(|e| panic!("{e:#}"));
     assert!(
-        !s.warnings.iter().any(|w| w.contains("albedo") || w.contains("varying")),
+        !s.warnings
+            .iter()
+            .any(|w| w.contains("albedo") || w.contains("varying")),
         "{:?}",
         s.warnings
     );
@@ -341,9 +365,18 @@ fn textured_layer_parameters_are_the_constant_ones_of_each_half() {
         .map(|d| to_material(d, &s.images, &mut w).unwrap())
         .collect();
     let dirs = [
-        (Vec3::new(0.3, 0.2, 0.93).normalize(), Vec3::new(-0.5, 0.1, 0.86).normalize()),
-        (Vec3::new(0.0, 0.6, 0.8), Vec3::new(0.1, -0.7, 0.7).normalize()),
-        (Vec3::new(0.7, 0.0, 0.71).normalize(), Vec3::new(0.69, 0.0, 0.72).normalize()),
+        (
+            Vec3::new(0.3, 0.2, 0.93).normalize(),
+            Vec3::new(-0.5, 0.1, 0.86).normalize(),
+        ),
+        (
+            Vec3::new(0.0, 0.6, 0.8),
+            Vec3::new(0.1, -0.7, 0.7).normalize(),
+        ),
+        (
+            Vec3::new(0.7, 0.0, 0.71).normalize(),
+            Vec3::new(0.69, 0.0, 0.72).normalize(),
+        ),
     ];
     let f = |mat: &Material, uv: Vec2| -> Vec<Rgb> {
         let b = mat.bsdf(&hit_at(uv), true);
@@ -359,6 +392,9 @@ fn textured_layer_parameters_are_the_constant_ones_of_each_half() {
             .iter()
             .zip(&fr)
             .any(|(a, b)| (*a - *b).abs().max_element() > 0.02 * a.max_element().max(1e-3));
-        assert!(differ, "material {base}: the halves' parameters change nothing: {fl:?} {fr:?}");
+        assert!(
+            differ,
+            "material {base}: the halves' parameters change nothing: {fl:?} {fr:?}"
+        );
     }
 }

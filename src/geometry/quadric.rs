@@ -225,12 +225,20 @@ impl Quadric {
 
 impl Quadric {
     /// Surface data of a bilinear patch hit near `t` (the patch solve again, for (u, v)).
-    fn bilinear_surface(&self, o: DVec3, d: DVec3, t: f32, c: &[Vec3; 4], uv: &[Vec2; 4]) -> QuadricHit {
+    fn bilinear_surface(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t: f32,
+        c: &[Vec3; 4],
+        uv: &[Vec2; 4],
+    ) -> QuadricHit {
         // The hit was found below t_max = t's successor: solve again just past it.
-        let (_, u, v) = bilinear_hit(o, d, c, t as f64 * (1.0 + 1e-6) + 1e-30).unwrap_or_else(|| {
-            // Not found again (rounding at an edge): project the point onto the patch.
-            (t as f64, 0.5, 0.5)
-        });
+        let (_, u, v) =
+            bilinear_hit(o, d, c, t as f64 * (1.0 + 1e-6) + 1e-30).unwrap_or_else(|| {
+                // Not found again (rounding at an edge): project the point onto the patch.
+                (t as f64, 0.5, 0.5)
+            });
         let cd = c.map(|p| p.as_dvec3());
         let lerp = |a: DVec3, b: DVec3, s: f64| a + (b - a) * s;
         let pobj = lerp(lerp(cd[0], cd[1], u), lerp(cd[2], cd[3], u), v);
@@ -238,7 +246,8 @@ impl Quadric {
         let dpdv = lerp(cd[2] - cd[0], cd[3] - cd[1], u);
         let n_obj = dpdu.cross(dpdv).as_vec3();
         let (uf, vf) = (u as f32, v as f32);
-        let tex = (uv[0] * (1.0 - uf) + uv[1] * uf) * (1.0 - vf) + (uv[2] * (1.0 - uf) + uv[3] * uf) * vf;
+        let tex =
+            (uv[0] * (1.0 - uf) + uv[1] * uf) * (1.0 - vf) + (uv[2] * (1.0 - uf) + uv[3] * uf) * vf;
         let pw = self.to_world.point(pobj.as_vec3());
         let mut n = self.to_world.normal(n_obj).normalize_or_zero();
         if self.flip {
@@ -280,7 +289,11 @@ pub fn bilinear_hit(o: DVec3, d: DVec3, c: &[Vec3; 4], t_max: f64) -> Option<(f6
             return None;
         }
         let s = disc.sqrt();
-        let q = if b < 0.0 { -0.5 * (b - s) } else { -0.5 * (b + s) };
+        let q = if b < 0.0 {
+            -0.5 * (b - s)
+        } else {
+            -0.5 * (b + s)
+        };
         let (r0, r1) = (q / a, if q != 0.0 { cc / q } else { -b / a });
         if r0 <= r1 { [r0, r1] } else { [r1, r0] }
     };

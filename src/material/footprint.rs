@@ -2,7 +2,8 @@
 //! and later vertices alike): `Camera::Approximate_dp_dxy` — the hit seen from the camera
 //! through rays one pixel apart (the camera's smallest position and direction differentials
 //! over the film), met on the hit's tangent plane, scaled by pbrt's
-//! max(1/8, 1/√spp) (here 1/8, its value at 64 spp and more) — then
+//! max(1/8, 1/√spp) with the scene's sample count (its `Sampler`'s `pixelsamples`, else 64:
+//! the scale is fixed when the scene is built, so `--spp` does not change it) — then
 //! `SurfaceInteraction::ComputeDifferentials`: ∂(u, v)/∂x, ∂(u, v)/∂y by least squares
 //! against the triangle's ∂p/∂u, ∂p/∂v. MIP-mapped images and checkerboards filter over it.
 
@@ -11,9 +12,10 @@ use crate::camera::Camera;
 use crate::geometry::{Geometry, PrimKind, SurfaceHit};
 use glam::{UVec2, Vec2, Vec3};
 
-/// pbrt-v4's footprint scale max(1/8, 1/√spp) at 64 spp or more (the scale is fixed when the
-/// scene is built; pbrt widens footprints below 64 spp).
-pub const SPP_SCALE: f32 = 0.125;
+/// pbrt-v4's footprint scale max(1/8, 1/√spp) for `spp` samples per pixel.
+pub fn spp_scale(spp: u32) -> f32 {
+    (1.0 / (spp.max(1) as f32).sqrt()).max(0.125)
+}
 
 /// What a footprint needs of the camera and of the textured triangles.
 #[derive(Debug)]
@@ -25,6 +27,8 @@ pub struct Footprint {
     dpos: f32,
     /// Smallest difference between neighbouring pixels' unit directions.
     ddir: f32,
+    /// pbrt's max(1/8, 1/√spp).
+    scale: f32,
     /// Per primitive: index into `derivs`, or `u32::MAX` (no filtered texture there).
     slot: Vec<u32>,
     /// ∂p/∂u, ∂p/∂v of the triangles that need them.
@@ -48,11 +52,12 @@ pub fn triangle_dpduv(p: [Vec3; 3], uv: [Vec2; 3]) -> Option<(Vec3, Vec3)> {
 }
 
 impl Footprint {
-    /// The footprint model of `camera` at resolution `res` for the primitives of `geometry`
-    /// whose material `wanted` says filters its textures.
+    /// The footprint model of `camera` at resolution `res` and `spp` samples per pixel for
+    /// the primitives of `geometry` whose material `wanted` says filters its textures.
     pub fn new(
         camera: &Camera,
         res: UVec2,
+        spp: u32,
         geometry: &Geometry,
         wanted: impl Fn(u32) -> bool,
     ) -> Self {
@@ -111,6 +116,7 @@ impl Footprint {
             axes,
             dpos: if dpos.is_finite() { dpos } else { 0.0 },
             ddir: if ddir.is_finite() { ddir } else { 0.0 },
+            scale: spp_scale(spp),
             slot,
             derivs,
         }
@@ -122,7 +128,7 @@ impl Footprint {
     }
 
     /// World-space ∂p/∂x, ∂p/∂y at a point `p` with normal `n` (pbrt's
-    /// `Approximate_dp_dxy`, already scaled by [`SPP_SCALE`]), `None` when the camera sees the
+    /// `Approximate_dp_dxy`, already scaled by [`spp_scale`]), `None` when the camera sees the
     /// plane edge-on or from its own position.
     pub fn dp_dxy(&self, p: Vec3, n: Vec3) -> Option<(Vec3, Vec3)> {
         let d = p - self.origin;
@@ -146,7 +152,7 @@ impl Footprint {
         };
         let dx = meet(self.origin + a * self.dpos, r + a * self.ddir)?;
         let dy = meet(self.origin + b * self.dpos, r + b * self.ddir)?;
-        Some((dx * SPP_SCALE, dy * SPP_SCALE))
+        Some((dx * self.scale, dy * self.scale))
     }
 
     /// The hit's texture coordinates with their footprint (a point lookup where there is

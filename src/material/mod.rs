@@ -184,7 +184,12 @@ impl Material {
     /// [`Material::bsdf`] for every material (the out-of-line path).
     #[inline(never)]
     fn bsdf_general(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
-        self.bsdf_with(hit, &TexCoord::point(hit.uv), front, AlphaOverride::default())
+        self.bsdf_with(
+            hit,
+            &TexCoord::point(hit.uv),
+            front,
+            AlphaOverride::default(),
+        )
     }
 
     /// The BSDF at a hit, textures read over `tc`, with GGX widths `ov` replacing the
@@ -334,7 +339,8 @@ impl Material {
         match self {
             Material::Diffuse { reflectance } => reflectance.filters(),
             Material::Phong { kd, .. } => kd.filters(),
-            Material::Conductor { reflectance, .. } | Material::CoatedConductor { reflectance, .. } => {
+            Material::Conductor { reflectance, .. }
+            | Material::CoatedConductor { reflectance, .. } => {
                 reflectance.as_ref().is_some_and(Texture::filters)
             }
             Material::CoatedDiffuse { reflectance, .. } => reflectance.filters(),

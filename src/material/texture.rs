@@ -168,7 +168,11 @@ impl TexCoord {
     /// pbrt-v4's isotropic filter width: 2 × the largest derivative component.
     #[inline]
     pub fn width(&self) -> f32 {
-        2.0 * self.duvdx.abs().max_element().max(self.duvdy.abs().max_element())
+        2.0 * self
+            .duvdx
+            .abs()
+            .max_element()
+            .max(self.duvdy.abs().max_element())
     }
 }
 

@@ -4,10 +4,10 @@
 //! which replace the shading normal (pbrt-v4's `NormalMap` and `BumpMap`).
 
 use super::float_texture::FloatTexture;
+use super::texture::{ImageRgb, TexCoord};
 use super::{Material, Texture};
 use crate::Rgb;
 use crate::bsdf::LayerParams;
-use super::texture::{ImageRgb, TexCoord};
 use crate::bsdf::roughness_to_alpha;
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
@@ -74,11 +74,19 @@ impl LayerTextures {
         let mut p = base;
         if let Some(t) = &self.thickness {
             let v = t.eval_at(tc);
-            p.thickness = if v.is_finite() { v.max(0.0) } else { base.thickness };
+            p.thickness = if v.is_finite() {
+                v.max(0.0)
+            } else {
+                base.thickness
+            };
         }
         if let Some(g) = &self.g {
             let v = g.eval_at(tc);
-            p.g = if v.is_finite() { v.clamp(-0.99, 0.99) } else { base.g };
+            p.g = if v.is_finite() {
+                v.clamp(-0.99, 0.99)
+            } else {
+                base.g
+            };
         }
         if let Some(a) = &self.albedo {
             p.albedo = a.eval_at(tc).clamp(Rgb::ZERO, Rgb::ONE);
@@ -167,7 +175,11 @@ impl NormalPerturbation {
                 // pbrt-v4's BumpMap: steps from the footprint, else 0.0005.
                 let step = |a: f32, b: f32| {
                     let s = 0.5 * (a.abs() + b.abs());
-                    if s > 0.0 && s.is_finite() { s } else { BUMP_DELTA }
+                    if s > 0.0 && s.is_finite() {
+                        s
+                    } else {
+                        BUMP_DELTA
+                    }
                 };
                 let du = step(tc.duvdx.x, tc.duvdy.x);
                 let dv = step(tc.duvdx.y, tc.duvdy.y);

@@ -343,7 +343,9 @@ impl SceneBuilder {
                 let (s, c) = phi.sin_cos();
                 for (z, v) in [(zmin, 0.0), (zmax, 1.0)] {
                     positions.push(to_world.point(Vec3::new(radius * c, radius * s, z)));
-                    let nn = nt.transform_vector3(Vec3::new(c, s, 0.0)).normalize_or_zero();
+                    let nn = nt
+                        .transform_vector3(Vec3::new(c, s, 0.0))
+                        .normalize_or_zero();
                     normals.push(if flip { -nn } else { nn });
                     uvs.push(glam::Vec2::new(u, v));
                 }
@@ -433,6 +435,7 @@ impl SceneBuilder {
             let fp = std::sync::Arc::new(crate::material::Footprint::new(
                 &camera,
                 film.resolution,
+                film.spp.unwrap_or(64),
                 &geometry,
                 |m| filtering.get(m as usize).copied().unwrap_or(false),
             ));

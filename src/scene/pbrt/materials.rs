@@ -264,16 +264,6 @@ fn normal_desc(
             "material has both 'normalmap' and 'displacement': the normal map is used".into(),
         );
     }
-    if map.is_none() && bump.is_some() {
-        warn(
-            "bump-approx",
-            loc,
-            format!(
-                "bump mapping: finite differences of {} in uv (no ray differentials) and without the displacement·∂n/∂u term of curved shading normals",
-                crate::material::varying::BUMP_DELTA
-            ),
-        );
-    }
     Ok(map.or(bump))
 }
 

@@ -130,10 +130,12 @@ impl ShapeGeom {
                     .iter()
                     .map(|(p, uv, f)| (p.map(|q| t.point(q)), *uv, *f ^ t.swaps_handedness()))
                     .collect(),
-                mesh: mesh.as_ref().map(|m| match ShapeGeom::Mesh(m.clone()).transformed(t) {
-                    ShapeGeom::Mesh(m) => m,
-                    _ => unreachable!(),
-                }),
+                mesh: mesh
+                    .as_ref()
+                    .map(|m| match ShapeGeom::Mesh(m.clone()).transformed(t) {
+                        ShapeGeom::Mesh(m) => m,
+                        _ => unreachable!(),
+                    }),
             },
             ShapeGeom::Cylinder {
                 to_world,
@@ -500,7 +502,9 @@ pub fn make_shape(
             if !(zmin.is_finite() && zmax.is_finite() && zmin != zmax) {
                 return Err(err_at(
                     loc,
-                    format!("cylinder: zmin and zmax must be finite and differ, found {zmin}, {zmax}"),
+                    format!(
+                        "cylinder: zmin and zmax must be finite and differ, found {zmin}, {zmax}"
+                    ),
                 ));
             }
             if !(phimax.is_finite() && phimax > 0.0) {
@@ -660,8 +664,12 @@ pub fn shape_alpha(
     Ok(Some(match t.constant() {
         Some(a) => Alpha::Constant(a.max(0.0)),
         None => {
-            let tex = super::materials::float_texture(&t, &textures.images)
-                .map_err(|e| err_at(params.loc_of("alpha").as_ref().unwrap_or(loc), format!("{e:#}")))?;
+            let tex = super::materials::float_texture(&t, &textures.images).map_err(|e| {
+                err_at(
+                    params.loc_of("alpha").as_ref().unwrap_or(loc),
+                    format!("{e:#}"),
+                )
+            })?;
             Alpha::Texture(std::sync::Arc::new(tex))
         }
     }))

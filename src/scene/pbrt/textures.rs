@@ -384,7 +384,11 @@ impl TextureTable {
                 }
             };
         }
-        Ok((path, Encoding::parse(params, &resolve(dir, &file), loc)?, sampling))
+        Ok((
+            path,
+            Encoding::parse(params, &resolve(dir, &file), loc)?,
+            sampling,
+        ))
     }
 
     /// Parse a `Texture "name" "spectrum"|"float" "class" params` directive and store it.
