@@ -311,3 +311,110 @@ fn triangle_dndu_matches_the_cylinders() {
     );
     assert!(dndv.length() < 1e-6, "{dndv}");
 }
+
+/// A flat curve along a straight line is hit from above exactly within half its width of
+/// the line, at the distance of the line, with u along it and the normal facing the ray; the
+/// `cylinder` type turns the normal across the width as a cylinder's; a `ribbon` seen edge-on
+/// vanishes.
+#[test]
+fn straight_curves_are_ribbons_of_their_width() {
+    let p = "\"point3 P\" [0 0 0  1 0 0  2 0 0  3 0 0] \"float width\" 0.2";
+    let (flat, w) = load(&format!("Shape \"curve\" {p}"));
+    assert!(!w.iter().any(|w| w.contains("curve")), "{w:?}");
+    let (cyl, _) = load(&format!("Shape \"curve\" {p} \"string type\" \"cylinder\""));
+    let (edge_on, _) = load(&format!(
+        "Shape \"curve\" {p} \"string type\" \"ribbon\" \"normal N\" [0 1 0  0 1 0]"
+    ));
+    let (face_on, _) = load(&format!(
+        "Shape \"curve\" {p} \"string type\" \"ribbon\" \"normal N\" [0 0 1  0 0 1]"
+    ));
+    let mut n_hit = 0;
+    for [a, b, _, _] in uniforms(2000, 5) {
+        let (x, y) = (0.1 + 2.8 * a, -0.2 + 0.4 * b);
+        if (y.abs() - 0.1).abs() < 1e-3 {
+            continue;
+        }
+        let ray = Ray::new(Vec3::new(x, y, 5.0), -Vec3::Z);
+        let h = flat.geometry.intersect(&ray);
+        assert_eq!(h.is_some(), y.abs() < 0.1, "x {x} y {y}");
+        assert_eq!(face_on.geometry.intersect(&ray).is_some(), y.abs() < 0.1);
+        assert!(edge_on.geometry.intersect(&ray).is_none());
+        if let Some(h) = h {
+            n_hit += 1;
+            assert!((h.t - 5.0).abs() < 1e-4, "t {}", h.t);
+            assert!(
+                (h.uv.x - x / 3.0).abs() < 1e-4,
+                "u {} vs {}",
+                h.uv.x,
+                x / 3.0
+            );
+            assert!(
+                ((h.uv.y - 0.5).abs() - y.abs() / 0.2).abs() < 1e-4,
+                "v {}",
+                h.uv.y
+            );
+            assert!((h.ng.z.abs() - 1.0).abs() < 1e-5, "flat normal {}", h.ng);
+            let c = cyl.geometry.intersect(&ray).expect("cylinder curve");
+            let want = (std::f32::consts::PI * y / 0.2).cos();
+            assert!(
+                (c.ng.z.abs() - want).abs() < 1e-3,
+                "cylinder normal {} vs cos {want}",
+                c.ng
+            );
+        }
+    }
+    assert!(n_hit > 500, "{n_hit}");
+}
+
+/// A curved flat curve (a Bézier arc in the xy plane, width 0.1 → 0.3) seen from above: a
+/// ray hits exactly when its distance to the arc (brute force over 20000 points) is below
+/// half the width there, outside a band of 5 % of the width around the edge (pbrt-v4
+/// refines the arc into pieces flat to 5 % of the width).
+#[test]
+fn curved_curves_match_the_brute_force_distance() {
+    let (scene, _) = load(
+        "Shape \"curve\" \"point3 P\" [0 0 0  1 1.2 0  2 1.2 0  3 0 0] \"float width0\" 0.1 \"float width1\" 0.3",
+    );
+    let cp = [
+        Vec3::ZERO,
+        Vec3::new(1.0, 1.2, 0.0),
+        Vec3::new(2.0, 1.2, 0.0),
+        Vec3::new(3.0, 0.0, 0.0),
+    ];
+    let bez = |u: f32| {
+        let s = 1.0 - u;
+        cp[0] * s * s * s + cp[1] * 3.0 * s * s * u + cp[2] * 3.0 * s * u * u + cp[3] * u * u * u
+    };
+    let pts: Vec<(f32, Vec3)> = (0..=20000)
+        .map(|i| {
+            let u = i as f32 / 20000.0;
+            (u, bez(u))
+        })
+        .collect();
+    let (mut agree, mut total) = (0, 0);
+    for [a, b, _, _] in uniforms(3000, 9) {
+        let q = Vec2::new(0.2 + 2.6 * a, -0.2 + 1.4 * b);
+        let (u, d) = pts
+            .iter()
+            .map(|&(u, p)| (u, (p.truncate() - q).length()))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .unwrap();
+        let half = 0.5 * (0.1 + 0.2 * u);
+        if (d - half).abs() < 0.05 * 2.0 * half {
+            continue;
+        }
+        total += 1;
+        let hit = scene.geometry.intersect(&Ray::new(q.extend(5.0), -Vec3::Z));
+        if hit.is_some() == (d < half) {
+            agree += 1;
+        } else {
+            eprintln!("disagree at {q}: distance {d}, half width {half}, hit {hit:?}");
+        }
+        if let Some(h) = hit {
+            assert!((h.t - 5.0).abs() < 1e-3, "t {}", h.t);
+            assert!((h.uv.x - u).abs() < 0.02, "u {} vs {u}", h.uv.x);
+        }
+    }
+    assert!(total > 2000);
+    assert_eq!(agree, total, "{agree} of {total} agree");
+}

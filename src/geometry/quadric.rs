@@ -42,6 +42,9 @@ pub enum QuadricKind {
         /// The corners' texture coordinates (pbrt's default: (0,0), (1,0), (0,1), (1,1)).
         uv: [Vec2; 4],
     },
+    /// One cubic Bézier segment of pbrt-v4's `curve` (see [`super::curve`]); uv = (u along
+    /// the curve, v across its width).
+    Curve(super::curve::CurveSegment),
 }
 
 /// A transformed sphere or disk.
@@ -87,6 +90,7 @@ impl Quadric {
                 p[0].min(p[1]).min(p[2].min(p[3])),
                 p[0].max(p[1]).max(p[2].max(p[3])),
             ),
+            QuadricKind::Curve(c) => c.bounds(),
         };
         let mut min = Vec3::splat(f32::INFINITY);
         let mut max = Vec3::splat(f32::NEG_INFINITY);
@@ -135,6 +139,7 @@ impl Quadric {
                 phimax,
             } => cylinder_t(oo, dd, radius as f64, zmin, zmax, phimax, t_max as f64)?,
             QuadricKind::Bilinear { p, .. } => bilinear_hit(oo, dd, &p, t_max as f64)?.0,
+            QuadricKind::Curve(c) => c.intersect(oo, dd, t_max as f64)?.t,
         };
         let t = t as f32;
         if t > 0.0 && t < t_max { Some(t) } else { None }
@@ -148,6 +153,9 @@ impl Quadric {
         let mut p = oo + dd * t as f64;
         if let QuadricKind::Bilinear { p: c, uv } = self.kind {
             return self.bilinear_surface(oo, dd, t, &c, &uv);
+        }
+        if let QuadricKind::Curve(c) = self.kind {
+            return self.curve_surface(oo, dd, t, &c);
         }
         let (n_obj, uv) = match self.kind {
             QuadricKind::Sphere { radius } => {
@@ -194,7 +202,7 @@ impl Quadric {
                     ),
                 )
             }
-            QuadricKind::Bilinear { .. } => unreachable!("handled above"),
+            QuadricKind::Bilinear { .. } | QuadricKind::Curve(_) => unreachable!("handled above"),
         };
         let pw = self.to_world.point(p.as_vec3());
         let mut n = self.to_world.normal(n_obj).normalize_or_zero();
@@ -234,11 +242,9 @@ impl Quadric {
         uv: &[Vec2; 4],
     ) -> QuadricHit {
         // The hit was found below t_max = t's successor: solve again just past it.
-        let (_, u, v) =
-            bilinear_hit(o, d, c, t as f64 * (1.0 + 1e-6) + 1e-30).unwrap_or_else(|| {
-                // Not found again (rounding at an edge): project the point onto the patch.
-                (t as f64, 0.5, 0.5)
-            });
+        let (_, u, v) = bilinear_hit(o, d, c, t as f64 * (1.0 + 1e-6) + 1e-30)
+            // Not found again (rounding at an edge): the patch's centre.
+            .unwrap_or((t as f64, 0.5, 0.5));
         let cd = c.map(|p| p.as_dvec3());
         let lerp = |a: DVec3, b: DVec3, s: f64| a + (b - a) * s;
         let pobj = lerp(lerp(cd[0], cd[1], u), lerp(cd[2], cd[3], u), v);
@@ -264,6 +270,44 @@ impl Quadric {
             p: pw,
             n,
             uv: tex,
+            p_error: err * 3.0f32.sqrt(),
+        }
+    }
+}
+
+impl Quadric {
+    /// Surface data of a curve hit at `t` (the curve solve again, for u, v and the normal).
+    fn curve_surface(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t: f32,
+        c: &super::curve::CurveSegment,
+    ) -> QuadricHit {
+        let h = c.intersect(o, d, t as f64 * (1.0 + 1e-6) + 1e-30);
+        let (u, v, n_obj, tt) = match h {
+            Some(h) => (h.u as f32, h.v as f32, h.n.as_vec3(), h.t),
+            None => (0.5, 0.5, (-d).normalize_or_zero().as_vec3(), t as f64),
+        };
+        let pobj = (o + d * tt).as_vec3();
+        let pw = self.to_world.point(pobj);
+        let mut n = self.to_world.normal(n_obj).normalize_or_zero();
+        if self.flip {
+            n = -n;
+        }
+        let scale = self.to_world.m.x_axis.abs().max_element()
+            + self.to_world.m.y_axis.abs().max_element()
+            + self.to_world.m.z_axis.abs().max_element();
+        let big = c.cp.iter().fold(pobj.abs().max_element(), |m, p| {
+            m.max(p.abs().max_element())
+        });
+        let err = gamma(8) * big * scale
+            + gamma(4)
+                * (pw.abs().max_element() + self.to_world.m.w_axis.truncate().abs().max_element());
+        QuadricHit {
+            p: pw,
+            n,
+            uv: Vec2::new(u, v),
             p_error: err * 3.0f32.sqrt(),
         }
     }

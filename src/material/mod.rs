@@ -151,7 +151,7 @@ impl Material {
                 v.base.lambert(hit)
             }
             Material::Filtered { base, footprint } if base.is_lambertian() => {
-                base.lambert_at(hit, &footprint.tex_coord(hit))
+                base.lambert_at(&footprint.tex_coord(hit))
             }
             _ => None,
         }
@@ -170,13 +170,13 @@ impl Material {
     }
 
     /// [`Material::lambert`] with textures read over the footprint `tc`.
-    fn lambert_at(&self, hit: &SurfaceHit, tc: &TexCoord) -> Option<Lambert> {
+    fn lambert_at(&self, tc: &TexCoord) -> Option<Lambert> {
         match self {
             Material::Diffuse { reflectance } => Some(diffuse_at(reflectance, tc)),
             Material::Varying(v) if v.roughness.is_none() && v.coat_roughness.is_none() => {
-                v.base.lambert_at(hit, tc)
+                v.base.lambert_at(tc)
             }
-            Material::Filtered { base, .. } => base.lambert_at(hit, tc),
+            Material::Filtered { base, .. } => base.lambert_at(tc),
             _ => None,
         }
     }
@@ -376,7 +376,7 @@ impl Material {
     /// The material without its footprint model (textures read at points).
     pub fn unfiltered(&self) -> &Material {
         match self {
-            Material::Filtered { base, .. } => &**base,
+            Material::Filtered { base, .. } => base,
             m => m,
         }
     }

@@ -398,6 +398,28 @@ impl SceneBuilder {
         self.add_quadric(q, material, None)
     }
 
+    /// Add one cubic Bézier segment of a pbrt-v4 `curve` in `to_world`'s object space (not
+    /// emissive).
+    pub fn add_curve(
+        &mut self,
+        to_world: Transform,
+        segment: crate::geometry::curve::CurveSegment,
+        material: u32,
+        reverse_orientation: bool,
+    ) -> anyhow::Result<()> {
+        ensure!(
+            segment.cp.iter().all(|p| p.is_finite())
+                && segment.width.iter().all(|w| w.is_finite() && *w >= 0.0),
+            "curve control points and widths must be finite (widths ≥ 0)"
+        );
+        let q = Quadric {
+            kind: QuadricKind::Curve(segment),
+            to_world,
+            flip: reverse_orientation ^ to_world.swaps_handedness(),
+        };
+        self.add_quadric(q, material, None)
+    }
+
     /// Add a light that is not attached to geometry (point, spot, distant, infinite).
     pub fn add_light(&mut self, light: Light) {
         self.lights.push(light);
@@ -533,7 +555,7 @@ fn quadric_light(q: &Quadric, e: &AreaEmission) -> anyhow::Result<Light> {
             }
             DiskLight::new(c, n, radius * sx, e.l, e.two_sided).map(Light::Disk)
         }
-        QuadricKind::Cylinder { .. } | QuadricKind::Bilinear { .. } => None,
+        QuadricKind::Cylinder { .. } | QuadricKind::Bilinear { .. } | QuadricKind::Curve(_) => None,
     };
     light.ok_or_else(|| anyhow::anyhow!("degenerate emissive shape"))
 }

@@ -145,6 +145,9 @@ impl PbrtScene {
                     s.emission,
                     s.reverse_orientation,
                 ),
+                ShapeGeom::Curves { to_world, segments } => segments
+                    .into_iter()
+                    .try_for_each(|c| b.add_curve(to_world, c, s.material, s.reverse_orientation)),
                 ShapeGeom::Bilinear { patches, mesh } => {
                     if s.emission.is_some() || s.alpha.is_some() {
                         // Lights and cut-outs are triangles: exact for parallelograms.

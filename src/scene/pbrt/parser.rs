@@ -1144,6 +1144,13 @@ impl Parser {
                 ),
             );
         }
+        if emission.is_some() && matches!(geom, super::shapes::ShapeGeom::Curves { .. }) {
+            self.warn(
+                "curve-light",
+                loc,
+                "area lights on curves are not supported: the curve is not emissive".into(),
+            );
+        }
         if emission.is_some() && self.cur_object.is_some() {
             self.warn(
                 "instance-light",

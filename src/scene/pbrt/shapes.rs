@@ -7,6 +7,7 @@ use super::params::ParamSet;
 use super::ply::read_ply;
 use super::textures::{TextureTable, Warn, resolve};
 use super::tokenizer::{Loc, err_at};
+use crate::geometry::curve::{CurveSegment, CurveType, bspline_to_bezier};
 use crate::geometry::{Alpha, Transform};
 use crate::scene::TriangleMesh;
 use crate::scene::mesh_repair::repair_mesh;
@@ -43,6 +44,13 @@ pub enum ShapeGeom {
         patches: Vec<([Vec3; 4], [Vec2; 4], bool)>,
         /// The triangle stand-in (`None` if every triangle was degenerate).
         mesh: Option<TriangleMesh>,
+    },
+    /// pbrt-v4's `curve`: cubic Bézier segments in the object space of `to_world`.
+    Curves {
+        /// Object-to-world.
+        to_world: Transform,
+        /// The segments.
+        segments: Vec<CurveSegment>,
     },
     /// pbrt-v4's cylinder (object space: axis z, z in [zmin, zmax], φ in [0, phimax]).
     Cylinder {
@@ -92,6 +100,17 @@ impl ShapeGeom {
             ShapeGeom::Bilinear { mesh, .. } => mesh
                 .as_ref()
                 .map_or(0.0, |m| ShapeGeom::Mesh(m.clone()).area()),
+            // Curves carry no emission (warned); a rough estimate: polygon length × width.
+            ShapeGeom::Curves { to_world, segments } => {
+                segments
+                    .iter()
+                    .map(|c| {
+                        let l: f32 = (0..3).map(|i| (c.cp[i + 1] - c.cp[i]).length()).sum();
+                        l * 0.5 * (c.width[0] + c.width[1])
+                    })
+                    .sum::<f32>()
+                    * area_scale(to_world)
+            }
         }
     }
 
@@ -124,6 +143,10 @@ impl ShapeGeom {
                 to_world: t.then_apply_to(to_world),
                 height: *height,
                 radius: *radius,
+            },
+            ShapeGeom::Curves { to_world, segments } => ShapeGeom::Curves {
+                to_world: t.then_apply_to(to_world),
+                segments: segments.clone(),
             },
             ShapeGeom::Bilinear { patches, mesh } => ShapeGeom::Bilinear {
                 patches: patches
@@ -488,6 +511,13 @@ pub fn make_shape(
                 radius,
             }
         }
+        "curve" => match curve_shape(params, ctx, warn)? {
+            Some(segments) => ShapeGeom::Curves {
+                to_world: *ctx.ctm,
+                segments,
+            },
+            None => return Ok(None),
+        },
         "cylinder" => {
             let radius = params.float("radius", 1.0)?;
             let zmin = params.float("zmin", -1.0)?;
@@ -627,6 +657,92 @@ fn loop_subdiv_shape(
     finish_mesh(raw, ctx, "loopsubdiv", warn)
 }
 
+/// pbrt-v4's `curve` parameters as cubic Bézier segments: `P` (`basis` `bezier`: 3k + 1
+/// points for degree 3, 2k + 1 for degree 2; `bspline`: k + 3 for degree 3), `type` (`flat`,
+/// `ribbon` with `N` at the k + 1 segment ends, `cylinder`), `width` or `width0`/`width1`
+/// (linear along the whole curve). `splitdepth` only splits pbrt's BVH leaves: ignored.
+fn curve_shape(
+    params: &ParamSet,
+    ctx: &ShapeCtx,
+    warn: &mut Warn,
+) -> anyhow::Result<Option<Vec<CurveSegment>>> {
+    let loc = ctx.loc;
+    let p = params
+        .point3s("P")?
+        .ok_or_else(|| err_at(loc, "curve: expected \"point3 P\", found none"))?;
+    let basis = params.string("basis")?.unwrap_or_else(|| "bezier".into());
+    let degree = params.int("degree", 3)?;
+    let kind = match params.string("type")?.as_deref().unwrap_or("flat") {
+        "flat" => CurveType::Flat,
+        "ribbon" => CurveType::Ribbon,
+        "cylinder" => CurveType::Cylinder,
+        other => {
+            return Err(err_at(
+                loc,
+                format!("curve: unknown type \"{other}\" (expected flat, ribbon or cylinder)"),
+            ));
+        }
+    };
+    let w = params.float("width", 1.0)?;
+    let (w0, w1) = (params.float("width0", w)?, params.float("width1", w)?);
+    let _ = params.int("splitdepth", 3)?;
+    let cubic: Vec<[Vec3; 4]> = match (basis.as_str(), degree) {
+        ("bezier", 3) if p.len() >= 4 && (p.len() - 1) % 3 == 0 => (0..(p.len() - 1) / 3)
+            .map(|k| [p[3 * k], p[3 * k + 1], p[3 * k + 2], p[3 * k + 3]])
+            .collect(),
+        ("bezier", 2) if p.len() >= 3 && (p.len() - 1) % 2 == 0 => (0..(p.len() - 1) / 2)
+            .map(|k| {
+                let (a, b, c) = (p[2 * k], p[2 * k + 1], p[2 * k + 2]);
+                [a, a + (b - a) * (2.0 / 3.0), c + (b - c) * (2.0 / 3.0), c]
+            })
+            .collect(),
+        ("bspline", 3) if p.len() >= 4 => (0..p.len() - 3)
+            .map(|k| bspline_to_bezier([p[k], p[k + 1], p[k + 2], p[k + 3]]))
+            .collect(),
+        (b, d) => {
+            warn(
+                "curve-basis",
+                loc,
+                format!(
+                    "curve: basis \"{b}\" of degree {d} with {} points is not supported; skipped",
+                    p.len()
+                ),
+            );
+            return Ok(None);
+        }
+    };
+    let nseg = cubic.len();
+    let normals = params.normals("N")?;
+    if kind == CurveType::Ribbon && normals.as_ref().is_none_or(|n| n.len() != nseg + 1) {
+        return Err(err_at(
+            loc,
+            format!(
+                "curve: a ribbon needs {} normals \"N\" (one per segment end), found {}",
+                nseg + 1,
+                normals.as_ref().map_or(0, |n| n.len())
+            ),
+        ));
+    }
+    Ok(Some(
+        cubic
+            .into_iter()
+            .enumerate()
+            .map(|(k, cp)| {
+                let f = |i: usize| i as f32 / nseg as f32;
+                let n = normals.as_ref().map_or([Vec3::Z; 2], |n| {
+                    [n[k].normalize_or_zero(), n[k + 1].normalize_or_zero()]
+                });
+                CurveSegment {
+                    cp,
+                    width: [w0 + (w1 - w0) * f(k), w0 + (w1 - w0) * f(k + 1)],
+                    n,
+                    kind,
+                }
+            })
+            .collect(),
+    ))
+}
+
 /// The shape's `"float alpha"` / `"texture alpha"` cut-out (pbrt-v4: none when the coverage is
 /// 1). Coverage is clamped to [0, 1] by the alpha test; a varying float texture (image,
 /// checkerboard, scale, mapped) is evaluated at each candidate hit's uv. Spheres and disks keep
@@ -653,7 +769,7 @@ pub fn shape_alpha(
             return Ok(None);
         }
     }
-    if matches!(kind, "sphere" | "disk" | "cylinder") {
+    if matches!(kind, "sphere" | "disk" | "cylinder" | "curve") {
         warn(
             "shape-alpha-quadric",
             loc,
