@@ -280,13 +280,13 @@ Shape "bilinearmesh" "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0] "integer indices" [0 1
 #[test]
 fn unsupported_shape_warns_once_with_file_and_line() {
     let s = world(
-        "Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\nShape \"curve\"\nShape \"hyperboloid\"",
+        "Shape \"cone\" \"float radius\" 2\nShape \"cone\"\nShape \"hyperboloid\"",
     );
     assert!(s.shapes.is_empty());
     let curve: Vec<_> = s
         .warnings
         .iter()
-        .filter(|w| w.contains("\"curve\""))
+        .filter(|w| w.contains("\"cone\""))
         .collect();
     assert_eq!(curve.len(), 1, "{:?}", s.warnings);
     assert!(curve[0].starts_with("t.pbrt:2:"));
