@@ -279,9 +279,7 @@ Shape "bilinearmesh" "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0] "integer indices" [0 1
 
 #[test]
 fn unsupported_shape_warns_once_with_file_and_line() {
-    let s = world(
-        "Shape \"cone\" \"float radius\" 2\nShape \"cone\"\nShape \"hyperboloid\"",
-    );
+    let s = world("Shape \"cone\" \"float radius\" 2\nShape \"cone\"\nShape \"hyperboloid\"");
     assert!(s.shapes.is_empty());
     let curve: Vec<_> = s
         .warnings
