@@ -418,3 +418,20 @@ fn curved_curves_match_the_brute_force_distance() {
     assert!(total > 2000);
     assert_eq!(agree, total, "{agree} of {total} agree");
 }
+
+/// Under a mirroring transform a cylinder's normal still points outward (pbrt-v4 flips its
+/// render-space ∂p/∂u × ∂p/∂v back for a handedness swap); ReverseOrientation turns it in.
+#[test]
+fn mirrored_cylinder_keeps_its_outward_normal() {
+    for (extra, outward) in [("", true), ("ReverseOrientation\n", false)] {
+        let (scene, _) = load(&format!(
+            "AttributeBegin\nScale -1 1 1\n{extra}Shape \"cylinder\" \"float radius\" 0.5\nAttributeEnd"
+        ));
+        let h = scene
+            .geometry
+            .intersect(&Ray::new(Vec3::new(3.0, 0.0, 0.0), -Vec3::X))
+            .expect("hit");
+        assert!((h.p - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-5, "{}", h.p);
+        assert_eq!(h.ng.x > 0.9, outward, "normal {} ({extra:?})", h.ng);
+    }
+}

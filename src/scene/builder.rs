@@ -331,7 +331,11 @@ impl SceneBuilder {
             zmin < zmax && phimax > 0.0 && phimax.is_finite(),
             "cylinder needs zmin < zmax and phimax > 0 (z {zmin}..{zmax}, phimax {phimax})"
         );
-        let flip = reverse_orientation ^ to_world.swaps_handedness();
+        // The object-space normal (x, y, 0) through the inverse transpose is already the
+        // outward one under a mirroring transform (pbrt-v4 crosses the render-space ∂p/∂u,
+        // ∂p/∂v, which a mirror turns inward, and flips them back): only
+        // ReverseOrientation flips it.
+        let flip = reverse_orientation;
         if let Some(e) = emission {
             let n = CYLINDER_LIGHT_SEGMENTS;
             let (mut positions, mut normals, mut uvs, mut indices) =
@@ -415,7 +419,9 @@ impl SceneBuilder {
         let q = Quadric {
             kind: QuadricKind::Curve(segment),
             to_world,
-            flip: reverse_orientation ^ to_world.swaps_handedness(),
+            // As the cylinder's: the normal through the inverse transpose needs no
+            // handedness flip.
+            flip: reverse_orientation,
         };
         self.add_quadric(q, material, None)
     }
