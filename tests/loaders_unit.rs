@@ -986,10 +986,16 @@ fn gltf_normal_texture_is_linear_scaled_and_follows_the_uv_handedness() {
     let t = (Vec3::new(200.0, 128.0, 230.0) / 255.0 * 2.0 - Vec3::ONE) * Vec3::new(0.5, 0.5, 1.0);
     let t = t.normalize();
     let uv = Vec2::splat(0.5);
-    let right = n.shading_normal(uv, Vec3::Z, Vec3::Z, Vec3::X, Vec3::Y);
+    let tc = penumbra::material::TexCoord::point(uv);
+    let d = |dpdv: Vec3| penumbra::material::ShadingDerivatives {
+        dpdu: Vec3::X,
+        dpdv,
+        ..Default::default()
+    };
+    let right = n.shading_normal(&tc, Vec3::Z, Vec3::Z, &d(Vec3::Y));
     assert!((right - t).abs().max_element() < 1e-5, "{right} vs {t}");
     // Mirrored uvs (∂p/∂v = −y): the bitangent, and so the map's green, flips.
-    let mirrored = n.shading_normal(uv, Vec3::Z, Vec3::Z, Vec3::X, -Vec3::Y);
+    let mirrored = n.shading_normal(&tc, Vec3::Z, Vec3::Z, &d(-Vec3::Y));
     let tm = Vec3::new(t.x, -t.y, t.z);
     assert!(
         (mirrored - tm).abs().max_element() < 1e-5,

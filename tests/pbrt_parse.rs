@@ -259,7 +259,15 @@ Shape "bilinearmesh" "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0] "integer indices" [0 1
         g => panic!("{g:?}"),
     }
     assert!(s.shapes[1].reverse_orientation);
-    let m = mesh(&s, 2);
+    // The true patch, and its two-triangle stand-in (emitters, cut-outs).
+    let m = match &s.shapes[2].geom {
+        ShapeGeom::Bilinear { patches, mesh } => {
+            assert_eq!(patches.len(), 1);
+            assert!(patches[0].2, "flipped by the ReverseOrientation above");
+            mesh.as_ref().expect("triangles")
+        }
+        g => panic!("{g:?}"),
+    };
     assert_eq!(m.indices, vec![0, 1, 3, 0, 3, 2]);
     // Both triangles keep the patch orientation (+z).
     for t in m.indices.chunks(3) {
@@ -271,21 +279,19 @@ Shape "bilinearmesh" "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0] "integer indices" [0 1
 
 #[test]
 fn unsupported_shape_warns_once_with_file_and_line() {
-    let s = world(
-        "Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\nShape \"curve\"\nShape \"cylinder\"",
-    );
+    let s = world("Shape \"cone\" \"float radius\" 2\nShape \"cone\"\nShape \"hyperboloid\"");
     assert!(s.shapes.is_empty());
     let curve: Vec<_> = s
         .warnings
         .iter()
-        .filter(|w| w.contains("\"curve\""))
+        .filter(|w| w.contains("\"cone\""))
         .collect();
     assert_eq!(curve.len(), 1, "{:?}", s.warnings);
     assert!(curve[0].starts_with("t.pbrt:2:"));
     assert!(
         s.warnings
             .iter()
-            .any(|w| w.starts_with("t.pbrt:4:") && w.contains("cylinder"))
+            .any(|w| w.starts_with("t.pbrt:4:") && w.contains("hyperboloid"))
     );
 }
 
@@ -531,6 +537,7 @@ Material "conductor" "texture roughness" "r"
             scale: Rgb::splat(0.5),
             invert: false,
             encoding: penumbra::scene::pbrt::textures::Encoding::SRgb,
+            sampling: Default::default(),
         }
     );
     assert!(

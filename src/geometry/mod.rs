@@ -4,6 +4,7 @@
 mod accel;
 pub mod alpha;
 mod bvh;
+pub mod curve;
 mod float;
 pub mod interaction;
 pub(crate) mod packet;

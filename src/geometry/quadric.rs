@@ -1,4 +1,5 @@
-//! Spheres and disks under an arbitrary affine transform: intersected in object space.
+//! Spheres, disks and cylinders under an arbitrary affine transform: intersected in object
+//! space.
 
 use super::Transform;
 use super::float::gamma;
@@ -20,6 +21,30 @@ pub enum QuadricKind {
         /// Radius.
         radius: f32,
     },
+    /// pbrt-v4's cylinder: x² + y² = radius² for z in [zmin, zmax] and φ in [0, phimax],
+    /// outward normal (x, y, 0), uv = (φ/phimax, (z − zmin)/(zmax − zmin)).
+    Cylinder {
+        /// Radius.
+        radius: f32,
+        /// Lower end.
+        zmin: f32,
+        /// Upper end.
+        zmax: f32,
+        /// Sweep in radians (2π: closed).
+        phimax: f32,
+    },
+    /// pbrt-v4's bilinear patch p(u, v) = lerp(v, lerp(u, p00, p10), lerp(u, p01, p11)) (in
+    /// object space; a `bilinearmesh` stores its patches in world space under the identity),
+    /// normal ∂p/∂u × ∂p/∂v, texture coordinates bilinear in the corners' `uv`.
+    Bilinear {
+        /// p00, p10, p01, p11.
+        p: [Vec3; 4],
+        /// The corners' texture coordinates (pbrt's default: (0,0), (1,0), (0,1), (1,1)).
+        uv: [Vec2; 4],
+    },
+    /// One cubic Bézier segment of pbrt-v4's `curve` (see [`super::curve`]); uv = (u along
+    /// the curve, v across its width).
+    Curve(super::curve::CurveSegment),
 }
 
 /// A transformed sphere or disk.
@@ -55,6 +80,17 @@ impl Quadric {
                 Vec3::new(-radius, -radius, height),
                 Vec3::new(radius, radius, height),
             ),
+            QuadricKind::Cylinder {
+                radius, zmin, zmax, ..
+            } => (
+                Vec3::new(-radius, -radius, zmin),
+                Vec3::new(radius, radius, zmax),
+            ),
+            QuadricKind::Bilinear { p, .. } => (
+                p[0].min(p[1]).min(p[2].min(p[3])),
+                p[0].max(p[1]).max(p[2].max(p[3])),
+            ),
+            QuadricKind::Curve(c) => c.bounds(),
         };
         let mut min = Vec3::splat(f32::INFINITY);
         let mut max = Vec3::splat(f32::NEG_INFINITY);
@@ -96,6 +132,14 @@ impl Quadric {
                 }
                 t
             }
+            QuadricKind::Cylinder {
+                radius,
+                zmin,
+                zmax,
+                phimax,
+            } => cylinder_t(oo, dd, radius as f64, zmin, zmax, phimax, t_max as f64)?,
+            QuadricKind::Bilinear { p, .. } => bilinear_hit(oo, dd, &p, t_max as f64)?.0,
+            QuadricKind::Curve(c) => c.intersect(oo, dd, t_max as f64)?.t,
         };
         let t = t as f32;
         if t > 0.0 && t < t_max { Some(t) } else { None }
@@ -107,6 +151,12 @@ impl Quadric {
         let oo = m.transform_point3(o).as_dvec3();
         let dd = m.transform_vector3(d).as_dvec3();
         let mut p = oo + dd * t as f64;
+        if let QuadricKind::Bilinear { p: c, uv } = self.kind {
+            return self.bilinear_surface(oo, dd, t, &c, &uv);
+        }
+        if let QuadricKind::Curve(c) = self.kind {
+            return self.curve_surface(oo, dd, t, &c);
+        }
         let (n_obj, uv) = match self.kind {
             QuadricKind::Sphere { radius } => {
                 // Re-project onto the surface: the point error is then a few ulps of the radius.
@@ -129,6 +179,30 @@ impl Quadric {
                     Vec2::new(phi / (2.0 * PI), 1.0 - r / radius.max(f32::MIN_POSITIVE)),
                 )
             }
+            QuadricKind::Cylinder {
+                radius,
+                zmin,
+                zmax,
+                phimax,
+            } => {
+                // Re-project onto the cylinder, as the sphere does.
+                let len = (p.x * p.x + p.y * p.y).sqrt();
+                if len > 0.0 {
+                    p.x *= radius as f64 / len;
+                    p.y *= radius as f64 / len;
+                }
+                let pf = p.as_vec3();
+                let phi = pf.y.atan2(pf.x).rem_euclid(2.0 * PI);
+                let dz = zmax - zmin;
+                (
+                    Vec3::new(pf.x, pf.y, 0.0),
+                    Vec2::new(
+                        phi / phimax.max(f32::MIN_POSITIVE),
+                        if dz != 0.0 { (pf.z - zmin) / dz } else { 0.0 },
+                    ),
+                )
+            }
+            QuadricKind::Bilinear { .. } | QuadricKind::Curve(_) => unreachable!("handled above"),
         };
         let pw = self.to_world.point(p.as_vec3());
         let mut n = self.to_world.normal(n_obj).normalize_or_zero();
@@ -154,6 +228,202 @@ impl Quadric {
             uv,
             p_error: err * 3.0f32.sqrt(),
         }
+    }
+}
+
+impl Quadric {
+    /// Surface data of a bilinear patch hit near `t` (the patch solve again, for (u, v)).
+    fn bilinear_surface(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t: f32,
+        c: &[Vec3; 4],
+        uv: &[Vec2; 4],
+    ) -> QuadricHit {
+        // The hit was found below t_max = t's successor: solve again just past it.
+        let (_, u, v) = bilinear_hit(o, d, c, t as f64 * (1.0 + 1e-6) + 1e-30)
+            // Not found again (rounding at an edge): the patch's centre.
+            .unwrap_or((t as f64, 0.5, 0.5));
+        let cd = c.map(|p| p.as_dvec3());
+        let lerp = |a: DVec3, b: DVec3, s: f64| a + (b - a) * s;
+        let pobj = lerp(lerp(cd[0], cd[1], u), lerp(cd[2], cd[3], u), v);
+        let dpdu = lerp(cd[1] - cd[0], cd[3] - cd[2], v);
+        let dpdv = lerp(cd[2] - cd[0], cd[3] - cd[1], u);
+        let n_obj = dpdu.cross(dpdv).as_vec3();
+        let (uf, vf) = (u as f32, v as f32);
+        let tex =
+            (uv[0] * (1.0 - uf) + uv[1] * uf) * (1.0 - vf) + (uv[2] * (1.0 - uf) + uv[3] * uf) * vf;
+        let pw = self.to_world.point(pobj.as_vec3());
+        let mut n = self.to_world.normal(n_obj).normalize_or_zero();
+        if self.flip {
+            n = -n;
+        }
+        let scale = self.to_world.m.x_axis.abs().max_element()
+            + self.to_world.m.y_axis.abs().max_element()
+            + self.to_world.m.z_axis.abs().max_element();
+        let big = c.iter().fold(0.0f32, |m, p| m.max(p.abs().max_element()));
+        let err = gamma(8) * big * scale
+            + gamma(4)
+                * (pw.abs().max_element() + self.to_world.m.w_axis.truncate().abs().max_element());
+        QuadricHit {
+            p: pw,
+            n,
+            uv: tex,
+            p_error: err * 3.0f32.sqrt(),
+        }
+    }
+}
+
+impl Quadric {
+    /// Surface data of a curve hit at `t` (the curve solve again, for u, v and the normal).
+    fn curve_surface(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t: f32,
+        c: &super::curve::CurveSegment,
+    ) -> QuadricHit {
+        let h = c.intersect(o, d, t as f64 * (1.0 + 1e-6) + 1e-30);
+        let (u, v, n_obj, tt) = match h {
+            Some(h) => (h.u as f32, h.v as f32, h.n.as_vec3(), h.t),
+            None => (0.5, 0.5, (-d).normalize_or_zero().as_vec3(), t as f64),
+        };
+        let pobj = (o + d * tt).as_vec3();
+        let pw = self.to_world.point(pobj);
+        let mut n = self.to_world.normal(n_obj).normalize_or_zero();
+        if self.flip {
+            n = -n;
+        }
+        let scale = self.to_world.m.x_axis.abs().max_element()
+            + self.to_world.m.y_axis.abs().max_element()
+            + self.to_world.m.z_axis.abs().max_element();
+        let big = c.cp.iter().fold(pobj.abs().max_element(), |m, p| {
+            m.max(p.abs().max_element())
+        });
+        let err = gamma(8) * big * scale
+            + gamma(4)
+                * (pw.abs().max_element() + self.to_world.m.w_axis.truncate().abs().max_element());
+        QuadricHit {
+            p: pw,
+            n,
+            uv: Vec2::new(u, v),
+            p_error: err * 3.0f32.sqrt(),
+        }
+    }
+}
+
+/// pbrt-v4's bilinear patch intersection (Reshetov's): the u of the ray's closest approach
+/// to the patch's u iso-lines from a quadratic, then v and t from the line through those
+/// iso-line points; the nearest (t, u, v) with u, v in [0, 1] and t in (0, t_max).
+pub fn bilinear_hit(o: DVec3, d: DVec3, c: &[Vec3; 4], t_max: f64) -> Option<(f64, f64, f64)> {
+    let [p00, p10, p01, p11] = c.map(|p| p.as_dvec3());
+    let a = (p10 - p00).cross(p01 - p11).dot(d);
+    let cc = (p00 - o).cross(d).dot(p01 - p00);
+    let b = (p10 - o).cross(d).dot(p11 - p10) - (a + cc);
+    // Roots of a u² + b u + c = 0 (a linear equation when a = 0).
+    let roots: [f64; 2] = if a.abs() < 1e-300 {
+        if b == 0.0 {
+            return None;
+        }
+        [-cc / b, f64::NAN]
+    } else {
+        let disc = b * b - 4.0 * a * cc;
+        if disc < 0.0 {
+            return None;
+        }
+        let s = disc.sqrt();
+        let q = if b < 0.0 {
+            -0.5 * (b - s)
+        } else {
+            -0.5 * (b + s)
+        };
+        let (r0, r1) = (q / a, if q != 0.0 { cc / q } else { -b / a });
+        if r0 <= r1 { [r0, r1] } else { [r1, r0] }
+    };
+    let scale = [o.abs().max_element(), d.abs().max_element()]
+        .into_iter()
+        .chain([p00, p10, p01, p11].map(|p| p.abs().max_element()))
+        .fold(0.0f64, f64::max);
+    let eps = 1e-12 * scale.max(1e-300);
+    let mut best: Option<(f64, f64, f64)> = None;
+    for (k, &u) in roots.iter().enumerate() {
+        if !(0.0..=1.0).contains(&u) || (k == 1 && u == roots[0]) {
+            continue;
+        }
+        let uo = p00 + (p10 - p00) * u;
+        let ud = p01 + (p11 - p01) * u - uo;
+        let deltao = uo - o;
+        let perp = d.cross(ud);
+        let p2 = perp.length_squared();
+        if p2 == 0.0 {
+            continue;
+        }
+        // det[deltao, d, perp] and det[deltao, ud, perp] (columns).
+        let v1 = deltao.dot(d.cross(perp));
+        let t1 = deltao.dot(ud.cross(perp));
+        if !(0.0..=p2).contains(&v1) {
+            continue;
+        }
+        let (t, v) = (t1 / p2, v1 / p2);
+        if t > eps && t < t_max && best.is_none_or(|b| t < b.0) {
+            best = Some((t, u, v));
+        }
+    }
+    best
+}
+
+/// The nearest t in (0, t_max) where the ray meets the cylinder x² + y² = r² inside
+/// z ∈ [zmin, zmax] and φ ∈ [0, phimax] (the far root when the near one is clipped away).
+fn cylinder_t(
+    o: DVec3,
+    d: DVec3,
+    r: f64,
+    zmin: f32,
+    zmax: f32,
+    phimax: f32,
+    t_max: f64,
+) -> Option<f64> {
+    let a = d.x * d.x + d.y * d.y;
+    if a == 0.0 {
+        return None;
+    }
+    let b = o.x * d.x + o.y * d.y;
+    // |o⊥ − (o⊥·d̂⊥)d̂⊥|², as the sphere's stable discriminant, in the xy plane.
+    let fx = o.x - d.x * (b / a);
+    let fy = o.y - d.y * (b / a);
+    let disc = r * r - (fx * fx + fy * fy);
+    if disc < 0.0 {
+        return None;
+    }
+    let s = (a * disc).sqrt();
+    let q = if b < 0.0 { -b + s } else { -b - s };
+    let c = o.x * o.x + o.y * o.y - r * r;
+    let (mut t0, mut t1) = (q / a, if q != 0.0 { c / q } else { 0.0 });
+    if t0 > t1 {
+        std::mem::swap(&mut t0, &mut t1);
+    }
+    let (zmin, zmax) = (zmin.min(zmax) as f64, zmin.max(zmax) as f64);
+    let inside = |t: f64| {
+        if !(t > 0.0 && t < t_max) {
+            return false;
+        }
+        let p = o + d * t;
+        if p.z < zmin || p.z > zmax {
+            return false;
+        }
+        if phimax as f64 >= 2.0 * std::f64::consts::PI {
+            return true;
+        }
+        let phi = p.y.atan2(p.x).rem_euclid(2.0 * std::f64::consts::PI);
+        phi <= phimax as f64
+    };
+    if inside(t0) {
+        Some(t0)
+    } else if inside(t1) {
+        Some(t1)
+    } else {
+        None
     }
 }
 

@@ -2,12 +2,17 @@
 //! The pbrt/OBJ/glTF loaders map onto exactly these variants.
 
 pub mod float_texture;
+pub mod footprint;
 pub mod texture;
 pub mod varying;
 
 pub use float_texture::FloatTexture;
-pub use texture::Texture;
-pub use varying::{AlphaOverride, NormalPerturbation, RoughnessTextures, VaryingMaterial};
+pub use footprint::Footprint;
+pub use texture::{TexCoord, Texture};
+pub use varying::{
+    AlphaOverride, LayerTextures, NormalPerturbation, RoughnessTextures, ShadingDerivatives,
+    VaryingMaterial,
+};
 
 use crate::Rgb;
 use crate::bsdf::coated_conductor::{coated_conductor, layered_diffuse};
@@ -19,6 +24,7 @@ use crate::bsdf::{
 };
 use crate::geometry::SurfaceHit;
 use glam::Vec2;
+use std::sync::Arc;
 
 /// A surface material description.
 #[derive(Clone, Debug)]
@@ -98,6 +104,14 @@ pub enum Material {
     },
     /// A material whose roughness varies over the surface (float textures).
     Varying(Box<VaryingMaterial>),
+    /// A material whose textures filter over each hit's pixel footprint (MIP-mapped images,
+    /// checkerboards); set by the scene builder, which knows the camera and the triangles.
+    Filtered {
+        /// The material.
+        base: Box<Material>,
+        /// The footprint model of the scene's camera and triangles.
+        footprint: Arc<Footprint>,
+    },
 }
 
 /// The Lambertian BSDF of a `diffuse` material (reflectance clamped to [0, 1]); inlined into the
@@ -105,6 +119,10 @@ pub enum Material {
 #[inline(always)]
 fn diffuse(reflectance: &Texture, hit: &SurfaceHit) -> Lambert {
     Lambert::new(reflectance.eval(hit.uv).clamp(Rgb::ZERO, Rgb::ONE))
+}
+
+fn diffuse_at(reflectance: &Texture, tc: &TexCoord) -> Lambert {
+    Lambert::new(reflectance.eval_at(tc).clamp(Rgb::ZERO, Rgb::ONE))
 }
 
 impl Material {
@@ -132,6 +150,33 @@ impl Material {
             Material::Varying(v) if v.roughness.is_none() && v.coat_roughness.is_none() => {
                 v.base.lambert(hit)
             }
+            Material::Filtered { base, footprint } if base.is_lambertian() => {
+                base.lambert_at(&footprint.tex_coord(hit))
+            }
+            _ => None,
+        }
+    }
+
+    /// True if [`Material::lambert`] gives this material's BSDF.
+    fn is_lambertian(&self) -> bool {
+        match self {
+            Material::Diffuse { .. } => true,
+            Material::Varying(v) => {
+                v.roughness.is_none() && v.coat_roughness.is_none() && v.base.is_lambertian()
+            }
+            Material::Filtered { base, .. } => base.is_lambertian(),
+            _ => false,
+        }
+    }
+
+    /// [`Material::lambert`] with textures read over the footprint `tc`.
+    fn lambert_at(&self, tc: &TexCoord) -> Option<Lambert> {
+        match self {
+            Material::Diffuse { reflectance } => Some(diffuse_at(reflectance, tc)),
+            Material::Varying(v) if v.roughness.is_none() && v.coat_roughness.is_none() => {
+                v.base.lambert_at(tc)
+            }
+            Material::Filtered { base, .. } => base.lambert_at(tc),
             _ => None,
         }
     }
@@ -139,21 +184,39 @@ impl Material {
     /// [`Material::bsdf`] for every material (the out-of-line path).
     #[inline(never)]
     fn bsdf_general(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
-        self.bsdf_with(hit, front, AlphaOverride::default())
+        self.bsdf_with(
+            hit,
+            &TexCoord::point(hit.uv),
+            front,
+            AlphaOverride::default(),
+        )
     }
 
-    /// The BSDF at a hit with GGX widths `ov` replacing the material's constant ones.
-    fn bsdf_with(&self, hit: &SurfaceHit, front: bool, ov: AlphaOverride) -> Bsdf {
+    /// The BSDF at a hit, textures read over `tc`, with GGX widths `ov` replacing the
+    /// material's constant ones.
+    fn bsdf_with(&self, hit: &SurfaceHit, tc: &TexCoord, front: bool, ov: AlphaOverride) -> Bsdf {
         match self {
-            Material::Varying(v) => {
-                let ov = AlphaOverride {
-                    alpha: v.roughness.as_ref().map(|r| r.alpha(hit.uv)),
-                    coat_alpha: v.coat_roughness.as_ref().map(|r| r.alpha(hit.uv)),
-                };
-                v.base.bsdf_with(hit, front, ov)
+            Material::Filtered { base, footprint } => {
+                base.bsdf_with(hit, &footprint.tex_coord(hit), front, ov)
             }
-            Material::Diffuse { reflectance } => Bsdf::Lambert(diffuse(reflectance, hit)),
-            Material::Phong { kd, ks, n } => Bsdf::Phong(Phong::clamped(kd.eval(hit.uv), *ks, *n)),
+            Material::Varying(v) => {
+                let base_layer = match &v.base {
+                    Material::CoatedDiffuse { layer, .. } => *layer,
+                    Material::CoatedConductor { layer, .. } => Some(*layer),
+                    _ => None,
+                };
+                let ov = AlphaOverride {
+                    alpha: v.roughness.as_ref().map(|r| r.alpha_at(tc)),
+                    coat_alpha: v.coat_roughness.as_ref().map(|r| r.alpha_at(tc)),
+                    layer: match (&v.layer, base_layer) {
+                        (Some(l), Some(b)) => Some(l.apply(b, tc)),
+                        _ => None,
+                    },
+                };
+                v.base.bsdf_with(hit, tc, front, ov)
+            }
+            Material::Diffuse { reflectance } => Bsdf::Lambert(diffuse_at(reflectance, tc)),
+            Material::Phong { kd, ks, n } => Bsdf::Phong(Phong::clamped(kd.eval_at(tc), *ks, *n)),
             Material::Conductor {
                 eta,
                 k,
@@ -161,7 +224,7 @@ impl Material {
                 reflectance,
             } => {
                 let (eta, k) = match reflectance {
-                    Some(r) => (Rgb::ONE, k_from_reflectance(r.eval(hit.uv))),
+                    Some(r) => (Rgb::ONE, k_from_reflectance(r.eval_at(tc))),
                     None => (*eta, *k),
                 };
                 Bsdf::Conductor(Conductor::new(eta, k, ov.alpha.unwrap_or(*alpha)))
@@ -173,17 +236,17 @@ impl Material {
                 layer,
             } => {
                 let alpha = ov.alpha.unwrap_or(*alpha);
-                match layer {
+                match ov.layer.or(*layer) {
                     None => Bsdf::CoatedDiffuse(CoatedDiffuse::new(
-                        reflectance.eval(hit.uv),
+                        reflectance.eval_at(tc),
                         alpha,
                         *eta,
                     )),
                     Some(p) => Bsdf::Layered(Box::new(layered_diffuse(
-                        reflectance.eval(hit.uv),
+                        reflectance.eval_at(tc),
                         *eta,
                         alpha,
-                        *p,
+                        p,
                     ))),
                 }
             }
@@ -197,7 +260,7 @@ impl Material {
                 layer,
             } => {
                 let (eta, k) = match reflectance {
-                    Some(r) => (Rgb::ONE, k_from_reflectance(r.eval(hit.uv))),
+                    Some(r) => (Rgb::ONE, k_from_reflectance(r.eval_at(tc))),
                     None => (*eta, *k),
                 };
                 Bsdf::Layered(Box::new(coated_conductor(
@@ -206,7 +269,7 @@ impl Material {
                     eta,
                     k,
                     ov.alpha.unwrap_or(*alpha),
-                    *layer,
+                    ov.layer.unwrap_or(*layer),
                 )))
             }
             Material::Dielectric { eta, alpha } => Bsdf::Dielectric(Dielectric {
@@ -220,8 +283,8 @@ impl Material {
                 transmittance,
                 scale,
             } => Bsdf::DiffuseTransmission(DiffuseTransmission::new(
-                reflectance.eval(hit.uv) * *scale,
-                transmittance.eval(hit.uv) * *scale,
+                reflectance.eval_at(tc) * *scale,
+                transmittance.eval_at(tc) * *scale,
             )),
         }
     }
@@ -231,6 +294,7 @@ impl Material {
     pub fn normal_perturbation(&self) -> Option<&NormalPerturbation> {
         match self {
             Material::Varying(v) => v.normal.as_ref(),
+            Material::Filtered { base, .. } => base.normal_perturbation(),
             _ => None,
         }
     }
@@ -240,8 +304,12 @@ impl Material {
         match self {
             // A roughness texture may be zero in places and not in others.
             Material::Varying(v) => {
-                v.roughness.is_none() && v.coat_roughness.is_none() && v.base.is_delta_only()
+                v.roughness.is_none()
+                    && v.coat_roughness.is_none()
+                    && v.layer.is_none()
+                    && v.base.is_delta_only()
             }
+            Material::Filtered { base, .. } => base.is_delta_only(),
             Material::Mirror => true,
             Material::Conductor { alpha, .. } | Material::Dielectric { alpha, .. } => {
                 is_smooth(*alpha)
@@ -256,6 +324,60 @@ impl Material {
             | Material::Phong { .. }
             | Material::CoatedDiffuse { .. }
             | Material::DiffuseTransmission { .. } => false,
+        }
+    }
+}
+
+impl Material {
+    /// True if some texture of the material filters over a footprint (MIP-mapped images,
+    /// checkerboards): the scene builder then gives it the camera's footprint model.
+    pub fn filters_textures(&self) -> bool {
+        let r = |r: &Option<RoughnessTextures>| {
+            r.as_ref()
+                .is_some_and(|r| r.uv[0].filters() || r.uv[1].filters())
+        };
+        match self {
+            Material::Diffuse { reflectance } => reflectance.filters(),
+            Material::Phong { kd, .. } => kd.filters(),
+            Material::Conductor { reflectance, .. }
+            | Material::CoatedConductor { reflectance, .. } => {
+                reflectance.as_ref().is_some_and(Texture::filters)
+            }
+            Material::CoatedDiffuse { reflectance, .. } => reflectance.filters(),
+            Material::DiffuseTransmission {
+                reflectance,
+                transmittance,
+                ..
+            } => reflectance.filters() || transmittance.filters(),
+            Material::Dielectric { .. } | Material::Mirror => false,
+            Material::Varying(v) => {
+                v.base.filters_textures()
+                    || r(&v.roughness)
+                    || r(&v.coat_roughness)
+                    || matches!(&v.normal, Some(NormalPerturbation::Bump(d)) if d.filters())
+                    || v.layer.as_ref().is_some_and(|l| {
+                        l.thickness.as_ref().is_some_and(FloatTexture::filters)
+                            || l.g.as_ref().is_some_and(FloatTexture::filters)
+                            || l.albedo.as_ref().is_some_and(Texture::filters)
+                    })
+            }
+            Material::Filtered { .. } => false,
+        }
+    }
+
+    /// The footprint model the scene builder gave this material, if any.
+    pub fn footprint(&self) -> Option<&Footprint> {
+        match self {
+            Material::Filtered { footprint, .. } => Some(&**footprint),
+            _ => None,
+        }
+    }
+
+    /// The material without its footprint model (textures read at points).
+    pub fn unfiltered(&self) -> &Material {
+        match self {
+            Material::Filtered { base, .. } => base,
+            m => m,
         }
     }
 }

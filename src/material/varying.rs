@@ -3,9 +3,11 @@
 //! each hit by the remapped texture values; and materials with a normal map or a bump map,
 //! which replace the shading normal (pbrt-v4's `NormalMap` and `BumpMap`).
 
-use super::Material;
 use super::float_texture::FloatTexture;
-use super::texture::ImageRgb;
+use super::texture::{ImageRgb, TexCoord};
+use super::{Material, Texture};
+use crate::Rgb;
+use crate::bsdf::LayerParams;
 use crate::bsdf::roughness_to_alpha;
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
@@ -24,7 +26,13 @@ impl RoughnessTextures {
     /// constant path does).
     #[inline]
     pub fn alpha(&self, uv: Vec2) -> Vec2 {
-        let r = Vec2::new(self.uv[0].eval(uv), self.uv[1].eval(uv)).max(Vec2::ZERO);
+        self.alpha_at(&super::TexCoord::point(uv))
+    }
+
+    /// [`RoughnessTextures::alpha`] over the footprint `tc`.
+    #[inline]
+    pub fn alpha_at(&self, tc: &super::TexCoord) -> Vec2 {
+        let r = Vec2::new(self.uv[0].eval_at(tc), self.uv[1].eval_at(tc)).max(Vec2::ZERO);
         if self.remap {
             Vec2::new(roughness_to_alpha(r.x), roughness_to_alpha(r.y))
         } else {
@@ -44,6 +52,47 @@ pub struct VaryingMaterial {
     pub coat_roughness: Option<RoughnessTextures>,
     /// How the shading normal is perturbed, if it is.
     pub normal: Option<NormalPerturbation>,
+    /// A coated material's textured layer parameters.
+    pub layer: Option<LayerTextures>,
+}
+
+/// A coated material's `thickness`, `g` and `albedo` as textures (pbrt-v4 evaluates them per
+/// hit); each present one replaces the constant parameter.
+#[derive(Clone, Debug, Default)]
+pub struct LayerTextures {
+    /// Slab thickness (clamped to ≥ 0).
+    pub thickness: Option<FloatTexture>,
+    /// Henyey–Greenstein asymmetry (clamped to [−0.99, 0.99]).
+    pub g: Option<FloatTexture>,
+    /// Slab single-scattering albedo (clamped to [0, 1]).
+    pub albedo: Option<Texture>,
+}
+
+impl LayerTextures {
+    /// `base` with the textured parameters evaluated over `tc`.
+    pub fn apply(&self, base: LayerParams, tc: &TexCoord) -> LayerParams {
+        let mut p = base;
+        if let Some(t) = &self.thickness {
+            let v = t.eval_at(tc);
+            p.thickness = if v.is_finite() {
+                v.max(0.0)
+            } else {
+                base.thickness
+            };
+        }
+        if let Some(g) = &self.g {
+            let v = g.eval_at(tc);
+            p.g = if v.is_finite() {
+                v.clamp(-0.99, 0.99)
+            } else {
+                base.g
+            };
+        }
+        if let Some(a) = &self.albedo {
+            p.albedo = a.eval_at(tc).clamp(Rgb::ZERO, Rgb::ONE);
+        }
+        p
+    }
 }
 
 /// pbrt-v4's two ways of changing the shading normal.
@@ -65,15 +114,36 @@ pub enum NormalPerturbation {
     Bump(FloatTexture),
 }
 
-/// uv step of the bump map's finite differences: pbrt-v4's fallback when a hit has no ray
-/// differentials (penumbra's never do).
+/// uv step of the bump map's finite differences where a hit has no footprint (pbrt-v4's
+/// fallback without ray differentials).
 pub const BUMP_DELTA: f32 = 0.0005;
 
+/// The surface derivatives a normal or bump map needs at a hit: ∂p/∂u, ∂p/∂v of the shading
+/// geometry and the shading normal's ∂n/∂u, ∂n/∂v (zero on flat triangles).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ShadingDerivatives {
+    /// ∂p/∂u.
+    pub dpdu: Vec3,
+    /// ∂p/∂v.
+    pub dpdv: Vec3,
+    /// ∂n/∂u.
+    pub dndu: Vec3,
+    /// ∂n/∂v.
+    pub dndv: Vec3,
+}
+
 impl NormalPerturbation {
-    /// The perturbed shading normal at texture coordinates `uv`, for shading normal `ns`,
-    /// geometric normal `ng` (the result is on its side) and surface derivatives ∂p/∂u, ∂p/∂v.
-    /// Bump mapping leaves out pbrt-v4's displacement·∂n/∂u term (zero on flat triangles).
-    pub fn shading_normal(&self, uv: Vec2, ns: Vec3, ng: Vec3, dpdu: Vec3, dpdv: Vec3) -> Vec3 {
+    /// The perturbed shading normal at texture coordinates `tc` (its footprint sets the bump
+    /// map's differencing step, as pbrt-v4's du = ½(|∂u/∂x| + |∂u/∂y|)), for shading normal
+    /// `ns`, geometric normal `ng` (the result is on its side) and the derivatives `d`.
+    pub fn shading_normal(
+        &self,
+        tc: &TexCoord,
+        ns: Vec3,
+        ng: Vec3,
+        d: &ShadingDerivatives,
+    ) -> Vec3 {
+        let (uv, dpdu, dpdv) = (tc.uv, d.dpdu, d.dpdv);
         let n = match self {
             NormalPerturbation::NormalMap {
                 image,
@@ -101,14 +171,32 @@ impl NormalPerturbation {
                 // for bit.
                 x * local.x + y * local.y + ns * local.z
             }
-            NormalPerturbation::Bump(d) => {
-                let du = BUMP_DELTA;
-                let h = d.eval(uv);
-                let hu = d.eval(uv + Vec2::new(du, 0.0));
-                let hv = d.eval(uv + Vec2::new(0.0, du));
-                // The displaced surface p + h·ns differentiated by forward differences.
-                let pu = dpdu + ns * ((hu - h) / du);
-                let pv = dpdv + ns * ((hv - h) / du);
+            NormalPerturbation::Bump(disp) => {
+                // pbrt-v4's BumpMap: steps from the footprint, else 0.0005.
+                let step = |a: f32, b: f32| {
+                    let s = 0.5 * (a.abs() + b.abs());
+                    if s > 0.0 && s.is_finite() {
+                        s
+                    } else {
+                        BUMP_DELTA
+                    }
+                };
+                let du = step(tc.duvdx.x, tc.duvdy.x);
+                let dv = step(tc.duvdx.y, tc.duvdy.y);
+                let at = |uv: Vec2| {
+                    disp.eval_at(&TexCoord {
+                        uv,
+                        duvdx: tc.duvdx,
+                        duvdy: tc.duvdy,
+                    })
+                };
+                let h = at(uv);
+                let hu = at(uv + Vec2::new(du, 0.0));
+                let hv = at(uv + Vec2::new(0.0, dv));
+                // The displaced surface p + h·n differentiated: forward differences of h
+                // along ns, plus h·∂n/∂u, h·∂n/∂v (the normal turning under the displacement).
+                let pu = dpdu + ns * ((hu - h) / du) + d.dndu * h;
+                let pv = dpdv + ns * ((hv - h) / dv) + d.dndv * h;
                 let n = pu.cross(pv).normalize_or_zero();
                 // ∂p/∂u × ∂p/∂v follows the uv winding, not the surface's side: face it to
                 // the shading normal it perturbs.
@@ -131,4 +219,6 @@ pub struct AlphaOverride {
     pub alpha: Option<Vec2>,
     /// A coated conductor's coat widths.
     pub coat_alpha: Option<Vec2>,
+    /// A coated material's layer parameters.
+    pub layer: Option<LayerParams>,
 }

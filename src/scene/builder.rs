@@ -12,6 +12,9 @@ use crate::material::Material;
 use anyhow::{Context, bail, ensure};
 use glam::Vec3;
 
+/// Segments around an emissive cylinder's tessellation ([`SceneBuilder::add_cylinder`]).
+pub const CYLINDER_LIGHT_SEGMENTS: u32 = 64;
+
 /// Accumulates shapes, materials and lights, then builds the BVH once.
 #[derive(Default)]
 pub struct SceneBuilder {
@@ -26,6 +29,9 @@ pub struct SceneBuilder {
     meshes_seen: usize,
     /// What was repaired in meshes added with [`SceneBuilder::add_mesh`], one line per mesh.
     pub warnings: Vec<String>,
+    /// Texture lookups at points only (no pixel footprints): MIP-mapped images read their
+    /// finest level, checkerboards are not antialiased.
+    point_textures: bool,
 }
 
 impl SceneBuilder {
@@ -38,6 +44,12 @@ impl SceneBuilder {
     pub fn add_material(&mut self, m: Material) -> u32 {
         self.materials.push(m);
         (self.materials.len() - 1) as u32
+    }
+
+    /// Whether textures filter over each hit's pixel footprint (pbrt-v4's MIP-mapping and
+    /// checkerboard antialiasing; the default) or are read at points.
+    pub fn set_texture_filtering(&mut self, on: bool) {
+        self.point_textures = !on;
     }
 
     /// Number of primitives added so far.
@@ -299,6 +311,121 @@ impl SceneBuilder {
         self.add_quadric(q, material, emission)
     }
 
+    /// Add pbrt-v4's cylinder `[radius, zmin, zmax, phimax (radians)]` of `to_world`'s object
+    /// space (axis z). An emissive one becomes a mesh of
+    /// [`CYLINDER_LIGHT_SEGMENTS`] × 2 triangle lights with the cylinder's normals (the
+    /// lights sample triangles; the loader warns).
+    pub fn add_cylinder(
+        &mut self,
+        to_world: Transform,
+        [radius, zmin, zmax, phimax]: [f32; 4],
+        material: u32,
+        emission: Option<AreaEmission>,
+        reverse_orientation: bool,
+    ) -> anyhow::Result<()> {
+        ensure!(
+            radius.is_finite() && radius > 0.0 && zmin.is_finite() && zmax.is_finite(),
+            "cylinder radius must be positive and finite (radius {radius}, z {zmin}..{zmax})"
+        );
+        ensure!(
+            zmin < zmax && phimax > 0.0 && phimax.is_finite(),
+            "cylinder needs zmin < zmax and phimax > 0 (z {zmin}..{zmax}, phimax {phimax})"
+        );
+        // The object-space normal (x, y, 0) through the inverse transpose is already the
+        // outward one under a mirroring transform (pbrt-v4 crosses the render-space ∂p/∂u,
+        // ∂p/∂v, which a mirror turns inward, and flips them back): only
+        // ReverseOrientation flips it.
+        let flip = reverse_orientation;
+        if let Some(e) = emission {
+            let n = CYLINDER_LIGHT_SEGMENTS;
+            let (mut positions, mut normals, mut uvs, mut indices) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            let nt = to_world.m_inv.transpose();
+            for i in 0..=n {
+                let u = i as f32 / n as f32;
+                let phi = u * phimax;
+                let (s, c) = phi.sin_cos();
+                for (z, v) in [(zmin, 0.0), (zmax, 1.0)] {
+                    positions.push(to_world.point(Vec3::new(radius * c, radius * s, z)));
+                    let nn = nt
+                        .transform_vector3(Vec3::new(c, s, 0.0))
+                        .normalize_or_zero();
+                    normals.push(if flip { -nn } else { nn });
+                    uvs.push(glam::Vec2::new(u, v));
+                }
+            }
+            for i in 0..n {
+                let (a, b) = (2 * i, 2 * i + 2);
+                // Wound so that (p1 − p0) × (p2 − p0) points outward: along +φ, then +z.
+                indices.extend_from_slice(&[a, b, b + 1, a, b + 1, a + 1]);
+            }
+            let mesh = TriangleMesh {
+                positions,
+                normals: Some(normals),
+                uvs: Some(uvs),
+                indices,
+                flip_normals: flip,
+            };
+            return self.add_mesh_repaired(mesh, material, Some(e)).map(|_| ());
+        }
+        let q = Quadric {
+            kind: QuadricKind::Cylinder {
+                radius,
+                zmin,
+                zmax,
+                phimax,
+            },
+            to_world,
+            flip,
+        };
+        self.add_quadric(q, material, None)
+    }
+
+    /// Add a world-space bilinear patch (corners p00, p10, p01, p11, their uvs), normal
+    /// ∂p/∂u × ∂p/∂v (negated with `flip`); not emissive.
+    pub fn add_bilinear_patch(
+        &mut self,
+        p: [Vec3; 4],
+        uv: [glam::Vec2; 4],
+        material: u32,
+        flip: bool,
+    ) -> anyhow::Result<()> {
+        ensure!(
+            p.iter().all(|v| v.is_finite()) && uv.iter().all(|v| v.is_finite()),
+            "bilinear patch corners and uvs must be finite"
+        );
+        let q = Quadric {
+            kind: QuadricKind::Bilinear { p, uv },
+            to_world: Transform::IDENTITY,
+            flip,
+        };
+        self.add_quadric(q, material, None)
+    }
+
+    /// Add one cubic Bézier segment of a pbrt-v4 `curve` in `to_world`'s object space (not
+    /// emissive).
+    pub fn add_curve(
+        &mut self,
+        to_world: Transform,
+        segment: crate::geometry::curve::CurveSegment,
+        material: u32,
+        reverse_orientation: bool,
+    ) -> anyhow::Result<()> {
+        ensure!(
+            segment.cp.iter().all(|p| p.is_finite())
+                && segment.width.iter().all(|w| w.is_finite() && *w >= 0.0),
+            "curve control points and widths must be finite (widths ≥ 0)"
+        );
+        let q = Quadric {
+            kind: QuadricKind::Curve(segment),
+            to_world,
+            // As the cylinder's: the normal through the inverse transpose needs no
+            // handedness flip.
+            flip: reverse_orientation,
+        };
+        self.add_quadric(q, material, None)
+    }
+
     /// Add a light that is not attached to geometry (point, spot, distant, infinite).
     pub fn add_light(&mut self, light: Light) {
         self.lights.push(light);
@@ -330,10 +457,30 @@ impl SceneBuilder {
             .filter(|(_, l)| l.is_infinite())
             .map(|(i, _)| i as u32)
             .collect();
+        let mut materials = self.materials;
+        let filtering: Vec<bool> = materials.iter().map(Material::filters_textures).collect();
+        if !self.point_textures && filtering.contains(&true) {
+            let fp = std::sync::Arc::new(crate::material::Footprint::new(
+                &camera,
+                film.resolution,
+                film.spp.unwrap_or(64),
+                &geometry,
+                |m| filtering.get(m as usize).copied().unwrap_or(false),
+            ));
+            for (m, f) in materials.iter_mut().zip(&filtering) {
+                if *f {
+                    let base = std::mem::replace(m, Material::Mirror);
+                    *m = Material::Filtered {
+                        base: Box::new(base),
+                        footprint: fp.clone(),
+                    };
+                }
+            }
+        }
         Ok(Scene {
             geometry,
             emitters,
-            materials: self.materials,
+            materials,
             lights,
             infinite_lights,
             camera,
@@ -414,6 +561,7 @@ fn quadric_light(q: &Quadric, e: &AreaEmission) -> anyhow::Result<Light> {
             }
             DiskLight::new(c, n, radius * sx, e.l, e.two_sided).map(Light::Disk)
         }
+        QuadricKind::Cylinder { .. } | QuadricKind::Bilinear { .. } | QuadricKind::Curve(_) => None,
     };
     light.ok_or_else(|| anyhow::anyhow!("degenerate emissive shape"))
 }

@@ -611,6 +611,7 @@ fn gltf_material(
                             scale,
                             uv_handed: true,
                         }),
+                        layer: None,
                     }))
                 }
                 None => material,

@@ -4,7 +4,24 @@
 
 use super::Scene;
 use crate::geometry::{HitColumns, PrimKind, SurfaceHit};
+use crate::material::{ShadingDerivatives, TexCoord};
 use glam::{Vec2, Vec3};
+
+/// pbrt-v4's triangle ∂n/∂u, ∂n/∂v from the vertex normals `n` and uvs (zero for degenerate
+/// uvs, where pbrt picks an arbitrary frame of the normals' spread instead).
+pub fn triangle_dndu(n: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
+    let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
+    let (dn1, dn2) = (n[0] - n[2], n[1] - n[2]);
+    let det = duv02.x * duv12.y - duv02.y * duv12.x;
+    if !(det.abs() > 1e-32) {
+        return (Vec3::ZERO, Vec3::ZERO);
+    }
+    let inv = 1.0 / det;
+    (
+        (dn1 * duv12.y - dn2 * duv02.y) * inv,
+        (dn2 * duv02.x - dn1 * duv12.x) * inv,
+    )
+}
 
 /// ∂p/∂u and ∂p/∂v of triangle `p` with texture coordinates `uv` (pbrt-v4's triangle
 /// derivatives, made perpendicular to the shading normal `ns` when the mesh has vertex
@@ -46,11 +63,10 @@ pub fn perturb_hits(
 ) {
     for k in crate::geometry::packet::bits(active) {
         let Some(hit) = &mut hits[k] else { continue };
-        let Some(pert) = scene
-            .materials
-            .get(hit.material as usize)
-            .and_then(|m| m.normal_perturbation())
-        else {
+        let Some(material) = scene.materials.get(hit.material as usize) else {
+            continue;
+        };
+        let Some(pert) = material.normal_perturbation() else {
             continue;
         };
         let Some(prim) = scene.geometry.primitive(hit.prim) else {
@@ -69,7 +85,20 @@ pub fn perturb_hits(
         else {
             continue;
         };
-        let ns = pert.shading_normal(hit.uv, hit.ns, hit.ng, dpdu, dpdv);
+        let (dndu, dndv) = match &m.normals {
+            Some(n) => triangle_dndu(v.map(|i| n[i as usize]), uv),
+            None => (Vec3::ZERO, Vec3::ZERO),
+        };
+        let tc = material
+            .footprint()
+            .map_or(TexCoord::point(hit.uv), |f| f.tex_coord(hit));
+        let d = ShadingDerivatives {
+            dpdu,
+            dpdv,
+            dndu,
+            dndv,
+        };
+        let ns = pert.shading_normal(&tc, hit.ns, hit.ng, &d);
         hit.ns = ns;
         for a in 0..3 {
             cols.ns[a][k] = ns[a];

@@ -11,7 +11,8 @@ use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
 use crate::bsdf::{LayerParams, roughness_to_alpha};
 use crate::material::{
-    FloatTexture, Material, NormalPerturbation, RoughnessTextures, Texture, VaryingMaterial,
+    FloatTexture, LayerTextures, Material, NormalPerturbation, RoughnessTextures, Texture,
+    VaryingMaterial,
 };
 use glam::Vec2;
 
@@ -110,7 +111,21 @@ pub enum MaterialDesc {
         coat_roughness: Option<[FloatTexDesc; 2]>,
         /// Normal or bump map.
         normal: Option<NormalDesc>,
+        /// Textured layer parameters of a coated material.
+        layer: Option<LayerTexDesc>,
     },
+}
+
+/// A coated material's layer parameters given as varying textures (pbrt-v4's `thickness`,
+/// `g`, `albedo` are textures); each replaces the constant one at every hit.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct LayerTexDesc {
+    /// `thickness`.
+    pub thickness: Option<FloatTexDesc>,
+    /// `g`.
+    pub g: Option<FloatTexDesc>,
+    /// `albedo`.
+    pub albedo: Option<TextureDesc>,
 }
 
 /// A material's normal map (resolved path, loaded while parsing) or bump displacement.
@@ -181,7 +196,17 @@ fn varying(
     coat_roughness: Option<[FloatTexDesc; 2]>,
     normal: Option<NormalDesc>,
 ) -> MaterialDesc {
-    if roughness.is_none() && coat_roughness.is_none() && normal.is_none() {
+    varying_layer(base, roughness, coat_roughness, normal, None)
+}
+
+fn varying_layer(
+    base: MaterialDesc,
+    roughness: Option<[FloatTexDesc; 2]>,
+    coat_roughness: Option<[FloatTexDesc; 2]>,
+    normal: Option<NormalDesc>,
+    layer: Option<LayerTexDesc>,
+) -> MaterialDesc {
+    if roughness.is_none() && coat_roughness.is_none() && normal.is_none() && layer.is_none() {
         return base;
     }
     // A material that is already varying (a `mix` component) keeps its own maps.
@@ -190,6 +215,7 @@ fn varying(
         roughness: r0,
         coat_roughness: c0,
         normal: n0,
+        layer: l0,
     } = base
     {
         return MaterialDesc::Varying {
@@ -197,6 +223,7 @@ fn varying(
             roughness: roughness.or(r0),
             coat_roughness: coat_roughness.or(c0),
             normal: normal.or(n0),
+            layer: layer.or(l0),
         };
     }
     MaterialDesc::Varying {
@@ -204,6 +231,7 @@ fn varying(
         roughness,
         coat_roughness,
         normal,
+        layer,
     }
 }
 
@@ -236,16 +264,6 @@ fn normal_desc(
             "material has both 'normalmap' and 'displacement': the normal map is used".into(),
         );
     }
-    if map.is_none() && bump.is_some() {
-        warn(
-            "bump-approx",
-            loc,
-            format!(
-                "bump mapping: finite differences of {} in uv (no ray differentials) and without the displacement·∂n/∂u term of curved shading normals",
-                crate::material::varying::BUMP_DELTA
-            ),
-        );
-    }
     Ok(map.or(bump))
 }
 
@@ -256,18 +274,29 @@ fn layer_params(
     tex: &TextureTable,
     loc: &Loc,
     warn: &mut Warn,
-) -> anyhow::Result<LayerParams> {
-    let thickness = tex.float_param(params, "thickness", 0.01, warn)?;
-    let g = tex.float_param(params, "g", 0.0, warn)?;
+) -> anyhow::Result<(LayerParams, Option<LayerTexDesc>)> {
+    let mut varying = LayerTexDesc::default();
+    let mut float = |name: &str, default: f32, warn: &mut Warn| -> anyhow::Result<f32> {
+        let t = tex.float_texture_param(params, name, default, warn)?;
+        Ok(match t.constant() {
+            Some(v) => v,
+            None => {
+                if name == "thickness" {
+                    varying.thickness = Some(t);
+                } else {
+                    varying.g = Some(t);
+                }
+                default
+            }
+        })
+    };
+    let thickness = float("thickness", 0.01, warn)?;
+    let g = float("g", 0.0, warn)?;
     let albedo = match tex.spectrum_param(params, "albedo", Some(Rgb::ZERO))? {
         Some(TextureDesc::Constant(c)) => c,
-        Some(_) => {
-            warn(
-                "layer-albedo-texture",
-                loc,
-                "varying 'albedo' texture of a layered material approximated by 0.5".into(),
-            );
-            Rgb::splat(0.5)
+        Some(t) => {
+            varying.albedo = Some(t);
+            Rgb::ZERO
         }
         None => Rgb::ZERO,
     };
@@ -290,13 +319,17 @@ fn layer_params(
             ),
         ));
     }
-    Ok(LayerParams {
-        thickness,
-        albedo,
-        g,
-        max_depth: max_depth as u32,
-        n_samples: n_samples as u32,
-    })
+    let textured = varying != LayerTexDesc::default();
+    Ok((
+        LayerParams {
+            thickness,
+            albedo,
+            g,
+            max_depth: max_depth as u32,
+            n_samples: n_samples as u32,
+        },
+        textured.then_some(varying),
+    ))
 }
 
 fn metal(params: &ParamSet, name: &str, default: &str) -> anyhow::Result<MetalSpectrum> {
@@ -423,6 +456,7 @@ fn material_body(
         }
         "coateddiffuse" => {
             let (r, rt) = roughness(params, tex, 0.0, warn)?;
+            let (layer, lt) = layer_params(params, tex, loc, warn)?;
             let base = MaterialDesc::CoatedDiffuse {
                 reflectance: tex
                     .spectrum_param(params, "reflectance", Some(Rgb::splat(0.5)))?
@@ -430,13 +464,14 @@ fn material_body(
                 roughness: r,
                 eta: ior(params, "eta", loc, warn)?,
                 remap: params.bool("remaproughness", true)?,
-                layer: layer_params(params, tex, loc, warn)?,
+                layer,
             };
-            varying(base, rt, None, None)
+            varying_layer(base, rt, None, None, lt)
         }
         "coatedconductor" => {
             let (cr, crt) = prefixed_roughness(params, tex, "interface.", 0.0, warn)?;
             let (r, rt) = prefixed_roughness(params, tex, "conductor.", 0.0, warn)?;
+            let (layer, lt) = layer_params(params, tex, loc, warn)?;
             let base = MaterialDesc::CoatedConductor {
                 coat_eta: ior(params, "interface.eta", loc, warn)?,
                 coat_roughness: cr,
@@ -445,9 +480,9 @@ fn material_body(
                 reflectance: tex.spectrum_param(params, "reflectance", None)?,
                 roughness: r,
                 remap: params.bool("remaproughness", true)?,
-                layer: layer_params(params, tex, loc, warn)?,
+                layer,
             };
-            varying(base, rt, crt, None)
+            varying_layer(base, rt, crt, None, lt)
         }
         "dielectric" | "thindielectric" => {
             let thin = ty == "thindielectric";
@@ -514,7 +549,18 @@ fn image(
     Ok(encoding.apply(path, img))
 }
 
-/// A float texture description as a renderer texture.
+fn mip(
+    img: std::sync::Arc<crate::material::texture::ImageRgb>,
+    sampling: super::textures::Sampling,
+) -> std::sync::Arc<crate::material::texture::MipMap> {
+    std::sync::Arc::new(crate::material::texture::MipMap::new(
+        img,
+        sampling.wrap,
+        sampling.filter,
+    ))
+}
+
+/// A float texture description as a renderer texture (images MIP-mapped, as pbrt-v4's).
 pub fn float_texture(t: &FloatTexDesc, images: &ImageCache) -> anyhow::Result<FloatTexture> {
     Ok(match t {
         FloatTexDesc::Constant(v) => FloatTexture::Constant(*v),
@@ -523,8 +569,9 @@ pub fn float_texture(t: &FloatTexDesc, images: &ImageCache) -> anyhow::Result<Fl
             scale,
             invert,
             encoding,
-        } => FloatTexture::Image {
-            image: image(path, *encoding, images)?,
+            sampling,
+        } => FloatTexture::Mip {
+            map: mip(image(path, *encoding, images)?, *sampling),
             scale: *scale,
             invert: *invert,
         },
@@ -533,6 +580,11 @@ pub fn float_texture(t: &FloatTexDesc, images: &ImageCache) -> anyhow::Result<Fl
             Box::new(float_texture(b, images)?),
         ),
         FloatTexDesc::Mapped(m, t) => FloatTexture::Mapped(*m, Box::new(float_texture(t, images)?)),
+        FloatTexDesc::Checkerboard { a, b, freq } => FloatTexture::Checkerboard {
+            a: *a,
+            b: *b,
+            freq: *freq,
+        },
     })
 }
 
@@ -549,21 +601,24 @@ fn texture(t: &TextureDesc, images: &ImageCache) -> anyhow::Result<Texture> {
             scale,
             invert,
             encoding,
+            sampling,
         } => {
             let img = image(path, *encoding, images)?;
             if *invert {
-                // pbrt-v4: max(0, 1 − scale·value), baked into a copy of the image.
+                // pbrt-v4: max(0, 1 − scale·value), baked into a copy of the image. pbrt
+                // inverts after filtering; 1 − s·x is affine, so the two agree wherever the
+                // clamp at 0 does not act.
                 let mut inv = (*img).clone();
                 for p in &mut inv.pixels {
                     *p = (Rgb::ONE - *p * *scale).max(Rgb::ZERO);
                 }
-                Texture::Image {
-                    image: std::sync::Arc::new(inv),
+                Texture::Mip {
+                    map: mip(std::sync::Arc::new(inv), *sampling),
                     scale: Rgb::ONE,
                 }
             } else {
-                Texture::Image {
-                    image: img,
+                Texture::Mip {
+                    map: mip(img, *sampling),
                     scale: *scale,
                 }
             }
@@ -700,6 +755,7 @@ pub fn to_material(
             roughness,
             coat_roughness,
             normal,
+            layer,
         } => {
             let remap = match **base {
                 MaterialDesc::Conductor { remap, .. }
@@ -734,6 +790,18 @@ pub fn to_material(
                 roughness: textures(roughness)?,
                 coat_roughness: textures(coat_roughness)?,
                 normal,
+                layer: match layer {
+                    Some(l) => Some(LayerTextures {
+                        thickness: l
+                            .thickness
+                            .as_ref()
+                            .map(|t| float_texture(t, images))
+                            .transpose()?,
+                        g: l.g.as_ref().map(|t| float_texture(t, images)).transpose()?,
+                        albedo: l.albedo.as_ref().map(|t| texture(t, images)).transpose()?,
+                    }),
+                    None => None,
+                },
             }))
         }
         MaterialDesc::Interface => {

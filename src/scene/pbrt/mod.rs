@@ -145,6 +145,47 @@ impl PbrtScene {
                     s.emission,
                     s.reverse_orientation,
                 ),
+                ShapeGeom::Curves { to_world, segments } => segments
+                    .into_iter()
+                    .try_for_each(|c| b.add_curve(to_world, c, s.material, s.reverse_orientation)),
+                ShapeGeom::Bilinear { patches, mesh } => {
+                    if s.emission.is_some() || s.alpha.is_some() {
+                        // Lights and cut-outs are triangles: exact for parallelograms.
+                        let bent = patches.iter().any(|(c, _, _)| {
+                            let size = (c[3] - c[0]).length().max((c[1] - c[2]).length());
+                            (c[3] - c[2] - c[1] + c[0]).length() > 1e-5 * size
+                        });
+                        if bent && warned_at.insert(format!("bilinear@{}", s.loc.file_line())) {
+                            warnings.push(format!(
+                                "{}: warning: emissive or cut-out bilinearmesh with non-parallelogram patches approximated by two triangles each",
+                                s.loc.file_line()
+                            ));
+                        }
+                        match mesh {
+                            Some(m) => b
+                                .add_mesh_cut_out(m, s.material, s.emission, s.alpha)
+                                .map(|_| ()),
+                            None => Ok(()),
+                        }
+                    } else {
+                        patches.into_iter().try_for_each(|(p, uv, flip)| {
+                            b.add_bilinear_patch(p, uv, s.material, flip)
+                        })
+                    }
+                }
+                ShapeGeom::Cylinder {
+                    to_world,
+                    radius,
+                    zmin,
+                    zmax,
+                    phimax,
+                } => b.add_cylinder(
+                    to_world,
+                    [radius, zmin, zmax, phimax],
+                    s.material,
+                    s.emission,
+                    s.reverse_orientation,
+                ),
             };
             r.map_err(|e| err_at(&s.loc, e))?;
         }

@@ -1134,6 +1134,23 @@ impl Parser {
             l: a.radiance_for_area(geom.area()),
             two_sided: a.two_sided,
         });
+        if emission.is_some() && matches!(geom, super::shapes::ShapeGeom::Cylinder { .. }) {
+            self.warn(
+                "cylinder-light",
+                loc,
+                format!(
+                    "emissive cylinder tessellated into {} triangle lights per side (penumbra samples no analytic cylinder light)",
+                    crate::scene::builder::CYLINDER_LIGHT_SEGMENTS * 2
+                ),
+            );
+        }
+        if emission.is_some() && matches!(geom, super::shapes::ShapeGeom::Curves { .. }) {
+            self.warn(
+                "curve-light",
+                loc,
+                "area lights on curves are not supported: the curve is not emissive".into(),
+            );
+        }
         if emission.is_some() && self.cur_object.is_some() {
             self.warn(
                 "instance-light",

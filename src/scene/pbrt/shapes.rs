@@ -1,4 +1,5 @@
-//! `Shape` directive: `trianglemesh`, `plymesh`, `bilinearmesh` (as triangles), `sphere`, `disk`.
+//! `Shape` directive: `trianglemesh`, `plymesh`, `bilinearmesh` (as triangles), `sphere`, `disk`,
+//! `cylinder`.
 //! Meshes are validated and taken to world space here: positions by the CTM, normals by its
 //! inverse transpose (renormalised); `flip_normals` = ReverseOrientation xor handedness swap.
 
@@ -6,6 +7,7 @@ use super::params::ParamSet;
 use super::ply::read_ply;
 use super::textures::{TextureTable, Warn, resolve};
 use super::tokenizer::{Loc, err_at};
+use crate::geometry::curve::{CurveSegment, CurveType, bspline_to_bezier};
 use crate::geometry::{Alpha, Transform};
 use crate::scene::TriangleMesh;
 use crate::scene::mesh_repair::repair_mesh;
@@ -34,6 +36,35 @@ pub enum ShapeGeom {
         /// Radius in object space.
         radius: f32,
     },
+    /// pbrt-v4's `bilinearmesh`: true bilinear patches (world space), and the same patches as
+    /// two triangles each for where penumbra needs triangles (emitters, alpha cut-outs).
+    Bilinear {
+        /// Per patch: corners p00, p10, p01, p11, their uvs, and whether the normal
+        /// ∂p/∂u × ∂p/∂v is flipped.
+        patches: Vec<([Vec3; 4], [Vec2; 4], bool)>,
+        /// The triangle stand-in (`None` if every triangle was degenerate).
+        mesh: Option<TriangleMesh>,
+    },
+    /// pbrt-v4's `curve`: cubic Bézier segments in the object space of `to_world`.
+    Curves {
+        /// Object-to-world.
+        to_world: Transform,
+        /// The segments.
+        segments: Vec<CurveSegment>,
+    },
+    /// pbrt-v4's cylinder (object space: axis z, z in [zmin, zmax], φ in [0, phimax]).
+    Cylinder {
+        /// Object-to-world.
+        to_world: Transform,
+        /// Radius in object space.
+        radius: f32,
+        /// Lower end.
+        zmin: f32,
+        /// Upper end.
+        zmax: f32,
+        /// Sweep in radians.
+        phimax: f32,
+    },
 }
 
 fn area_scale(t: &Transform) -> f32 {
@@ -59,6 +90,27 @@ impl ShapeGeom {
             ShapeGeom::Disk {
                 to_world, radius, ..
             } => PI * radius * radius * area_scale(to_world),
+            ShapeGeom::Cylinder {
+                to_world,
+                radius,
+                zmin,
+                zmax,
+                phimax,
+            } => phimax * radius * (zmax - zmin).abs() * area_scale(to_world),
+            ShapeGeom::Bilinear { mesh, .. } => mesh
+                .as_ref()
+                .map_or(0.0, |m| ShapeGeom::Mesh(m.clone()).area()),
+            // Curves carry no emission (warned); a rough estimate: polygon length × width.
+            ShapeGeom::Curves { to_world, segments } => {
+                segments
+                    .iter()
+                    .map(|c| {
+                        let l: f32 = (0..3).map(|i| (c.cp[i + 1] - c.cp[i]).length()).sum();
+                        l * 0.5 * (c.width[0] + c.width[1])
+                    })
+                    .sum::<f32>()
+                    * area_scale(to_world)
+            }
         }
     }
 
@@ -91,6 +143,35 @@ impl ShapeGeom {
                 to_world: t.then_apply_to(to_world),
                 height: *height,
                 radius: *radius,
+            },
+            ShapeGeom::Curves { to_world, segments } => ShapeGeom::Curves {
+                to_world: t.then_apply_to(to_world),
+                segments: segments.clone(),
+            },
+            ShapeGeom::Bilinear { patches, mesh } => ShapeGeom::Bilinear {
+                patches: patches
+                    .iter()
+                    .map(|(p, uv, f)| (p.map(|q| t.point(q)), *uv, *f ^ t.swaps_handedness()))
+                    .collect(),
+                mesh: mesh
+                    .as_ref()
+                    .map(|m| match ShapeGeom::Mesh(m.clone()).transformed(t) {
+                        ShapeGeom::Mesh(m) => m,
+                        _ => unreachable!(),
+                    }),
+            },
+            ShapeGeom::Cylinder {
+                to_world,
+                radius,
+                zmin,
+                zmax,
+                phimax,
+            } => ShapeGeom::Cylinder {
+                to_world: t.then_apply_to(to_world),
+                radius: *radius,
+                zmin: *zmin,
+                zmax: *zmax,
+                phimax: *phimax,
             },
         }
     }
@@ -301,27 +382,54 @@ pub fn make_shape(
                     ),
                 ));
             }
-            // Patch vertices are p00 p10 p01 p11: split along p00–p11 keeping the
-            // orientation of (p10 − p00) × (p01 − p00).
+            // Patch vertices are p00 p10 p01 p11. The true patches, in world space:
+            let m = ctx.ctm.m;
+            let nt = ctx.ctm.m_inv.transpose();
+            let swap = ctx.reverse ^ ctx.ctm.swaps_handedness();
+            let mut patches = Vec::with_capacity(quads.len() / 4);
+            for q in quads.chunks_exact(4) {
+                let c = [0, 1, 2, 3].map(|k| m.transform_point3(p[q[k] as usize]));
+                if !c.iter().all(|v| v.is_finite()) {
+                    return Err(err_at(loc, "bilinearmesh: non-finite vertex position"));
+                }
+                let uvc = match &uv {
+                    Some(uv) => [0, 1, 2, 3].map(|k| uv[q[k] as usize]),
+                    None => [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE],
+                };
+                // pbrt-v4: with normals, ∂p/∂u × ∂p/∂v faces the interpolated normal; without,
+                // it flips for ReverseOrientation ⊕ a handedness swap. (The normals are then
+                // not used for shading.)
+                let ng = (c[1] - c[0] + c[3] - c[2]).cross(c[2] - c[0] + c[3] - c[1]);
+                let flip = match &n {
+                    Some(ns) => {
+                        let sum: Vec3 = (0..4).map(|k| ns[q[k] as usize]).sum();
+                        ng.dot(nt.transform_vector3(sum)) < 0.0
+                    }
+                    None => swap,
+                };
+                patches.push((c, uvc, flip));
+            }
+            if n.is_some() {
+                warn(
+                    "bilinearmesh-normals",
+                    loc,
+                    "bilinearmesh: 'N' orients the patches but is not interpolated for shading (geometric normals)".into(),
+                );
+            }
+            // The triangle stand-in: split along p00–p11 keeping the orientation of
+            // (p10 − p00) × (p01 − p00).
             let mut indices = Vec::with_capacity(quads.len() / 4 * 6);
             for q in quads.chunks_exact(4) {
                 indices.extend_from_slice(&[q[0], q[1], q[3], q[0], q[3], q[2]]);
             }
-            warn(
-                "bilinearmesh",
-                loc,
-                "bilinear patches approximated by two triangles each".into(),
-            );
             let raw = RawMesh {
                 positions: p,
                 normals: n,
                 uvs: uv,
                 indices,
             };
-            match finish_mesh(raw, ctx, "bilinearmesh", warn)? {
-                Some(m) => ShapeGeom::Mesh(m),
-                None => return Ok(None),
-            }
+            let mesh = finish_mesh(raw, ctx, "bilinearmesh", warn)?;
+            ShapeGeom::Bilinear { patches, mesh }
         }
         "plymesh" => {
             let file = params
@@ -401,6 +509,46 @@ pub fn make_shape(
                 to_world: *ctx.ctm,
                 height: params.float("height", 0.0)?,
                 radius,
+            }
+        }
+        "curve" => match curve_shape(params, ctx, warn)? {
+            Some(segments) => ShapeGeom::Curves {
+                to_world: *ctx.ctm,
+                segments,
+            },
+            None => return Ok(None),
+        },
+        "cylinder" => {
+            let radius = params.float("radius", 1.0)?;
+            let zmin = params.float("zmin", -1.0)?;
+            let zmax = params.float("zmax", 1.0)?;
+            let phimax = params.float("phimax", 360.0)?;
+            if !(radius.is_finite() && radius > 0.0) {
+                return Err(err_at(
+                    loc,
+                    format!("cylinder: radius must be positive, found {radius}"),
+                ));
+            }
+            if !(zmin.is_finite() && zmax.is_finite() && zmin != zmax) {
+                return Err(err_at(
+                    loc,
+                    format!(
+                        "cylinder: zmin and zmax must be finite and differ, found {zmin}, {zmax}"
+                    ),
+                ));
+            }
+            if !(phimax.is_finite() && phimax > 0.0) {
+                return Err(err_at(
+                    loc,
+                    format!("cylinder: phimax must be positive, found {phimax}"),
+                ));
+            }
+            ShapeGeom::Cylinder {
+                to_world: *ctx.ctm,
+                radius,
+                zmin: zmin.min(zmax),
+                zmax: zmin.max(zmax),
+                phimax: phimax.min(360.0).to_radians(),
             }
         }
         other => {
@@ -509,10 +657,96 @@ fn loop_subdiv_shape(
     finish_mesh(raw, ctx, "loopsubdiv", warn)
 }
 
+/// pbrt-v4's `curve` parameters as cubic Bézier segments: `P` (`basis` `bezier`: 3k + 1
+/// points for degree 3, 2k + 1 for degree 2; `bspline`: k + 3 for degree 3), `type` (`flat`,
+/// `ribbon` with `N` at the k + 1 segment ends, `cylinder`), `width` or `width0`/`width1`
+/// (linear along the whole curve). `splitdepth` only splits pbrt's BVH leaves: ignored.
+fn curve_shape(
+    params: &ParamSet,
+    ctx: &ShapeCtx,
+    warn: &mut Warn,
+) -> anyhow::Result<Option<Vec<CurveSegment>>> {
+    let loc = ctx.loc;
+    let p = params
+        .point3s("P")?
+        .ok_or_else(|| err_at(loc, "curve: expected \"point3 P\", found none"))?;
+    let basis = params.string("basis")?.unwrap_or_else(|| "bezier".into());
+    let degree = params.int("degree", 3)?;
+    let kind = match params.string("type")?.as_deref().unwrap_or("flat") {
+        "flat" => CurveType::Flat,
+        "ribbon" => CurveType::Ribbon,
+        "cylinder" => CurveType::Cylinder,
+        other => {
+            return Err(err_at(
+                loc,
+                format!("curve: unknown type \"{other}\" (expected flat, ribbon or cylinder)"),
+            ));
+        }
+    };
+    let w = params.float("width", 1.0)?;
+    let (w0, w1) = (params.float("width0", w)?, params.float("width1", w)?);
+    let _ = params.int("splitdepth", 3)?;
+    let cubic: Vec<[Vec3; 4]> = match (basis.as_str(), degree) {
+        ("bezier", 3) if p.len() >= 4 && (p.len() - 1) % 3 == 0 => (0..(p.len() - 1) / 3)
+            .map(|k| [p[3 * k], p[3 * k + 1], p[3 * k + 2], p[3 * k + 3]])
+            .collect(),
+        ("bezier", 2) if p.len() >= 3 && (p.len() - 1) % 2 == 0 => (0..(p.len() - 1) / 2)
+            .map(|k| {
+                let (a, b, c) = (p[2 * k], p[2 * k + 1], p[2 * k + 2]);
+                [a, a + (b - a) * (2.0 / 3.0), c + (b - c) * (2.0 / 3.0), c]
+            })
+            .collect(),
+        ("bspline", 3) if p.len() >= 4 => (0..p.len() - 3)
+            .map(|k| bspline_to_bezier([p[k], p[k + 1], p[k + 2], p[k + 3]]))
+            .collect(),
+        (b, d) => {
+            warn(
+                "curve-basis",
+                loc,
+                format!(
+                    "curve: basis \"{b}\" of degree {d} with {} points is not supported; skipped",
+                    p.len()
+                ),
+            );
+            return Ok(None);
+        }
+    };
+    let nseg = cubic.len();
+    let normals = params.normals("N")?;
+    if kind == CurveType::Ribbon && normals.as_ref().is_none_or(|n| n.len() != nseg + 1) {
+        return Err(err_at(
+            loc,
+            format!(
+                "curve: a ribbon needs {} normals \"N\" (one per segment end), found {}",
+                nseg + 1,
+                normals.as_ref().map_or(0, |n| n.len())
+            ),
+        ));
+    }
+    Ok(Some(
+        cubic
+            .into_iter()
+            .enumerate()
+            .map(|(k, cp)| {
+                let f = |i: usize| i as f32 / nseg as f32;
+                let n = normals.as_ref().map_or([Vec3::Z; 2], |n| {
+                    [n[k].normalize_or_zero(), n[k + 1].normalize_or_zero()]
+                });
+                CurveSegment {
+                    cp,
+                    width: [w0 + (w1 - w0) * f(k), w0 + (w1 - w0) * f(k + 1)],
+                    n,
+                    kind,
+                }
+            })
+            .collect(),
+    ))
+}
+
 /// The shape's `"float alpha"` / `"texture alpha"` cut-out (pbrt-v4: none when the coverage is
-/// 1). Coverage is clamped to [0, 1]; a varying float texture, which penumbra's float textures
-/// cannot yet give the geometry, is warned about by the texture table and read as opaque.
-/// Spheres and disks keep no cut-out (warned).
+/// 1). Coverage is clamped to [0, 1] by the alpha test; a varying float texture (image,
+/// checkerboard, scale, mapped) is evaluated at each candidate hit's uv. Spheres and disks keep
+/// no cut-out (warned).
 pub fn shape_alpha(
     kind: &str,
     params: &ParamSet,
@@ -523,17 +757,19 @@ pub fn shape_alpha(
     if !params.has("alpha") {
         return Ok(None);
     }
-    let a = textures.float_param(params, "alpha", 1.0, warn)?;
-    if !a.is_finite() {
-        return Err(err_at(
-            params.loc_of("alpha").as_ref().unwrap_or(loc),
-            format!("'alpha' must be a finite number, found {a}"),
-        ));
+    let t = textures.float_texture_param(params, "alpha", 1.0, warn)?;
+    if let Some(a) = t.constant() {
+        if !a.is_finite() {
+            return Err(err_at(
+                params.loc_of("alpha").as_ref().unwrap_or(loc),
+                format!("'alpha' must be a finite number, found {a}"),
+            ));
+        }
+        if a >= 1.0 {
+            return Ok(None);
+        }
     }
-    if a >= 1.0 {
-        return Ok(None);
-    }
-    if matches!(kind, "sphere" | "disk") {
+    if matches!(kind, "sphere" | "disk" | "cylinder" | "curve") {
         warn(
             "shape-alpha-quadric",
             loc,
@@ -541,5 +777,16 @@ pub fn shape_alpha(
         );
         return Ok(None);
     }
-    Ok(Some(Alpha::Constant(a.max(0.0))))
+    Ok(Some(match t.constant() {
+        Some(a) => Alpha::Constant(a.max(0.0)),
+        None => {
+            let tex = super::materials::float_texture(&t, &textures.images).map_err(|e| {
+                err_at(
+                    params.loc_of("alpha").as_ref().unwrap_or(loc),
+                    format!("{e:#}"),
+                )
+            })?;
+            Alpha::Texture(std::sync::Arc::new(tex))
+        }
+    }))
 }

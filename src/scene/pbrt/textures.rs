@@ -5,7 +5,7 @@ use super::params::{ParamSet, ParamType};
 use super::spectra::{SpectrumUse, to_rgb};
 use super::tokenizer::{Loc, err_at};
 use crate::Rgb;
-use crate::material::texture::{ImageRgb, UvMap};
+use crate::material::texture::{ImageRgb, MipFilter, UvMap, Wrap};
 use glam::Vec2;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -90,6 +90,15 @@ impl Encoding {
     }
 }
 
+/// How an image texture is read (pbrt-v4's `wrap` and `filter`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Sampling {
+    /// `"string wrap"`.
+    pub wrap: Wrap,
+    /// `"string filter"` (`ewa` read as trilinear, warned).
+    pub filter: MipFilter,
+}
+
 /// A float texture as the scene describes it.
 #[derive(Clone, Debug, PartialEq)]
 pub enum FloatTexDesc {
@@ -105,11 +114,22 @@ pub enum FloatTexDesc {
         invert: bool,
         /// pbrt's `encoding`.
         encoding: Encoding,
+        /// pbrt's `wrap` and `filter`.
+        sampling: Sampling,
     },
     /// Product (pbrt's float `scale` texture with a varying factor).
     Product(Box<FloatTexDesc>, Box<FloatTexDesc>),
     /// Looked up through a uv mapping.
     Mapped(UvMap, Box<FloatTexDesc>),
+    /// pbrt-v4's float 2D checkerboard: `a` where ⌊u·fu⌋ + ⌊v·fv⌋ is even.
+    Checkerboard {
+        /// tex1
+        a: f32,
+        /// tex2
+        b: f32,
+        /// (uscale, vscale)
+        freq: Vec2,
+    },
 }
 
 impl FloatTexDesc {
@@ -120,6 +140,7 @@ impl FloatTexDesc {
             Self::Product(a, b) => Some(a.constant()? * b.constant()?),
             Self::Image { .. } => None,
             Self::Mapped(_, t) => t.constant(),
+            Self::Checkerboard { a, b, .. } => (a == b).then_some(*a),
         }
     }
 
@@ -147,6 +168,8 @@ pub enum TextureDesc {
         invert: bool,
         /// pbrt's `encoding`.
         encoding: Encoding,
+        /// pbrt's `wrap` and `filter`.
+        sampling: Sampling,
     },
     /// The product of two textures.
     Product(Box<TextureDesc>, Box<TextureDesc>),
@@ -175,11 +198,13 @@ impl TextureDesc {
                 scale,
                 invert: false,
                 encoding,
+                sampling,
             } => Self::Image {
                 path,
                 scale: scale * s,
                 invert: false,
                 encoding,
+                sampling,
             },
             t if s == Rgb::ONE => t,
             t @ (Self::Image { .. } | Self::Float(_)) => {
@@ -308,7 +333,7 @@ impl TextureTable {
         dir: &Path,
         loc: &Loc,
         warn: &mut Warn,
-    ) -> anyhow::Result<(PathBuf, Encoding)> {
+    ) -> anyhow::Result<(PathBuf, Encoding, Sampling)> {
         let file = params.string("filename")?.ok_or_else(|| {
             err_at(
                 loc,
@@ -324,27 +349,46 @@ impl TextureTable {
         }
         let floc = params.loc_of("filename").unwrap_or(loc.clone());
         load_image(&mut self.images, &path, &floc)?;
-        if let Some(w) = params.string("wrap")?
-            && w != "repeat"
-        {
-            warn(
-                "texture-wrap",
-                params.loc_of("wrap").as_ref().unwrap_or(loc),
-                format!("image texture wrap mode \"{w}\" approximated by \"repeat\""),
-            );
+        let mut sampling = Sampling::default();
+        if let Some(w) = params.string("wrap")? {
+            sampling.wrap = Wrap::parse(&w).ok_or_else(|| {
+                err_at(
+                    params.loc_of("wrap").as_ref().unwrap_or(loc),
+                    format!(
+                        "unknown wrap mode \"{w}\" (expected \"repeat\", \"black\", \"clamp\" or \"octahedralsphere\")"
+                    ),
+                )
+            })?;
         }
-        if let Some(f) = params.string("filter")?
-            && f != "bilinear"
-        {
-            warn(
-                "texture-filter",
-                params.loc_of("filter").as_ref().unwrap_or(loc),
-                format!(
-                    "image texture filter \"{f}\" approximated by \"bilinear\" (no MIP-mapping)"
-                ),
-            );
+        if let Some(f) = params.string("filter")? {
+            let floc = params.loc_of("filter").unwrap_or(loc.clone());
+            sampling.filter = match f.as_str() {
+                "point" => MipFilter::Point,
+                "bilinear" => MipFilter::Bilinear,
+                "trilinear" => MipFilter::Trilinear,
+                "ewa" | "EWA" => {
+                    warn(
+                        "texture-filter-ewa",
+                        &floc,
+                        "image texture filter \"ewa\" approximated by \"trilinear\" (isotropic footprint)".into(),
+                    );
+                    MipFilter::Trilinear
+                }
+                other => {
+                    return Err(err_at(
+                        &floc,
+                        format!(
+                            "unknown texture filter \"{other}\" (expected \"point\", \"bilinear\", \"trilinear\" or \"ewa\")"
+                        ),
+                    ));
+                }
+            };
         }
-        Ok((path, Encoding::parse(params, &resolve(dir, &file), loc)?))
+        Ok((
+            path,
+            Encoding::parse(params, &resolve(dir, &file), loc)?,
+            sampling,
+        ))
     }
 
     /// Parse a `Texture "name" "spectrum"|"float" "class" params` directive and store it.
@@ -411,12 +455,43 @@ impl TextureTable {
                         Some(t.times(s))
                     }
                     "imagemap" => {
-                        let (path, encoding) = self.image_file(params, dir, loc, warn)?;
+                        let (path, encoding, sampling) = self.image_file(params, dir, loc, warn)?;
                         Some(FloatTexDesc::Image {
                             path,
                             scale: params.float("scale", 1.0)?,
                             invert: params.bool("invert", false)?,
                             encoding,
+                            sampling,
+                        })
+                    }
+                    "checkerboard" => {
+                        if params.int("dimension", 2)? != 2 {
+                            warn(
+                                "checkerboard-3d",
+                                loc,
+                                "3D checkerboard approximated by 2D".into(),
+                            );
+                        }
+                        let konst = |n: &str, d: f32, warn: &mut Warn| -> anyhow::Result<f32> {
+                            let t = self.float_texture_param(params, n, d, warn)?;
+                            Ok(t.constant().unwrap_or_else(|| {
+                                warn(
+                                    "nested-texture",
+                                    loc,
+                                    format!(
+                                        "non-constant texture for '{n}' is not supported; using {d}"
+                                    ),
+                                );
+                                d
+                            }))
+                        };
+                        Some(FloatTexDesc::Checkerboard {
+                            a: konst("tex1", 1.0, warn)?,
+                            b: konst("tex2", 0.0, warn)?,
+                            freq: Vec2::new(
+                                params.float("uscale", 1.0)?,
+                                params.float("vscale", 1.0)?,
+                            ),
                         })
                     }
                     _ => {
@@ -480,13 +555,14 @@ impl TextureTable {
                 TextureDesc::Constant(self.const_spectrum(params, "value", Rgb::ONE, loc, warn)?)
             }
             "imagemap" => {
-                let (path, encoding) = self.image_file(params, dir, loc, warn)?;
+                let (path, encoding, sampling) = self.image_file(params, dir, loc, warn)?;
                 let scale = params.float("scale", 1.0)?;
                 TextureDesc::Image {
                     path,
                     scale: Rgb::splat(scale),
                     invert: params.bool("invert", false)?,
                     encoding,
+                    sampling,
                 }
             }
             "scale" => {
