@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # A fuzz campaign on one target (pbrt, obj, gltf, ply, image) with cargo-fuzz on nightly:
 #   scripts/fuzz.sh TARGET [SECONDS]        (default 3600 s; one job, one core)
+#   scripts/fuzz.sh all [SECONDS]           (each of the five in turn, SECONDS each)
+# On a shared machine run it as `nice -n 19 scripts/fuzz.sh ...`.
 # The corpus grows in fuzz/corpus/TARGET/ (local, not committed: it derives from the
 # third-party scenes), seeded from fuzz/seeds/TARGET/, fuzz/regressions/TARGET/ and
 # ../shared/scenes/. Crashes, timeouts and OOMs land in fuzz/artifacts/TARGET/; minimise one
@@ -8,9 +10,15 @@
 # tests/fuzz_replay.rs replays them all on stable. The last line libFuzzer prints, "Done N runs
 # in S second(s)", is the execution count to report.
 set -euo pipefail
-target=${1:?usage: scripts/fuzz.sh pbrt|obj|gltf|ply|image [SECONDS]}
+target=${1:?usage: scripts/fuzz.sh pbrt|obj|gltf|ply|image|all [SECONDS]}
 secs=${2:-3600}
 root=$(cd "$(dirname "$0")/.." && pwd)
+if [ "$target" = all ]; then
+  for t in pbrt obj gltf ply image; do
+    "$0" "$t" "$secs"
+  done
+  exit 0
+fi
 shared="$root/../shared/scenes"
 corpus="$root/fuzz/corpus/$target"
 mkdir -p "$corpus"

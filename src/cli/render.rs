@@ -589,8 +589,8 @@ fn prepare_output(out: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Test hook: `PENUMBRA_TEST_WRITE_PAUSE_MS` pauses the image write after every 1 MiB so the
-/// tests can interrupt a write in progress.
+/// Test hook: `PENUMBRA_TEST_WRITE_PAUSE_MS` pauses the image write after every 1 MiB (a
+/// signal ends the pause) so the tests can interrupt a write in progress.
 fn test_write_pause() -> Duration {
     std::env::var("PENUMBRA_TEST_WRITE_PAUSE_MS")
         .ok()

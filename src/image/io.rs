@@ -8,7 +8,7 @@
 use std::io::{Cursor, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
 
@@ -199,7 +199,8 @@ pub struct WriteControl<'a> {
     /// Once set (by a signal handler, say), the write stops at the next chunk: the temp file is
     /// removed, the destination left as it was, and [`WriteCancelled`] returned.
     pub cancel: Option<&'a AtomicBool>,
-    /// Pause after each chunk: a test hook that makes a write last long enough to interrupt.
+    /// Pause after each chunk, ended early by `cancel`: a test hook that holds a write open
+    /// until it is interrupted.
     pub chunk_pause: Duration,
 }
 
@@ -238,8 +239,10 @@ pub fn write_bytes_atomic_with(
                 bail!(WriteCancelled { path: path.into() });
             }
             f.write_all(chunk)?;
-            if !ctl.chunk_pause.is_zero() {
-                std::thread::sleep(ctl.chunk_pause);
+            // The pause ends early on a cancel, so a test can park a write and interrupt it.
+            let pause_end = Instant::now() + ctl.chunk_pause;
+            while !cancelled() && Instant::now() < pause_end {
+                std::thread::sleep(Duration::from_millis(1).min(ctl.chunk_pause));
             }
         }
         f.sync_all()?;

@@ -221,12 +221,14 @@ const GL_W: [f64; 4] = [
 /// error then falls far below the Poisson noise of a 1M-sample histogram.
 const MAX_SPLITS: u32 = 20;
 
-/// Quadrature of one rectangle: the integral, and whether the pdf vanishes at some of the
-/// probed points but not at others (the rectangle straddles the edge of the support).
+/// Quadrature of one rectangle: the integral, whether the pdf vanishes at some of the
+/// probed points but not at others (the rectangle straddles the edge of the support), and
+/// the largest probed value times the area (what a straddling estimate can be off by).
 #[derive(Clone, Copy)]
 struct Piece {
     integral: f64,
     straddles: bool,
+    bound: f64,
 }
 
 /// Tensor Gauss–Legendre rule on a rectangle, plus a probe of its corners: a support edge
@@ -235,9 +237,11 @@ fn gauss(f: &impl Fn(f64, f64) -> f64, r: [f64; 4]) -> Piece {
     let (cx, hx) = (0.5 * (r[0] + r[1]), 0.5 * (r[1] - r[0]));
     let (cy, hy) = (0.5 * (r[2] + r[3]), 0.5 * (r[3] - r[2]));
     let (mut zero, mut positive) = (false, false);
+    let mut peak = 0.0f64;
     let mut probe = |v: f64| {
         zero |= v == 0.0;
         positive |= v != 0.0;
+        peak = peak.max(v.abs());
         // A NaN/inf pdf must surface as a failed test, not poison a neighbour silently.
         if v.is_finite() { v } else { f64::NAN }
     };
@@ -255,12 +259,16 @@ fn gauss(f: &impl Fn(f64, f64) -> f64, r: [f64; 4]) -> Piece {
     Piece {
         integral: s * hx * hy,
         straddles: zero && positive,
+        bound: peak * 4.0 * hx * hy,
     }
 }
 
 /// Anisotropic adaptive quadrature: try halving along each axis, keep the halving that
 /// changes the estimate most, and recurse until the change is below `tol` and the piece no
-/// longer straddles the support's edge (or the depth limit is hit). Halving only across a
+/// longer straddles the support's edge by more than `tol` can absorb (or the depth limit is
+/// hit): a straddling piece is off by at most about its peak × area, so once that is below
+/// `tol` the edge is resolved well enough (before this bound a sharp rough-glass lobe took 567M
+/// pdf evaluations instead of 44M, with the same statistic). Halving only across a
 /// discontinuity (e.g. the rim of a cone, a line of constant z) costs O(depth) work, where
 /// isotropic splitting would need O(2^depth).
 fn adaptive(f: &impl Fn(f64, f64) -> f64, r: [f64; 4], whole: Piece, tol: f64, depth: u32) -> f64 {
@@ -281,7 +289,7 @@ fn adaptive(f: &impl Fn(f64, f64) -> f64, r: [f64; 4], whole: Piece, tol: f64, d
         ex > ey
     };
     let (halves, vals) = if along_x { (xs, xv) } else { (ys, yv) };
-    if ex.max(ey) <= tol && !whole.straddles {
+    if ex.max(ey) <= tol && (!whole.straddles || 2.0 * whole.bound <= tol) {
         return vals[0].integral + vals[1].integral;
     }
     adaptive(f, halves[0], vals[0], 0.5 * tol, depth + 1)
