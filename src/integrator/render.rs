@@ -46,7 +46,9 @@ struct TileWork {
 impl TileWork {
     fn new(pattern: &dyn crate::sampling::SamplePattern) -> Self {
         Self {
-            pxs: (0..TILE * TILE).map(|_| pattern.pixel(UVec2::ZERO)).collect(),
+            pxs: (0..TILE * TILE)
+                .map(|_| pattern.pixel(UVec2::ZERO))
+                .collect(),
             cams: Vec::with_capacity(WAVE),
             weights: Vec::with_capacity(WAVE),
             radiance: vec![Rgb::ZERO; WAVE * PACKET],
@@ -125,110 +127,118 @@ pub fn render(
     let rays = AtomicU64::new(0);
     let counts = std::sync::Mutex::new(RayCounts::default());
     let bad = AtomicU64::new(0);
+    let works: Vec<std::sync::Mutex<Option<TileWork>>> = (0..rayon::current_num_threads().max(1))
+        .map(|_| std::sync::Mutex::new(None))
+        .collect();
     let start = Instant::now();
     let tiles: Vec<Vec<Rgb>> = (0..tiles_x * tiles_y)
         .into_par_iter()
-        // Per worker: one PixelSamples per pixel of a tile (filled in place) and the wave's
-        // queues, reused from tile to tile.
-        .map_init(
-            || TileWork::new(pattern.as_ref()),
-            |work, t| {
-                let (tx, ty) = (t % tiles_x, t / tiles_x);
-                let x0 = tx * TILE;
-                let y0 = ty * TILE;
-                let x1 = (x0 + TILE).min(res.x);
-                let y1 = (y0 + TILE).min(res.y);
-                let (w, h) = (x1 - x0, y1 - y0);
-                // Samples in pixel-major order, PACKET at a time into camera packets, up to
-                // WAVE packets at a time into a wave: a pixel's sum adds its samples in index
-                // order, exactly as one loop per pixel would, whatever order the wave's paths
-                // finish in.
-                let mut sums = vec![Rgb::ZERO; (w * h) as usize];
-                let TileWork {
-                    pxs,
-                    cams,
-                    weights,
-                    radiance,
-                    queues,
-                    wave,
-                } = work;
+        // Per worker thread: one PixelSamples per pixel of a tile (filled in place) and the
+        // wave's queues, made once and reused from tile to tile (rayon's `map_init` would make
+        // them again for every split of the range).
+        .map(|t| {
+            let me = rayon::current_thread_index().unwrap_or(0) % works.len();
+            let mut guard = works[me].lock().unwrap_or_else(|e| e.into_inner());
+            let work = guard.get_or_insert_with(|| TileWork::new(pattern.as_ref()));
+            let (tx, ty) = (t % tiles_x, t / tiles_x);
+            let x0 = tx * TILE;
+            let y0 = ty * TILE;
+            let x1 = (x0 + TILE).min(res.x);
+            let y1 = (y0 + TILE).min(res.y);
+            let (w, h) = (x1 - x0, y1 - y0);
+            // Samples in pixel-major order, PACKET at a time into camera packets, up to
+            // WAVE packets at a time into a wave: a pixel's sum adds its samples in index
+            // order, exactly as one loop per pixel would, whatever order the wave's paths
+            // finish in.
+            let mut sums = vec![Rgb::ZERO; (w * h) as usize];
+            let TileWork {
+                pxs,
+                cams,
+                weights,
+                radiance,
+                queues,
+                wave,
+            } = work;
+            cams.clear();
+            weights.clear();
+            let mut cam = CameraPacket::new();
+            let (mut tile_rays, mut tile_bad) = (RayCounts::default(), 0u64);
+            let mut flush = |cams: &mut Vec<CameraPacket>,
+                             weights: &mut Vec<[f32; PACKET]>,
+                             pxs: &[PixelSamples]| {
+                let counts = est.li_wave(pxs, cams, radiance, queues, wave);
+                tile_rays.add(&counts);
+                for (i, (cam, weight)) in cams.iter().zip(weights.iter()).enumerate() {
+                    for k in 0..cam.n {
+                        // Filters with negative lobes weight their samples (mean weight
+                        // 1); box, tent and gaussian samples all weigh exactly 1.
+                        let l = radiance[i * PACKET + k];
+                        let l = if filter.is_analytic() {
+                            l
+                        } else {
+                            l * weight[k]
+                        };
+                        if l.is_finite() {
+                            sums[cam.pixel[k] as usize] += l;
+                        } else {
+                            tile_bad += 1;
+                        }
+                    }
+                }
                 cams.clear();
                 weights.clear();
-                let mut cam = CameraPacket::new();
-                let (mut tile_rays, mut tile_bad) = (RayCounts::default(), 0u64);
-                let mut flush = |cams: &mut Vec<CameraPacket>,
-                                 weights: &mut Vec<[f32; PACKET]>,
-                                 pxs: &[PixelSamples]| {
-                    let counts = est.li_wave(pxs, cams, radiance, queues, wave);
-                    tile_rays.add(&counts);
-                    for (i, (cam, weight)) in cams.iter().zip(weights.iter()).enumerate() {
-                        for k in 0..cam.n {
-                            // Filters with negative lobes weight their samples (mean weight
-                            // 1); box, tent and gaussian samples all weigh exactly 1.
-                            let l = radiance[i * PACKET + k];
-                            let l = if filter.is_analytic() { l } else { l * weight[k] };
-                            if l.is_finite() {
-                                sums[cam.pixel[k] as usize] += l;
-                            } else {
-                                tile_bad += 1;
-                            }
-                        }
+            };
+            // Per lane: the pixel and filter draw; the camera rays of a full packet are then
+            // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
+            let mut lanes = CameraLanes::new();
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    if opts.is_cancelled() {
+                        break;
                     }
-                    cams.clear();
-                    weights.clear();
-                };
-                // Per lane: the pixel and filter draw; the camera rays of a full packet are then
-                // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
-                let mut lanes = CameraLanes::new();
-                for y in y0..y1 {
-                    for x in x0..x1 {
-                        if opts.is_cancelled() {
-                            break;
+                    let pixel = UVec2::new(x, y);
+                    // The pixel's slot is its index in the tile (and in `sums`).
+                    let slot = ((y - y0) * w + (x - x0)) as usize;
+                    pattern.pixel_into(pixel, &mut pxs[slot]);
+                    for i in samples.clone() {
+                        let k = cam.n;
+                        lanes.pixel[k] = pixel;
+                        lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
+                        if camera.needs_lens_sample() {
+                            lanes.lens[k] = pxs[slot].sample_2d(DIM_LENS, i, opts.spp);
                         }
-                        let pixel = UVec2::new(x, y);
-                        // The pixel's slot is its index in the tile (and in `sums`).
-                        let slot = ((y - y0) * w + (x - x0)) as usize;
-                        pattern.pixel_into(pixel, &mut pxs[slot]);
-                        for i in samples.clone() {
-                            let k = cam.n;
-                            lanes.pixel[k] = pixel;
-                            lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
-                            if camera.needs_lens_sample() {
-                                lanes.lens[k] = pxs[slot].sample_2d(DIM_LENS, i, opts.spp);
-                            }
-                            cam.pixel[k] = slot as u8;
-                            cam.eye[k] = i;
-                            cam.n = k + 1;
-                            if cam.is_full() {
-                                lanes.rays(isa, &camera, &filter, &mut cam.rays);
-                                cams.push(cam);
-                                weights.push(lanes.weight);
-                                cam.clear();
-                                if cams.len() == WAVE {
-                                    flush(cams, weights, pxs);
-                                }
+                        cam.pixel[k] = slot as u8;
+                        cam.eye[k] = i;
+                        cam.n = k + 1;
+                        if cam.is_full() {
+                            lanes.rays(isa, &camera, &filter, &mut cam.rays);
+                            cams.push(cam);
+                            weights.push(lanes.weight);
+                            cam.clear();
+                            if cams.len() == WAVE {
+                                flush(cams, weights, pxs);
                             }
                         }
                     }
                 }
-                if cam.n > 0 {
-                    lanes.rays(isa, &camera, &filter, &mut cam.rays);
-                    cams.push(cam);
-                    weights.push(lanes.weight);
-                }
-                if !cams.is_empty() {
-                    flush(cams, weights, pxs);
-                }
-                let out: Vec<Rgb> = sums.iter().map(|&s| s / samples.len() as f32).collect();
-                rays.fetch_add(tile_rays.total(), Ordering::Relaxed);
-                if let Ok(mut c) = counts.lock() {
-                    c.add(&tile_rays);
-                }
-                bad.fetch_add(tile_bad, Ordering::Relaxed);
-                bar.inc(1);
-                out
-            },
-        )
+            }
+            if cam.n > 0 {
+                lanes.rays(isa, &camera, &filter, &mut cam.rays);
+                cams.push(cam);
+                weights.push(lanes.weight);
+            }
+            if !cams.is_empty() {
+                flush(cams, weights, pxs);
+            }
+            let out: Vec<Rgb> = sums.iter().map(|&s| s / samples.len() as f32).collect();
+            rays.fetch_add(tile_rays.total(), Ordering::Relaxed);
+            if let Ok(mut c) = counts.lock() {
+                c.add(&tile_rays);
+            }
+            bad.fetch_add(tile_bad, Ordering::Relaxed);
+            bar.inc(1);
+            out
+        })
         .collect();
     bar.finish_and_clear();
     if opts.is_cancelled() {

@@ -12,6 +12,11 @@
 //!                   └──── continuing BSDF rays (while depth < max depth) ◀──┘
 //! ```
 //!
+//! The driver ([`Integrator::li_wave`]) takes a wave of camera packets one depth at a time:
+//! the paths that continue past a vertex wait as [`PathRecord`]s and are packed 16 to a packet
+//! again at the next depth (compaction), so a packet keeps its lanes full after the first
+//! bounces; a path's radiance goes to its wave slot when it ends.
+//!
 //! Direct lighting is the path with max depth 1: its BSDF rays are the last of the path, so
 //! `gather_emitters` finds what they reach with a query of the emitters alone (most BSDF rays
 //! reach no light: no closest-hit query of the whole scene for them) and tests the visibility
@@ -242,19 +247,6 @@ impl RayCounts {
         self.timed.shadow.add(&other.timed.shadow);
         self.timed.secondary.add(&other.timed.secondary);
     }
-}
-
-/// Experiment only (not to be committed): PENUMBRA_RR_FROM moves the roulette start.
-fn rr_depth(depth: u32) -> u32 {
-    use super::estimator::ROULETTE_FROM;
-    static S: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
-    let from = *S.get_or_init(|| {
-        std::env::var("PENUMBRA_RR_FROM")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(ROULETTE_FROM)
-    });
-    if depth >= from { ROULETTE_FROM } else { 0 }
 }
 
 /// After a vertex of the packet whose lanes `live` entered it: the paths that ended give
@@ -762,7 +754,7 @@ impl<'a> Integrator<'a> {
             let beta = q.paths.beta.get(k) * b.weight;
             let survive = if self.roulette {
                 let px = &pxs[q.paths.pixel[k] as usize];
-                roulette(rr_depth(depth), beta, || {
+                roulette(depth, beta, || {
                     let (index, count) = sample_index(depth, q.paths.sample[k], 0, n, mm);
                     px.sample_1d(dim, index, count)
                 })
