@@ -39,7 +39,8 @@ for mode in ${MODES:-mis emitter bsdf path}; do
   # triangles, so it draws what Mitsuba's power-weighted emitter choice draws, without the
   # default light BVH's per-sample cost (docs/many-lights.md).
   # shellcheck disable=SC2086
-  $BIN render cornell --spp 64 --seed 1 --quiet --light-selection uniform $ours \
+  /usr/bin/time -f "penumbra TIME %e s wall, %U s user, %S s sys (load $(cut -d' ' -f1-3 /proc/loadavg))" \
+    $BIN render cornell --spp 64 --seed 1 --quiet --light-selection uniform $ours \
     -o "$OUT/penumbra-$mode.exr"
   echo "mitsuba $mode vs reference:";  $BIN compare "$OUT/mitsuba-$mode.exr" "$REF" | grep relMSE
   echo "penumbra $mode vs reference:"; $BIN compare "$OUT/penumbra-$mode.exr" "$REF" | grep relMSE
