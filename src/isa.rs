@@ -4,8 +4,8 @@
 //! the detected set (one per set, with the set's one feature string), handing it the set's
 //! [`Token`], and vector code takes that token as its proof that the intrinsics it calls exist
 //! on this CPU. So one binary runs on any x86-64 (and elsewhere, on the portable code), and
-//! every version computes the same bits. (The integrator's lane kernels still have their own
-//! trampolines: that module is being rewritten.)
+//! every version computes the same bits. Every vector entry point of the crate (packet queries,
+//! pattern fills, the integrator's lane kernels and camera rays) goes through it.
 
 /// A vector instruction set, narrowest first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]

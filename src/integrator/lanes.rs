@@ -22,7 +22,7 @@ use super::queues::{BsdfRays, Lanes, Receivers, ShadowRays, V3, col};
 use crate::Rgb;
 use crate::bsdf::{Bxdf, Lambert};
 use crate::geometry::{PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
-use crate::isa::Isa;
+use crate::isa::{Cpu, Kernel, Token};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
 use crate::sampling::Frame;
 use glam::{Vec2, Vec3};
@@ -30,32 +30,16 @@ use glam::{Vec2, Vec3};
 impl Receivers {
     /// Every lane's [`ShadingGeometry`] seen along `rays` (lanes without a hit too: theirs
     /// are ignored), on `isa`.
-    pub(super) fn shade(&mut self, rays: &RayPacket, isa: Isa) {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => {
-                // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.shade_avx512(rays) }
+    pub(super) fn shade(&mut self, rays: &RayPacket, cpu: Cpu) {
+        struct Shade<'a>(&'a mut Receivers, &'a RayPacket);
+        impl Kernel for Shade<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<T: Token>(self, _: T) {
+                self.0.shade_body(self.1)
             }
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => {
-                // SAFETY: as above.
-                unsafe { self.shade_avx2(rays) }
-            }
-            _ => self.shade_body(rays),
         }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn shade_avx512(&mut self, rays: &RayPacket) {
-        self.shade_body(rays)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn shade_avx2(&mut self, rays: &RayPacket) {
-        self.shade_body(rays)
+        cpu.dispatch(Shade(self, rays))
     }
 
     #[inline(always)]
@@ -174,51 +158,36 @@ impl TriangleLightLanes {
         u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
-        isa: Isa,
+        cpu: Cpu,
         out: &mut ShadowRays,
     ) -> u32 {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => {
-                // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx, u, mis, mode, out) }
-            }
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => {
-                // SAFETY: as above.
-                unsafe { self.run_avx2(rx, u, mis, mode, out) }
-            }
-            _ => self.dispatch(rx, u, mis, mode, out),
+        struct Run<'a> {
+            lanes: &'a mut TriangleLightLanes,
+            rx: &'a Receivers,
+            u: &'a [Lanes; 2],
+            mis: Option<MisHeuristic>,
+            mode: SamplingMode,
+            out: &'a mut ShadowRays,
         }
+        impl Kernel for Run<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<T: Token>(self, _: T) {
+                self.lanes
+                    .dispatch(self.rx, self.u, self.mis, self.mode, self.out)
+            }
+        }
+        cpu.dispatch(Run {
+            lanes: self,
+            rx,
+            u,
+            mis,
+            mode,
+            out: &mut *out,
+        });
         let ok = mask_of(&self.ok) & self.active;
         out.active |= ok;
         ok.count_ones()
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn run_avx512(
-        &mut self,
-        rx: &Receivers,
-        u: &[Lanes; 2],
-        mis: Option<MisHeuristic>,
-        mode: SamplingMode,
-        out: &mut ShadowRays,
-    ) {
-        self.dispatch(rx, u, mis, mode, out)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(
-        &mut self,
-        rx: &Receivers,
-        u: &[Lanes; 2],
-        mis: Option<MisHeuristic>,
-        mode: SamplingMode,
-        out: &mut ShadowRays,
-    ) {
-        self.dispatch(rx, u, mis, mode, out)
     }
 
     /// One copy of the lane loop per (`mis`, `mode`), each with both constant, so each loop
@@ -320,37 +289,26 @@ impl DiffuseBsdfLanes {
         &mut self,
         rx: &Receivers,
         u: &[Lanes; 2],
-        isa: Isa,
+        cpu: Cpu,
         out: &mut BsdfRays,
     ) -> u32 {
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 => {
-                // SAFETY: `isa` is a set this CPU runs (`Geometry::isa`, detected at build).
-                unsafe { self.run_avx512(rx, u, out) }
+        struct Run<'a>(
+            &'a mut DiffuseBsdfLanes,
+            &'a Receivers,
+            &'a [Lanes; 2],
+            &'a mut BsdfRays,
+        );
+        impl Kernel for Run<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<T: Token>(self, _: T) {
+                self.0.body(self.1, self.2, self.3)
             }
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => {
-                // SAFETY: as above.
-                unsafe { self.run_avx2(rx, u, out) }
-            }
-            _ => self.body(rx, u, out),
         }
+        cpu.dispatch(Run(self, rx, u, &mut *out));
         let ok = mask_of(&self.ok) & self.active;
         out.active |= ok;
         ok.count_ones()
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn run_avx512(&mut self, rx: &Receivers, u: &[Lanes; 2], out: &mut BsdfRays) {
-        self.body(rx, u, out)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&mut self, rx: &Receivers, u: &[Lanes; 2], out: &mut BsdfRays) {
-        self.body(rx, u, out)
     }
 
     /// The lane loop.
@@ -386,6 +344,7 @@ fn mask_of(b: &[bool; PACKET]) -> u32 {
 mod tests {
     use super::*;
     use crate::bsdf::LobeSampling;
+    use crate::isa::Isa;
     use crate::sampling::hash::{next_f32, pcg_from_keys};
     use rand_pcg::Pcg32;
 
@@ -400,7 +359,7 @@ mod tests {
 
     /// A packet of random receivers (points, normals slightly off the geometric ones, rays from
     /// either side, albedos) with their shading computed on `isa`.
-    fn receivers(rng: &mut Pcg32, isa: Isa) -> (Receivers, RayPacket) {
+    fn receivers(rng: &mut Pcg32, isa: Cpu) -> (Receivers, RayPacket) {
         let mut rx = Receivers::new();
         let mut rays = RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]);
         for k in 0..PACKET {
@@ -484,7 +443,7 @@ mod tests {
         for isa in Isa::available() {
             for round in 0..24u64 {
                 let mut rng = pcg_from_keys(&[7, round]);
-                let (rx, rays) = receivers(&mut rng, isa);
+                let (rx, rays) = receivers(&mut rng, isa.cpu());
                 let mut lanes = TriangleLightLanes::new();
                 let mut tris = Vec::new();
                 for k in 0..PACKET {
@@ -501,7 +460,7 @@ mod tests {
                 let mis = [None, Some(MisHeuristic::Power), Some(MisHeuristic::Balance)]
                     [round as usize % 3];
                 let mut out = ShadowRays::new();
-                let n = lanes.run(&rx, &draws, mis, mode, isa, &mut out);
+                let n = lanes.run(&rx, &draws, mis, mode, isa.cpu(), &mut out);
                 assert_eq!(n, out.active.count_ones());
                 for (k, (tri, pmf, u)) in tris.iter().enumerate() {
                     let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
@@ -531,7 +490,7 @@ mod tests {
         for isa in Isa::available() {
             for round in 0..16u64 {
                 let mut rng = pcg_from_keys(&[8, round]);
-                let (rx, rays) = receivers(&mut rng, isa);
+                let (rx, rays) = receivers(&mut rng, isa.cpu());
                 let mut lanes = DiffuseBsdfLanes::new();
                 let u: Vec<Vec2> = (0..PACKET)
                     .map(|_| Vec2::new(next_f32(&mut rng), next_f32(&mut rng)))
@@ -539,7 +498,7 @@ mod tests {
                 lanes.active = u32::MAX >> (32 - PACKET);
                 let draws = [0, 1].map(|a| std::array::from_fn(|k| u[k][a]));
                 let mut out = BsdfRays::new();
-                lanes.run(&rx, &draws, isa, &mut out);
+                lanes.run(&rx, &draws, isa.cpu(), &mut out);
                 for (k, &u) in u.iter().enumerate() {
                     let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
                     let want = lambert

@@ -11,7 +11,7 @@ use crate::Rgb;
 use crate::camera::CameraRays;
 use crate::geometry::{PACKET, Ray, RayPacket};
 use crate::image::Image;
-use crate::isa::Isa;
+use crate::isa::{Cpu, Kernel, Token};
 use crate::light_selection::make_selector;
 use crate::sampling::{PixelSamples, make_pattern};
 use crate::scene::Filter;
@@ -109,7 +109,7 @@ pub fn render(
     };
     let camera = scene.camera.rays(res);
     let filter = FilterSampler::new(&scene.film.filter)?;
-    let isa = Isa::detect();
+    let cpu = scene.geometry.cpu();
     let tiles_x = res.x.div_ceil(TILE);
     let tiles_y = res.y.div_ceil(TILE);
     let n_tiles = (tiles_x * tiles_y) as u64;
@@ -211,7 +211,7 @@ pub fn render(
                         cam.eye[k] = i;
                         cam.n = k + 1;
                         if cam.is_full() {
-                            lanes.rays(isa, &camera, &filter, &mut cam.rays);
+                            lanes.rays(cpu, &camera, &filter, &mut cam.rays);
                             cams.push(cam);
                             weights.push(lanes.weight);
                             cam.clear();
@@ -223,7 +223,7 @@ pub fn render(
                 }
             }
             if cam.n > 0 {
-                lanes.rays(isa, &camera, &filter, &mut cam.rays);
+                lanes.rays(cpu, &camera, &filter, &mut cam.rays);
                 cams.push(cam);
                 weights.push(lanes.weight);
             }
@@ -298,20 +298,24 @@ impl CameraLanes {
     /// [`CameraRays::direction`] per lane exactly as the scalar [`CameraRays::generate`], on
     /// `isa`'s widest vectors; other cameras and tabulated filters take one scalar loop.
     #[inline]
-    fn rays(&mut self, isa: Isa, camera: &CameraRays, filter: &FilterSampler, ray: &mut RayPacket) {
+    fn rays(&mut self, cpu: Cpu, camera: &CameraRays, filter: &FilterSampler, ray: &mut RayPacket) {
         if !(camera.is_pinhole() && filter.is_analytic()) {
             return self.rays_general(camera, filter, ray);
         }
-        let filter = filter.filter();
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `isa` comes from `Isa::detect`: this CPU runs AVX-512 F.
-            Isa::Avx512 => unsafe { self.rays_avx512(camera, filter, ray) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as above, this CPU runs AVX2.
-            Isa::Avx2 => unsafe { self.rays_avx2(camera, filter, ray) },
-            _ => self.rays_portable(camera, filter, ray),
+        struct Rays<'a>(
+            &'a CameraLanes,
+            &'a CameraRays,
+            &'a Filter,
+            &'a mut RayPacket,
+        );
+        impl Kernel for Rays<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<T: Token>(self, _: T) {
+                self.0.rays_portable(self.1, self.2, self.3)
+            }
         }
+        cpu.dispatch(Rays(self, camera, filter.filter(), ray))
     }
 
     /// Any camera and filter: [`FilterSampler::sample`] then [`CameraRays::generate_lens`].
@@ -332,26 +336,13 @@ impl CameraLanes {
             ray.set(k, &Ray { d, ..o });
         }
     }
-
-    /// [`CameraLanes::rays_portable`] compiled for AVX-512 (16 lanes = one vector).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    fn rays_avx512(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
-        self.rays_portable(camera, filter, ray)
-    }
-
-    /// [`CameraLanes::rays_portable`] compiled for AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn rays_avx2(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
-        self.rays_portable(camera, filter, ray)
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::camera::Camera;
+    use crate::isa::Isa;
     use crate::sampling::PatternKind;
 
     #[test]
@@ -380,7 +371,7 @@ mod tests {
                     }
                     let mut out = RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]);
                     let sampler = FilterSampler::new(&filter).expect("box and tent sample");
-                    lanes.rays(isa, &rays, &sampler, &mut out);
+                    lanes.rays(isa.cpu(), &rays, &sampler, &mut out);
                     for (k, r) in (0..PACKET).map(|k| (k, out.ray(k))) {
                         let want =
                             rays.generate(filter_sample(&filter, lanes.pixel[k], lanes.u[k]));

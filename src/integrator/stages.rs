@@ -564,7 +564,7 @@ impl<'a> Integrator<'a> {
     /// [`Bsdf::lane_kind`] says they evaluate it.
     #[inline(always)]
     fn shade(&self, rays: &RayPacket, q: &mut Queues, t: Techniques, out: &mut [Rgb; PACKET]) {
-        q.rx.shade(rays, self.scene.geometry.isa());
+        q.rx.shade(rays, self.scene.geometry.cpu());
         q.rx.diffuse = 0;
         let mut shaded = 0;
         for k in bits(q.paths.active) {
@@ -624,10 +624,10 @@ impl<'a> Integrator<'a> {
         // The kernel writes every lane of its output, so it goes first and the per-lane path
         // then fills in its own lanes.
         if q.tri_lanes.active != 0 {
-            let isa = scene.geometry.isa();
+            let cpu = scene.geometry.cpu();
             let (mis, mode) = (t.mis(), self.mode());
             let u = &q.drawn.light;
-            rays += u64::from(q.tri_lanes.run(&q.rx, u, mis, mode, isa, &mut q.nee));
+            rays += u64::from(q.tri_lanes.run(&q.rx, u, mis, mode, cpu, &mut q.nee));
         }
         for k in bits(q.lone_light) {
             let Some(sh) = q.view(k) else { continue };
@@ -662,10 +662,10 @@ impl<'a> Integrator<'a> {
         let mut rays = 0;
         // The kernel goes first, as in `sample_lights`.
         if q.bsdf_lanes.active != 0 {
-            let isa = self.scene.geometry.isa();
+            let cpu = self.scene.geometry.cpu();
             rays += u64::from(
                 q.bsdf_lanes
-                    .run(&q.rx, &q.drawn.bsdf, isa, &mut q.bsdf_rays),
+                    .run(&q.rx, &q.drawn.bsdf, cpu, &mut q.bsdf_rays),
             );
         }
         let (n, m, depth) = (self.eye_rays.max(1), self.shadow_rays.max(1), q.paths.depth);

@@ -67,6 +67,11 @@ impl Geometry {
         self.cpu.isa()
     }
 
+    /// [`Self::isa`] as the proof that this CPU runs it (what vector kernels dispatch on).
+    pub fn cpu(&self) -> Cpu {
+        self.cpu
+    }
+
     /// Build the default BVH over `prims` (reordered internally so the BVH's leaf order is the
     /// storage order: one indirection less per intersection test).
     pub fn new(prims: Vec<Primitive>, meshes: Vec<MeshShading>, quadrics: Vec<Quadric>) -> Self {
