@@ -24,6 +24,7 @@ sed -e 's/name="resy" value="1024"/name="resy" value="512"/' \
 # The scene file refers to no external assets, so it renders from the copy.
 for mode in ${MODES:-mis emitter bsdf path}; do
   theirs=""
+  REF=$SHARED/reference/cornell-direct-mis-8192spp.exr
   case $mode in
     mis) ours="--integrator direct --strategy mis --mis-light area" ;;
     emitter) ours="--integrator direct --strategy light-area" ;;

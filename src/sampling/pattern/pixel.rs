@@ -40,9 +40,9 @@ impl Pattern {
             fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
             chunks_1d: Default::default(),
             chunks_2d: Default::default(),
-            deep: std::array::from_fn(|_| {
-                std::array::from_fn(|_| Cell::new((u64::MAX, SetKeys::default())))
-            }),
+            deep: Default::default(),
+            deep_tag: Default::default(),
+            generation: Cell::new(1),
         }
     }
 }
@@ -153,10 +153,15 @@ pub struct PixelSamples {
     pub(super) chunks_1d: [Chunk<f32>; CACHED_DIMS],
     pub(super) chunks_2d: [Chunk<Vec2>; CACHED_DIMS],
     /// The keys of the 1D and 2D sets of dimensions past [`CACHED_DIMS`] (a path's later
-    /// vertices), computed at their first use in this pixel: slot `dim % DEEP` holds
-    /// (dim, keys) of the last such dim (u64::MAX: none). Values are evaluated one at a time
-    /// as [`Pattern::sample_1d`] / [`Pattern::sample_2d`] do, from the same keys and strata.
-    deep: [[Cell<(u64, SetKeys)>; DEEP]; 2],
+    /// vertices), computed at their first use in this pixel: slot `dim % DEEP` holds the
+    /// keys of the last such dim, valid when its tag is (`generation`, dim). Values are
+    /// evaluated one at a time as [`Pattern::sample_1d`] / [`Pattern::sample_2d`] do, from the
+    /// same keys and strata.
+    deep: [[Cell<SetKeys>; DEEP]; 2],
+    /// Per slot of `deep`: (generation, dim) of its keys.
+    deep_tag: [[Cell<(u64, u32)>; DEEP]; 2],
+    /// Bumped by every reset to a new pixel, which so empties `deep` in one store.
+    generation: Cell<u64>,
 }
 
 /// Slots of [`PixelSamples::deep`] per arity.
@@ -177,10 +182,7 @@ impl PixelSamples {
         for c in &self.chunks_2d {
             c.len.set(0);
         }
-        for slot in self.deep.iter().flatten() {
-            let (_, keys) = slot.get();
-            slot.set((u64::MAX, keys));
-        }
+        self.generation.set(self.generation.get() + 1);
     }
 
     /// The pixel these samples belong to.
@@ -344,19 +346,22 @@ impl PixelSamples {
             // A dimension past the cached ones: its keys from the deep slots (what
             // `Pattern::sample_1d` / `sample_2d` derive from the pixel, dim and arity at
             // each call), then the same evaluation with the same strata.
-            let slot = &self.deep[arity][dim as usize % DEEP];
-            let (tag, mut keys) = slot.get();
-            if tag != u64::from(dim) {
-                let tag = if arity == 0 {
+            let i = dim as usize % DEEP;
+            let (slot, tag) = (&self.deep[arity][i], &self.deep_tag[arity][i]);
+            let want = (self.generation.get(), dim);
+            if tag.get() != want {
+                let set_tag = if arity == 0 {
                     super::TAG_1D
                 } else {
                     super::TAG_2D
                 };
-                keys = self
-                    .pattern
-                    .set(self.pattern.pixel_hash(self.pixel), dim, tag);
-                slot.set((u64::from(dim), keys));
+                slot.set(
+                    self.pattern
+                        .set(self.pattern.pixel_hash(self.pixel), dim, set_tag),
+                );
+                tag.set(want);
             }
+            let keys = slot.get();
             return eval(&keys, self.pattern.kind, index, &self.strata(count));
         };
         let set = &set;
