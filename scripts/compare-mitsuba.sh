@@ -24,6 +24,7 @@ sed -e 's/name="resy" value="1024"/name="resy" value="512"/' \
 # The scene file refers to no external assets, so it renders from the copy.
 for mode in ${MODES:-mis emitter bsdf path}; do
   theirs=""
+  REF=$SHARED/reference/cornell-direct-mis-8192spp.exr
   case $mode in
     mis) ours="--integrator direct --strategy mis --mis-light area" ;;
     emitter) ours="--integrator direct --strategy light-area" ;;
@@ -39,7 +40,8 @@ for mode in ${MODES:-mis emitter bsdf path}; do
   # triangles, so it draws what Mitsuba's power-weighted emitter choice draws, without the
   # default light BVH's per-sample cost (docs/many-lights.md).
   # shellcheck disable=SC2086
-  $BIN render cornell --spp 64 --seed 1 --quiet --light-selection uniform $ours \
+  /usr/bin/time -f "penumbra TIME %e s wall, %U s user, %S s sys (load $(cut -d' ' -f1-3 /proc/loadavg))" \
+    $BIN render cornell --spp 64 --seed 1 --quiet --light-selection uniform $ours \
     -o "$OUT/penumbra-$mode.exr"
   echo "mitsuba $mode vs reference:";  $BIN compare "$OUT/mitsuba-$mode.exr" "$REF" | grep relMSE
   echo "penumbra $mode vs reference:"; $BIN compare "$OUT/penumbra-$mode.exr" "$REF" | grep relMSE

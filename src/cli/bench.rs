@@ -112,6 +112,51 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             );
         }
     }
+    path_section(&names, spp, res)
+}
+
+/// Path-traced rows: the default Cornell box's path tracing (MIS, max depth 65, pbrt-v4's
+/// file's) on each scene, with the rays of each kind and the Mrays/s of their queries alone
+/// (the time inside the camera packets' closest-hit queries, the shadow rays' any-hit packet
+/// queries and the continuing BSDF rays' one-ray closest-hit queries), so the cost of
+/// incoherence is visible.
+fn path_section(names: &[String], spp: u32, res: UVec2) -> anyhow::Result<()> {
+    use penumbra::integrator::IntegratorKind;
+    use penumbra::integrator::stages::TIME_QUERIES;
+    use std::sync::atomic::Ordering;
+    println!();
+    println!(
+        "| scene | path, max depth | spp | time (s) | Mrays/s (all) | camera: rays, Mrays/s per thread | shadow: rays, Mrays/s per thread | secondary: rays, Mrays/s per thread | emitter-gather rays |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for name in names {
+        let scene = load(name, &LoadOptions::default())?.scene;
+        let opts = RenderOptions {
+            spp,
+            integrator: IntegratorKind::Path,
+            max_depth: 65,
+            ..RenderOptions::default()
+        };
+        TIME_QUERIES.store(true, Ordering::Relaxed);
+        let r = render(&scene, res, &opts);
+        TIME_QUERIES.store(false, Ordering::Relaxed);
+        let (_, stats) = r?;
+        let k = &stats.by_kind;
+        let m = |n: u64| n as f64 / 1e6;
+        println!(
+            "| {name} | mis, {} | {spp} | {:.3} | {:.1} | {:.2}M, {:.1} | {:.2}M, {:.1} | {:.2}M, {:.1} | {:.2}M |",
+            opts.max_depth,
+            stats.time.as_secs_f64(),
+            stats.mrays_per_s(),
+            m(k.timed.camera.rays),
+            k.timed.camera.mrays_per_s(),
+            m(k.timed.shadow.rays),
+            k.timed.shadow.mrays_per_s(),
+            m(k.timed.secondary.rays),
+            k.timed.secondary.mrays_per_s(),
+            m(k.gather),
+        );
+    }
     Ok(())
 }
 

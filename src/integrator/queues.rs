@@ -136,6 +136,8 @@ pub(super) struct PathLanes {
     pub(super) pixel: [u8; PACKET],
     /// Per lane: eye sample index within the pixel (the pattern's sample index at depth 0).
     pub(super) sample: [u32; PACKET],
+    /// Per lane: the path's index in its wave (where its radiance goes when it ends).
+    pub(super) id: [u32; PACKET],
     /// Throughput β: the product of the BSDF weights f·cos / pdf of the bounces so far
     /// (divided by the Russian-roulette survival probabilities).
     pub(super) beta: V3,
@@ -167,6 +169,7 @@ impl PathLanes {
             depth: 0,
             pixel: [0; PACKET],
             sample: [0; PACKET],
+            id: [0; PACKET],
             beta: V3::splat(Vec3::ONE),
             le_scale: [1.0; PACKET],
             rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
@@ -183,13 +186,14 @@ impl PathLanes {
     }
 
     /// The paths of camera packet `cam`: β = 1, leaving the camera (whose rays count what they
-    /// see with weight 1, as a delta vertex's).
+    /// see with weight 1, as a delta vertex's); lane k is path `first + k` of its wave.
     #[inline]
-    pub(super) fn start(&mut self, cam: &CameraPacket) {
+    pub(super) fn start(&mut self, cam: &CameraPacket, first: u32) {
         self.active = cam.active();
         self.depth = 0;
         self.pixel = cam.pixel;
         self.sample = cam.eye;
+        self.id = std::array::from_fn(|k| first + k as u32);
         self.beta = V3::splat(Vec3::ONE);
         self.le_scale = [1.0; PACKET];
         self.next = 0;
@@ -228,6 +232,50 @@ impl PathLanes {
         }
     }
 
+    /// Load waiting paths `recs` (at most [`PACKET`], all at vertex `depth`) into lanes
+    /// 0..recs.len(), their radiance so far into `out`: each lane then holds exactly the state
+    /// it had when [`Self::record`] saved it (lanes are independent: a path's numbers do not
+    /// depend on the lane or the packet it runs in).
+    #[inline]
+    pub(super) fn load(&mut self, recs: &[PathRecord], depth: u32, out: &mut [Rgb; PACKET]) {
+        debug_assert!(recs.len() <= PACKET);
+        self.active = ((1u64 << recs.len()) - 1) as u32;
+        self.depth = depth;
+        self.next = 0;
+        let mut delta = 0;
+        for (k, r) in recs.iter().enumerate() {
+            self.pixel[k] = r.pixel;
+            self.sample[k] = r.sample;
+            self.id[k] = r.id;
+            self.beta.set(k, r.beta);
+            self.le_scale[k] = r.le_scale;
+            self.rays.set(k, &r.ray);
+            delta |= (r.prev_delta as u32) << k;
+            self.prev_pdf[k] = r.prev_pdf;
+            self.prev_at[k] = r.prev_at;
+            out[k] = r.l;
+        }
+        self.prev_delta = delta;
+    }
+
+    /// Lane k's path as it waits for its next vertex, with radiance `l` so far (valid for
+    /// an active lane after [`Self::advance`]).
+    #[inline]
+    pub(super) fn record(&self, k: usize, l: Rgb) -> PathRecord {
+        PathRecord {
+            ray: self.rays.ray(k),
+            beta: self.beta.get(k),
+            l,
+            prev_at: self.prev_at[k],
+            le_scale: self.le_scale[k],
+            prev_pdf: self.prev_pdf[k],
+            id: self.id[k],
+            sample: self.sample[k],
+            pixel: self.pixel[k],
+            prev_delta: self.prev_delta(k),
+        }
+    }
+
     /// Whether path k's current ray left the camera or a delta lobe.
     #[inline(always)]
     pub(super) fn prev_delta(&self, k: usize) -> bool {
@@ -242,6 +290,33 @@ impl PathLanes {
             at: self.prev_at[k],
         }
     }
+}
+
+/// A path between two vertices, out of its lane: the wave's queue of paths waiting for their
+/// next vertex holds these, and the paths at one depth are packed 16 to a packet again
+/// whatever packets they came from (see `stages.rs`, *compaction*).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PathRecord {
+    /// The ray to trace next.
+    pub(super) ray: Ray,
+    /// Throughput β at the next vertex.
+    pub(super) beta: Rgb,
+    /// Radiance gathered so far.
+    pub(super) l: Rgb,
+    /// The vertex the ray left, as light selection saw it.
+    pub(super) prev_at: ShadingPoint,
+    /// Emission scale of the ray (see [`PathLanes::le_scale`]).
+    pub(super) le_scale: f32,
+    /// Pdf of the BSDF sample that made the ray.
+    pub(super) prev_pdf: f32,
+    /// Index of the path in its wave.
+    pub(super) id: u32,
+    /// Eye sample index within the pixel.
+    pub(super) sample: u32,
+    /// Index of the pixel's samples.
+    pub(super) pixel: u8,
+    /// The ray left a delta lobe.
+    pub(super) prev_delta: bool,
 }
 
 /// The pattern values of a round's light and BSDF samples, per lane (written by the draw

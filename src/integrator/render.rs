@@ -6,7 +6,7 @@ use super::RenderOptions;
 use super::dims::{DIM_FILTER, DIM_LENS};
 use super::film::{FilterSampler, filter_sample};
 use super::queues::CameraPacket;
-use super::stages::{Integrator, Queues};
+use super::stages::{Integrator, Queues, RayCounts, Wave};
 use crate::Rgb;
 use crate::camera::CameraRays;
 use crate::geometry::{PACKET, Ray, RayPacket};
@@ -25,6 +25,39 @@ use std::time::{Duration, Instant};
 
 const TILE: u32 = 16;
 
+/// Camera packets per wave (see [`Integrator::li_wave`]): the paths of this many packets are
+/// compacted together at each depth.
+const WAVE: usize = 64;
+
+/// What a render thread reuses from tile to tile.
+struct TileWork {
+    /// One per pixel of a tile (a pixel's slot is its index in the tile).
+    pxs: Vec<PixelSamples>,
+    /// The wave's camera packets.
+    cams: Vec<CameraPacket>,
+    /// Per camera packet: its lanes' filter weights.
+    weights: Vec<[f32; PACKET]>,
+    /// Per path of the wave: its radiance.
+    radiance: Vec<Rgb>,
+    queues: Queues,
+    wave: Wave,
+}
+
+impl TileWork {
+    fn new(pattern: &dyn crate::sampling::SamplePattern) -> Self {
+        Self {
+            pxs: (0..TILE * TILE)
+                .map(|_| pattern.pixel(UVec2::ZERO))
+                .collect(),
+            cams: Vec::with_capacity(WAVE),
+            weights: Vec::with_capacity(WAVE),
+            radiance: vec![Rgb::ZERO; WAVE * PACKET],
+            queues: Queues::new(),
+            wave: Wave::new(),
+        }
+    }
+}
+
 /// What a render measured.
 #[derive(Clone, Debug)]
 pub struct RenderStats {
@@ -32,6 +65,8 @@ pub struct RenderStats {
     pub time: Duration,
     /// Rays traced (camera, shadow and BSDF rays).
     pub rays: u64,
+    /// The same by kind.
+    pub by_kind: RayCounts,
     /// Samples whose radiance was NaN/Inf and were dropped.
     pub non_finite: u64,
 }
@@ -90,95 +125,120 @@ pub fn render(
         ProgressBar::hidden()
     };
     let rays = AtomicU64::new(0);
+    let counts = std::sync::Mutex::new(RayCounts::default());
     let bad = AtomicU64::new(0);
+    let works: Vec<std::sync::Mutex<Option<TileWork>>> = (0..rayon::current_num_threads().max(1))
+        .map(|_| std::sync::Mutex::new(None))
+        .collect();
     let start = Instant::now();
     let tiles: Vec<Vec<Rgb>> = (0..tiles_x * tiles_y)
         .into_par_iter()
-        // One pool of PixelSamples per worker (filled in place, pixel after pixel).
-        .map_init(
-            || -> Vec<PixelSamples> { (0..PACKET).map(|_| pattern.pixel(UVec2::ZERO)).collect() },
-            |pxs, t| {
-                let (tx, ty) = (t % tiles_x, t / tiles_x);
-                let x0 = tx * TILE;
-                let y0 = ty * TILE;
-                let x1 = (x0 + TILE).min(res.x);
-                let y1 = (y0 + TILE).min(res.y);
-                let (w, h) = (x1 - x0, y1 - y0);
-                // Samples in pixel-major order, PACKET at a time: a pixel's sum adds its samples in
-                // index order, exactly as one loop per pixel would.
-                let mut sums = vec![Rgb::ZERO; (w * h) as usize];
-                // Pixels take the pool's slots in turn and keep theirs while their samples last.
-                // No slot is taken while still in use: a pixel takes one when the open packet has
-                // at most PACKET − 1 lanes, of at most PACKET − 1 pixels, which hold the slots
-                // just before it in turn.
-                let mut owner = [0usize; PACKET];
-                let mut next = 0;
-                let mut cam = CameraPacket::new();
-                let mut radiance = [Rgb::ZERO; PACKET];
-                let mut queues = Queues::new();
-                let (mut tile_rays, mut tile_bad) = (0u64, 0u64);
-                let mut flush = |cam: &mut CameraPacket,
-                                 pxs: &[PixelSamples],
-                                 owner: &[usize; PACKET],
-                                 weight: &[f32; PACKET]| {
-                    tile_rays += est.li_packet(pxs, cam, &mut radiance, &mut queues);
+        // Per worker thread: one PixelSamples per pixel of a tile (filled in place) and the
+        // wave's queues, made once and reused from tile to tile (rayon's `map_init` would make
+        // them again for every split of the range).
+        .map(|t| {
+            let me = rayon::current_thread_index().unwrap_or(0) % works.len();
+            let mut guard = works[me].lock().unwrap_or_else(|e| e.into_inner());
+            let work = guard.get_or_insert_with(|| TileWork::new(pattern.as_ref()));
+            let (tx, ty) = (t % tiles_x, t / tiles_x);
+            let x0 = tx * TILE;
+            let y0 = ty * TILE;
+            let x1 = (x0 + TILE).min(res.x);
+            let y1 = (y0 + TILE).min(res.y);
+            let (w, h) = (x1 - x0, y1 - y0);
+            // Samples in pixel-major order, PACKET at a time into camera packets, up to
+            // WAVE packets at a time into a wave: a pixel's sum adds its samples in index
+            // order, exactly as one loop per pixel would, whatever order the wave's paths
+            // finish in.
+            let mut sums = vec![Rgb::ZERO; (w * h) as usize];
+            let TileWork {
+                pxs,
+                cams,
+                weights,
+                radiance,
+                queues,
+                wave,
+            } = work;
+            cams.clear();
+            weights.clear();
+            let mut cam = CameraPacket::new();
+            let (mut tile_rays, mut tile_bad) = (RayCounts::default(), 0u64);
+            let mut flush = |cams: &mut Vec<CameraPacket>,
+                             weights: &mut Vec<[f32; PACKET]>,
+                             pxs: &[PixelSamples]| {
+                let counts = est.li_wave(pxs, cams, radiance, queues, wave);
+                tile_rays.add(&counts);
+                for (i, (cam, weight)) in cams.iter().zip(weights.iter()).enumerate() {
                     for k in 0..cam.n {
-                        // Filters with negative lobes weight their samples (mean weight 1);
-                        // box, tent and gaussian samples all weigh exactly 1.
+                        // Filters with negative lobes weight their samples (mean weight
+                        // 1); box, tent and gaussian samples all weigh exactly 1.
+                        let l = radiance[i * PACKET + k];
                         let l = if filter.is_analytic() {
-                            radiance[k]
+                            l
                         } else {
-                            radiance[k] * weight[k]
+                            l * weight[k]
                         };
                         if l.is_finite() {
-                            sums[owner[cam.pixel[k] as usize]] += l;
+                            sums[cam.pixel[k] as usize] += l;
                         } else {
                             tile_bad += 1;
                         }
                     }
-                    cam.clear();
-                };
-                // Per lane: the pixel and filter draw; the camera rays of a full packet are then
-                // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
-                let mut lanes = CameraLanes::new();
-                for y in y0..y1 {
-                    for x in x0..x1 {
-                        if opts.is_cancelled() {
-                            break;
+                }
+                cams.clear();
+                weights.clear();
+            };
+            // Per lane: the pixel and filter draw; the camera rays of a full packet are then
+            // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
+            let mut lanes = CameraLanes::new();
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    if opts.is_cancelled() {
+                        break;
+                    }
+                    let pixel = UVec2::new(x, y);
+                    // The pixel's slot is its index in the tile (and in `sums`).
+                    let slot = ((y - y0) * w + (x - x0)) as usize;
+                    pattern.pixel_into(pixel, &mut pxs[slot]);
+                    for i in samples.clone() {
+                        let k = cam.n;
+                        lanes.pixel[k] = pixel;
+                        lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
+                        if camera.needs_lens_sample() {
+                            lanes.lens[k] = pxs[slot].sample_2d(DIM_LENS, i, opts.spp);
                         }
-                        let pixel = UVec2::new(x, y);
-                        let slot = next;
-                        next = (next + 1) % PACKET;
-                        pattern.pixel_into(pixel, &mut pxs[slot]);
-                        owner[slot] = ((y - y0) * w + (x - x0)) as usize;
-                        for i in samples.clone() {
-                            let k = cam.n;
-                            lanes.pixel[k] = pixel;
-                            lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
-                            if camera.needs_lens_sample() {
-                                lanes.lens[k] = pxs[slot].sample_2d(DIM_LENS, i, opts.spp);
-                            }
-                            cam.pixel[k] = slot as u8;
-                            cam.eye[k] = i;
-                            cam.n = k + 1;
-                            if cam.is_full() {
-                                lanes.rays(cpu, &camera, &filter, &mut cam.rays);
-                                flush(&mut cam, pxs, &owner, &lanes.weight);
+                        cam.pixel[k] = slot as u8;
+                        cam.eye[k] = i;
+                        cam.n = k + 1;
+                        if cam.is_full() {
+                            lanes.rays(cpu, &camera, &filter, &mut cam.rays);
+                            cams.push(cam);
+                            weights.push(lanes.weight);
+                            cam.clear();
+                            if cams.len() == WAVE {
+                                flush(cams, weights, pxs);
                             }
                         }
                     }
                 }
-                if cam.n > 0 {
-                    lanes.rays(cpu, &camera, &filter, &mut cam.rays);
-                    flush(&mut cam, pxs, &owner, &lanes.weight);
-                }
-                let out: Vec<Rgb> = sums.iter().map(|&s| s / samples.len() as f32).collect();
-                rays.fetch_add(tile_rays, Ordering::Relaxed);
-                bad.fetch_add(tile_bad, Ordering::Relaxed);
-                bar.inc(1);
-                out
-            },
-        )
+            }
+            if cam.n > 0 {
+                lanes.rays(cpu, &camera, &filter, &mut cam.rays);
+                cams.push(cam);
+                weights.push(lanes.weight);
+            }
+            if !cams.is_empty() {
+                flush(cams, weights, pxs);
+            }
+            let out: Vec<Rgb> = sums.iter().map(|&s| s / samples.len() as f32).collect();
+            rays.fetch_add(tile_rays.total(), Ordering::Relaxed);
+            if let Ok(mut c) = counts.lock() {
+                c.add(&tile_rays);
+            }
+            bad.fetch_add(tile_bad, Ordering::Relaxed);
+            bar.inc(1);
+            out
+        })
         .collect();
     bar.finish_and_clear();
     if opts.is_cancelled() {
@@ -198,6 +258,7 @@ pub fn render(
     let stats = RenderStats {
         time,
         rays: rays.into_inner(),
+        by_kind: counts.into_inner().unwrap_or_default(),
         non_finite: bad.into_inner(),
     };
     if stats.non_finite > 0 {

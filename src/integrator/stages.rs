@@ -12,6 +12,11 @@
 //!                   └──── continuing BSDF rays (while depth < max depth) ◀──┘
 //! ```
 //!
+//! The driver ([`Integrator::li_wave`]) takes a wave of camera packets one depth at a time:
+//! the paths that continue past a vertex wait as [`PathRecord`]s and are packed 16 to a packet
+//! again at the next depth (compaction), so a packet keeps its lanes full after the first
+//! bounces; a path's radiance goes to its wave slot when it ends.
+//!
 //! Direct lighting is the path with max depth 1: its BSDF rays are the last of the path, so
 //! `gather_emitters` finds what they reach with a query of the emitters alone (most BSDF rays
 //! reach no light: no closest-hit query of the whole scene for them) and tests the visibility
@@ -27,7 +32,9 @@ use super::estimator::{
     light_estimate, nee_pdf, roulette,
 };
 use super::lanes::{DiffuseBsdfLanes, TriangleLightLanes};
-use super::queues::{BsdfRays, CameraPacket, Draws, LaneShading, PathLanes, Receivers, ShadowRays};
+use super::queues::{
+    BsdfRays, CameraPacket, Draws, LaneShading, PathLanes, PathRecord, Receivers, ShadowRays,
+};
 use super::{MisHeuristic, Strategy};
 use crate::Rgb;
 use crate::bsdf::{Bsdf, Bxdf, LaneBsdf, LobeSampling};
@@ -41,6 +48,8 @@ use crate::lights::{Emitter, LaneLight, LightSampleContext, LightSource, Samplin
 use crate::sampling::{Frame, PixelSamples, SamplePattern};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 /// The integrator configured for one render.
 pub struct Integrator<'a> {
@@ -153,6 +162,113 @@ impl Queues {
     }
 }
 
+/// The paths of a wave between vertices (made once per render thread and reused): those of
+/// the current depth and those that continue to the next.
+#[derive(Default)]
+pub struct Wave {
+    now: Vec<PathRecord>,
+    next: Vec<PathRecord>,
+}
+
+impl Wave {
+    /// An empty wave.
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+/// When set, [`Integrator::li_wave`] times its ray queries by kind into
+/// [`RayCounts::timed`] (for `penumbra bench`; two clock reads per packet query otherwise
+/// not made).
+pub static TIME_QUERIES: AtomicBool = AtomicBool::new(false);
+
+/// Rays of one kind of query and the time spent in those queries.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct QueryTime {
+    /// Rays traced.
+    pub rays: u64,
+    /// Nanoseconds in the queries.
+    pub ns: u64,
+}
+
+impl QueryTime {
+    /// Millions of rays per second of query time.
+    pub fn mrays_per_s(&self) -> f64 {
+        self.rays as f64 / (self.ns as f64).max(1.0) * 1e3
+    }
+
+    fn add(&mut self, other: &QueryTime) {
+        self.rays += other.rays;
+        self.ns += other.ns;
+    }
+}
+
+/// With [`TIME_QUERIES`]: the time of each kind of ray query.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct QueryTimes {
+    /// Camera rays' closest-hit packet queries.
+    pub camera: QueryTime,
+    /// Shadow rays (light samples and the visibility of emitters BSDF rays reached), any-hit
+    /// packet queries.
+    pub shadow: QueryTime,
+    /// Continuing BSDF rays' closest-hit queries (one ray each).
+    pub secondary: QueryTime,
+}
+
+/// Rays traced, by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    /// Camera rays (closest hit, coherent packets).
+    pub camera: u64,
+    /// Light samples' shadow rays (any hit).
+    pub shadow: u64,
+    /// BSDF rays that continue their path (closest hit, one query each).
+    pub secondary: u64,
+    /// BSDF rays that end their path: the emitters' query, then a visibility test of those
+    /// that reach one.
+    pub gather: u64,
+    /// Query times (zero unless [`TIME_QUERIES`] was set).
+    pub timed: QueryTimes,
+}
+
+impl RayCounts {
+    /// All kinds together.
+    pub fn total(&self) -> u64 {
+        self.camera + self.shadow + self.secondary + self.gather
+    }
+
+    /// Add `other`.
+    pub fn add(&mut self, other: &RayCounts) {
+        self.camera += other.camera;
+        self.shadow += other.shadow;
+        self.secondary += other.secondary;
+        self.gather += other.gather;
+        self.timed.camera.add(&other.timed.camera);
+        self.timed.shadow.add(&other.timed.shadow);
+        self.timed.secondary.add(&other.timed.secondary);
+    }
+}
+
+/// After a vertex of the packet whose lanes `live` entered it: the paths that ended give
+/// their radiance (`out`) to `radiance`, those that continue (the active lanes) wait in
+/// `next`.
+#[inline(always)]
+fn retire(
+    q: &Queues,
+    live: u32,
+    out: &[Rgb; PACKET],
+    radiance: &mut [Rgb],
+    next: &mut Vec<PathRecord>,
+) {
+    let going = q.paths.active;
+    for k in bits(live & !going) {
+        radiance[q.paths.id[k] as usize] = out[k];
+    }
+    for k in bits(going) {
+        next.push(q.paths.record(k, out[k]));
+    }
+}
+
 /// The shading state at a hit, as the per-lane estimators read it. The parts whose address
 /// goes to out-of-line calls (hit, BSDF, light context) are borrowed from separate places: a
 /// struct with one field passed by address is kept whole in memory, so owning them would force
@@ -221,9 +337,7 @@ impl<'a> Integrator<'a> {
 
     /// Radiance of each lane of `cam` (lane k: eye sample `cam.eye[k]` of the pixel whose
     /// samples are `pxs[cam.pixel[k]]`, along `cam.rays` lane k) into `out[k]`; returns the
-    /// number of rays traced. The driver of the stages: each kind of ray goes to the geometry
-    /// as one packet query, so the coherent camera and shadow rays of neighbouring samples
-    /// share their traversal.
+    /// number of rays traced. A wave of one packet ([`Self::li_wave`]).
     pub fn li_packet(
         &self,
         pxs: &[PixelSamples],
@@ -231,49 +345,132 @@ impl<'a> Integrator<'a> {
         out: &mut [Rgb; PACKET],
         q: &mut Queues,
     ) -> u64 {
-        let t = self.techniques();
-        q.paths.start(cam);
         *out = [Rgb::ZERO; PACKET];
-        // The first round's draws are pure arithmetic that does not depend on the hits:
-        // issued before the camera rays' traversal, they overlap with its memory-bound work.
-        self.draw(pxs, q, t, 0, q.paths.active, self.continues(0));
-        let mut rays = self.intersect(&cam.rays, q);
-        self.shade(&cam.rays, q, t, out);
-        // One vertex per pass: the path's ray has been traced and shaded (its emission added).
-        while q.paths.depth < self.max_depth {
-            let depth = q.paths.depth;
-            let m = rounds_at(depth, self.shadow_rays.max(1));
-            // Whether this vertex's BSDF ray (round 0's) may continue the path.
-            let go_on = self.continues(depth);
-            // The vertex's M rounds of light and BSDF samples (N eye rays × M shadow rays at
-            // the first vertex, one round later).
-            q.sums = [Rgb::ZERO; PACKET];
-            for j in 0..m {
-                if j > 0 {
-                    self.draw(pxs, q, t, j, q.shaded, false);
-                }
-                rays += self.sample_lights(q, t);
-                rays += self.sample_bsdfs(pxs, q, t, j, go_on && j == 0);
-                if go_on && j == 0 {
-                    self.continue_or_terminate(pxs, q, t, m);
-                }
-                // Continuing rays find their emission at the next vertex (stage *shade*).
-                let on = if go_on && j == 0 { q.paths.next } else { 0 };
-                self.gather_emitters(q, t, on);
-                self.trace_shadows(q);
-                self.accumulate(q, t);
+        let mut wave = Wave::new();
+        self.li_wave(pxs, std::slice::from_ref(cam), out, q, &mut wave)
+            .total()
+    }
+
+    /// Radiance of every path of camera packets `cams` (path `i·PACKET + k`: lane k of
+    /// `cams[i]`, eye sample `cams[i].eye[k]` of the pixel whose samples are
+    /// `pxs[cams[i].pixel[k]]`) into `radiance[i·PACKET + k]` (lanes past a packet's end are
+    /// left as they are); returns the rays traced by kind. The driver of the stages, one depth
+    /// at a time: the camera packets go through their first vertex as they are (their
+    /// coherent rays share the packet query), and the paths that continue wait in the wave's
+    /// queue; the paths at each later depth are then packed 16 to a packet whatever packet
+    /// they came from (*compaction*), so a packet whose paths ended does not keep running
+    /// with few lanes. Each lane's numbers are independent of its packet, so the radiance of
+    /// every path is what the path alone would get ([`Self::li`]).
+    pub fn li_wave(
+        &self,
+        pxs: &[PixelSamples],
+        cams: &[CameraPacket],
+        radiance: &mut [Rgb],
+        q: &mut Queues,
+        wave: &mut Wave,
+    ) -> RayCounts {
+        let t = self.techniques();
+        let mut rays = RayCounts::default();
+        let timing = TIME_QUERIES.load(Ordering::Relaxed);
+        wave.next.clear();
+        for (i, cam) in cams.iter().enumerate() {
+            let first = (i * PACKET) as u32;
+            q.paths.start(cam, first);
+            let mut out = [Rgb::ZERO; PACKET];
+            // The first round's draws are pure arithmetic that does not depend on the hits:
+            // issued before the camera rays' traversal, they overlap with its memory-bound
+            // work.
+            self.draw(pxs, q, t, 0, q.paths.active, self.continues(0));
+            let clock = timing.then(Instant::now);
+            let traced = self.intersect(&cam.rays, q);
+            rays.camera += traced;
+            if let Some(c) = clock {
+                rays.timed.camera.add(&QueryTime {
+                    rays: traced,
+                    ns: c.elapsed().as_nanos() as u64,
+                });
             }
-            self.finish(q, m, out);
-            if q.paths.active == 0 {
-                break;
+            self.shade(&cam.rays, q, t, &mut out);
+            self.vertex(pxs, q, t, &mut out, &mut rays, timing);
+            retire(q, cam.active(), &out, radiance, &mut wave.next);
+        }
+        let mut depth = 0;
+        while !wave.next.is_empty() {
+            std::mem::swap(&mut wave.now, &mut wave.next);
+            wave.next.clear();
+            depth += 1;
+            for recs in wave.now.chunks(PACKET) {
+                let mut out = [Rgb::ZERO; PACKET];
+                q.paths.load(recs, depth, &mut out);
+                let live = q.paths.active;
+                self.draw(pxs, q, t, 0, live, self.continues(depth));
+                let next = q.paths.rays;
+                let clock = timing.then(Instant::now);
+                self.intersect(&next, q);
+                if let Some(c) = clock {
+                    rays.timed.secondary.add(&QueryTime {
+                        rays: u64::from(live.count_ones()),
+                        ns: c.elapsed().as_nanos() as u64,
+                    });
+                }
+                self.shade(&next, q, t, &mut out);
+                self.vertex(pxs, q, t, &mut out, &mut rays, timing);
+                retire(q, live, &out, radiance, &mut wave.next);
             }
-            // The next vertex: the continuing BSDF rays are the paths' rays.
-            self.draw(pxs, q, t, 0, q.paths.active, self.continues(q.paths.depth));
-            let next = q.paths.rays;
-            self.intersect(&next, q);
-            self.shade(&next, q, t, out);
         }
         rays
+    }
+
+    /// The light and BSDF sampling of the packet's current vertex, whose ray has been traced
+    /// and shaded (its emission added): its M rounds (N eye rays × M shadow rays at the first
+    /// vertex, one round later), then *finish*; afterwards the active lanes are the paths
+    /// that continue (at the next depth). Nothing at max depth 0.
+    #[inline(always)]
+    fn vertex(
+        &self,
+        pxs: &[PixelSamples],
+        q: &mut Queues,
+        t: Techniques,
+        out: &mut [Rgb; PACKET],
+        rays: &mut RayCounts,
+        timing: bool,
+    ) {
+        let depth = q.paths.depth;
+        if depth >= self.max_depth {
+            q.paths.active = 0;
+            return;
+        }
+        let m = rounds_at(depth, self.shadow_rays.max(1));
+        // Whether this vertex's BSDF ray (round 0's) may continue the path.
+        let go_on = self.continues(depth);
+        q.sums = [Rgb::ZERO; PACKET];
+        for j in 0..m {
+            if j > 0 {
+                self.draw(pxs, q, t, j, q.shaded, false);
+            }
+            rays.shadow += self.sample_lights(q, t);
+            let bsdf = self.sample_bsdfs(pxs, q, t, j, go_on && j == 0);
+            if go_on && j == 0 {
+                self.continue_or_terminate(pxs, q, t, m);
+            }
+            // Continuing rays find their emission at the next vertex (stage *shade*).
+            let on = if go_on && j == 0 { q.paths.next } else { 0 };
+            let on_rays = u64::from(on.count_ones());
+            rays.secondary += on_rays;
+            rays.gather += bsdf - on_rays;
+            self.gather_emitters(q, t, on);
+            let clock = timing.then(Instant::now);
+            self.trace_shadows(q);
+            if let Some(c) = clock {
+                let traced = q.nee.active.count_ones() + q.gathered.active.count_ones();
+                rays.timed.shadow.add(&QueryTime {
+                    rays: u64::from(traced),
+                    ns: c.elapsed().as_nanos() as u64,
+                });
+            }
+            self.accumulate(q, t);
+        }
+        self.finish(q, m, out);
     }
 
     /// Whether the BSDF ray of vertex `depth` may continue its path (a later vertex samples

@@ -9,7 +9,7 @@ use std::cell::Cell;
 use super::avx512::RawSets;
 use super::fast::FastStrata;
 use super::sets::{SetKeys, Strata};
-use super::{CACHED_DIMS, Pattern, PatternKind, SamplePattern};
+use super::{CACHED_DIMS, Pattern, PatternKind};
 use crate::isa::Isa;
 
 impl Pattern {
@@ -40,6 +40,9 @@ impl Pattern {
             fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
             chunks_1d: Default::default(),
             chunks_2d: Default::default(),
+            deep: Default::default(),
+            deep_tag: Default::default(),
+            generation: Cell::new(1),
         }
     }
 }
@@ -149,7 +152,20 @@ pub struct PixelSamples {
     /// Batches of precomputed `stratified` values per cached 1D / 2D dimension.
     pub(super) chunks_1d: [Chunk<f32>; CACHED_DIMS],
     pub(super) chunks_2d: [Chunk<Vec2>; CACHED_DIMS],
+    /// The keys of the 1D and 2D sets of dimensions past [`CACHED_DIMS`] (a path's later
+    /// vertices), computed at their first use in this pixel: slot `dim % DEEP` holds the
+    /// keys of the last such dim, valid when its tag is (`generation`, dim). Values are
+    /// evaluated one at a time as [`Pattern::sample_1d`] / [`Pattern::sample_2d`] do, from the
+    /// same keys and strata.
+    deep: [[Cell<SetKeys>; DEEP]; 2],
+    /// Per slot of `deep`: (generation, dim) of its keys.
+    deep_tag: [[Cell<(u64, u32)>; DEEP]; 2],
+    /// Bumped by every reset to a new pixel, which so empties `deep` in one store.
+    generation: Cell<u64>,
 }
+
+/// Slots of [`PixelSamples::deep`] per arity.
+const DEEP: usize = 16;
 
 impl PixelSamples {
     /// Make these the samples of `pixel` under `pattern` except for the set keys (which the
@@ -166,6 +182,7 @@ impl PixelSamples {
         for c in &self.chunks_2d {
             c.len.set(0);
         }
+        self.generation.set(self.generation.get() + 1);
     }
 
     /// The pixel these samples belong to.
@@ -240,7 +257,7 @@ impl PixelSamples {
                 dim,
                 index,
                 count,
-                general: |p: &Pattern| p.sample_1d(self.pixel, dim, index, count),
+                arity: 0,
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_1d(kind, i, st),
                 fast: |f: &FastStrata, set: &SetKeys, base| {
                     f.chunk_1d_on(self.pattern.cpu, set, base)
@@ -277,7 +294,7 @@ impl PixelSamples {
                 dim,
                 index,
                 count,
-                general: |p: &Pattern| p.sample_2d(self.pixel, dim, index, count),
+                arity: 1,
                 eval: |set: &SetKeys, kind, i, st: &Strata| set.sample_2d(kind, i, st),
                 fast: |f: &FastStrata, set: &SetKeys, base| {
                     f.chunk_2d_on(self.pattern.cpu, set, base)
@@ -306,15 +323,14 @@ impl PixelSamples {
     /// where it applies) or evaluate the general way (uncached dimension, wrapped index).
     /// Written once for 1D and 2D; inlined into each so that every loop is specialised.
     #[inline(always)]
-    fn miss<T, G, E, F>(
+    fn miss<T, E, F>(
         &self,
         set: Option<SetKeys>,
         chunks: &[Chunk<T>; CACHED_DIMS],
-        a: Arity<G, E, F>,
+        a: Arity<E, F>,
     ) -> T
     where
         T: Copy + Default,
-        G: Fn(&Pattern) -> T,
         E: Fn(&SetKeys, PatternKind, u32, &Strata) -> T,
         F: Fn(&FastStrata, &SetKeys, u32) -> [T; CHUNK],
     {
@@ -322,12 +338,31 @@ impl PixelSamples {
             dim,
             index,
             count,
-            general,
+            arity,
             eval,
             fast,
         } = a;
         let Some(set) = set else {
-            return general(&self.pattern);
+            // A dimension past the cached ones: its keys from the deep slots (what
+            // `Pattern::sample_1d` / `sample_2d` derive from the pixel, dim and arity at
+            // each call), then the same evaluation with the same strata.
+            let i = dim as usize % DEEP;
+            let (slot, tag) = (&self.deep[arity][i], &self.deep_tag[arity][i]);
+            let want = (self.generation.get(), dim);
+            if tag.get() != want {
+                let set_tag = if arity == 0 {
+                    super::TAG_1D
+                } else {
+                    super::TAG_2D
+                };
+                slot.set(
+                    self.pattern
+                        .set(self.pattern.pixel_hash(self.pixel), dim, set_tag),
+                );
+                tag.set(want);
+            }
+            let keys = slot.get();
+            return eval(&keys, self.pattern.kind, index, &self.strata(count));
         };
         let set = &set;
         let kind = self.pattern.kind;
@@ -368,12 +403,13 @@ impl PixelSamples {
 }
 
 /// What [`PixelSamples::miss`] needs of one request and of its dimension count (1D or 2D):
-/// the request, the uncached evaluation, the per-index evaluation and the fast chunk.
-struct Arity<G, E, F> {
+/// the request, which kind of set, the per-index evaluation and the fast chunk.
+struct Arity<E, F> {
     dim: u32,
     index: u32,
     count: u32,
-    general: G,
+    /// 0: a 1D set, 1: a 2D set.
+    arity: usize,
     eval: E,
     fast: F,
 }
