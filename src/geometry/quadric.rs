@@ -204,22 +204,33 @@ impl Quadric {
             }
             QuadricKind::Bilinear { .. } | QuadricKind::Curve(_) => unreachable!("handled above"),
         };
-        let pw = self.to_world.point(p.as_vec3());
+        // Object-space error: γ5 of the coordinates.
+        self.world_hit(
+            p.as_vec3(),
+            n_obj,
+            uv,
+            gamma(5) * p.as_vec3().abs().max_element(),
+        )
+    }
+
+    /// A hit at object-space point `p_obj` with normal `n_obj` and texture coordinates `uv`,
+    /// in world space. Its error bound is pbrt-v4's, made isotropic: the object-space error
+    /// `obj_err` carried through the affine map, plus the map's own rounding (γ3 of the
+    /// result), and γ1 more of the result for the rounding of a spawned ray's origin p + n·d
+    /// (half an ulp per coordinate), as the triangles' `POINT_ERROR_GAMMA` has. The
+    /// intersection maps that origin back to object space in f32 and (with the f32 inverse's
+    /// own error) moves it by less than half this bound (tests/geometry.rs measures it far
+    /// from the origin).
+    fn world_hit(&self, p_obj: Vec3, n_obj: Vec3, uv: Vec2, obj_err: f32) -> QuadricHit {
+        let pw = self.to_world.point(p_obj);
         let mut n = self.to_world.normal(n_obj).normalize_or_zero();
         if self.flip {
             n = -n;
         }
-        // Object-space error (γ5 of the coordinates) carried through the affine map, plus the
-        // map's own rounding (γ3 of the result): pbrt-v4's bound, made isotropic; and γ1 more
-        // of the result for the rounding of a spawned ray's origin p + n·d (half an ulp per
-        // coordinate), as the triangles' `POINT_ERROR_GAMMA` has. The intersection maps that
-        // origin back to object space in f32 and (with the f32 inverse's own error) moves it
-        // by less than half this bound (tests/geometry.rs measures it far from the origin).
         let scale = self.to_world.m.x_axis.abs().max_element()
             + self.to_world.m.y_axis.abs().max_element()
             + self.to_world.m.z_axis.abs().max_element();
-        let obj_err = gamma(5) * p.as_vec3().abs().max_element() * scale;
-        let err = obj_err
+        let err = obj_err * scale
             + gamma(4)
                 * (pw.abs().max_element() + self.to_world.m.w_axis.truncate().abs().max_element());
         QuadricHit {
@@ -254,24 +265,8 @@ impl Quadric {
         let (uf, vf) = (u as f32, v as f32);
         let tex =
             (uv[0] * (1.0 - uf) + uv[1] * uf) * (1.0 - vf) + (uv[2] * (1.0 - uf) + uv[3] * uf) * vf;
-        let pw = self.to_world.point(pobj.as_vec3());
-        let mut n = self.to_world.normal(n_obj).normalize_or_zero();
-        if self.flip {
-            n = -n;
-        }
-        let scale = self.to_world.m.x_axis.abs().max_element()
-            + self.to_world.m.y_axis.abs().max_element()
-            + self.to_world.m.z_axis.abs().max_element();
         let big = c.iter().fold(0.0f32, |m, p| m.max(p.abs().max_element()));
-        let err = gamma(8) * big * scale
-            + gamma(4)
-                * (pw.abs().max_element() + self.to_world.m.w_axis.truncate().abs().max_element());
-        QuadricHit {
-            p: pw,
-            n,
-            uv: tex,
-            p_error: err * 3.0f32.sqrt(),
-        }
+        self.world_hit(pobj.as_vec3(), n_obj, tex, gamma(8) * big)
     }
 }
 
@@ -290,26 +285,10 @@ impl Quadric {
             None => (0.5, 0.5, (-d).normalize_or_zero().as_vec3(), t as f64),
         };
         let pobj = (o + d * tt).as_vec3();
-        let pw = self.to_world.point(pobj);
-        let mut n = self.to_world.normal(n_obj).normalize_or_zero();
-        if self.flip {
-            n = -n;
-        }
-        let scale = self.to_world.m.x_axis.abs().max_element()
-            + self.to_world.m.y_axis.abs().max_element()
-            + self.to_world.m.z_axis.abs().max_element();
         let big = c.cp.iter().fold(pobj.abs().max_element(), |m, p| {
             m.max(p.abs().max_element())
         });
-        let err = gamma(8) * big * scale
-            + gamma(4)
-                * (pw.abs().max_element() + self.to_world.m.w_axis.truncate().abs().max_element());
-        QuadricHit {
-            p: pw,
-            n,
-            uv: Vec2::new(u, v),
-            p_error: err * 3.0f32.sqrt(),
-        }
+        self.world_hit(pobj, n_obj, Vec2::new(u, v), gamma(8) * big)
     }
 }
 
