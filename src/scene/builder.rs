@@ -331,11 +331,10 @@ impl SceneBuilder {
             zmin < zmax && phimax > 0.0 && phimax.is_finite(),
             "cylinder needs zmin < zmax and phimax > 0 (z {zmin}..{zmax}, phimax {phimax})"
         );
-        // The object-space normal (x, y, 0) through the inverse transpose is already the
-        // outward one under a mirroring transform (pbrt-v4 crosses the render-space ∂p/∂u,
-        // ∂p/∂v, which a mirror turns inward, and flips them back): only
-        // ReverseOrientation flips it.
-        let flip = reverse_orientation;
+        // pbrt-v4's quadric rule, as for spheres and disks: the object-space ∂p/∂u × ∂p/∂v
+        // is negated for ReverseOrientation XOR a handedness swap, then carried to world
+        // space as a normal, so a mirrored cylinder faces inward.
+        let flip = reverse_orientation ^ to_world.swaps_handedness();
         if let Some(e) = emission {
             let n = CYLINDER_LIGHT_SEGMENTS;
             let (mut positions, mut normals, mut uvs, mut indices) =
@@ -419,9 +418,8 @@ impl SceneBuilder {
         let q = Quadric {
             kind: QuadricKind::Curve(segment),
             to_world,
-            // As the cylinder's: the normal through the inverse transpose needs no
-            // handedness flip.
-            flip: reverse_orientation,
+            // pbrt-v4's curves flip as its quadrics do.
+            flip: reverse_orientation ^ to_world.swaps_handedness(),
         };
         self.add_quadric(q, material, None)
     }
@@ -551,7 +549,8 @@ fn quadric_light(q: &Quadric, e: &AreaEmission) -> anyhow::Result<Light> {
     let light = match q.kind {
         QuadricKind::Sphere { radius } => {
             let c = q.to_world.point(Vec3::ZERO);
-            SphereLight::new(c, radius * sx, e.l, q.flip).map(Light::Sphere)
+            SphereLight::new(c, radius * sx, e.l, q.flip)
+                .map(|s| Light::Sphere(s.with_two_sided(e.two_sided)))
         }
         QuadricKind::Disk { height, radius } => {
             let c = q.to_world.point(Vec3::new(0.0, 0.0, height));
