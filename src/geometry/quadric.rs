@@ -167,7 +167,9 @@ impl Quadric {
                 let pf = p.as_vec3();
                 let phi = pf.y.atan2(pf.x).rem_euclid(2.0 * PI);
                 let cos_theta = (pf.z / radius).clamp(-1.0, 1.0);
-                (pf, Vec2::new(phi / (2.0 * PI), cos_theta.acos() / PI))
+                // pbrt-v4's v = (θ − θ_zmin)/(θ_zmax − θ_zmin) with θ_zmin = π: 0 at the
+                // bottom pole, 1 at the top.
+                (pf, Vec2::new(phi / (2.0 * PI), 1.0 - cos_theta.acos() / PI))
             }
             QuadricKind::Disk { height, radius } => {
                 p.z = height as f64;
