@@ -1150,6 +1150,8 @@ impl Parser {
                 geom,
                 super::shapes::ShapeGeom::Sphere { .. }
                     | super::shapes::ShapeGeom::Disk { .. }
+                    | super::shapes::ShapeGeom::PartialSphere { .. }
+                    | super::shapes::ShapeGeom::PartialDisk { .. }
                     | super::shapes::ShapeGeom::Cylinder { .. }
             )
         {
@@ -1160,6 +1162,22 @@ impl Parser {
                 loc,
                 format!(
                     "one-sided \"{ty}\" light under a mirroring transform emits to the side of pbrt-v4's intersection normal (ReverseOrientation XOR handedness swap) for hits and light samples alike; pbrt-v4's own light samples emit to the other side"
+                ),
+            );
+        }
+        if emission.is_some()
+            && matches!(
+                geom,
+                super::shapes::ShapeGeom::PartialSphere { .. }
+                    | super::shapes::ShapeGeom::PartialDisk { .. }
+            )
+        {
+            let (nu, nv) = crate::scene::builder::PARTIAL_LIGHT_GRID;
+            self.warn(
+                "partial-quadric-light",
+                loc,
+                format!(
+                    "emissive partial \"{ty}\" tessellated into {nu}×{nv}×2 triangle lights (penumbra samples no analytic partial sphere or annulus)"
                 ),
             );
         }
