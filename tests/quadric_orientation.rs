@@ -109,10 +109,10 @@ fn mirrored_quadric_lights_follow_pbrt_v4_orientation() {
 
 #[test]
 fn two_sided_sphere_lights_emit_inside_and_out() {
-    let (scene, warnings) = load(&format!(
+    let (scene, warnings) = load(
         "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1] \"bool twosided\" true\n\
-         Shape \"sphere\" \"float radius\" 1\nAttributeEnd"
-    ));
+         Shape \"sphere\" \"float radius\" 1\nAttributeEnd",
+    );
     assert!(
         !warnings.iter().any(|w| w.contains("sphere")),
         "{warnings:?}"
