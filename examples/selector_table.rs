@@ -49,6 +49,7 @@ fn parse_args() -> anyhow::Result<Args> {
             "many-open",
             "many-rooms",
             "many-mesh",
+            "many-street",
         ]
         .map(String::from)
         .to_vec(),

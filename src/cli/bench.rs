@@ -194,7 +194,7 @@ fn bvh_section(names: &[String]) -> anyhow::Result<()> {
 }
 
 /// The scenes of `--many-lights`.
-const MANY: &[&str] = &["many-open", "many-rooms", "many-mesh"];
+const MANY: &[&str] = &["many-open", "many-rooms", "many-mesh", "many-street"];
 
 /// The strategies whose high-spp renders are averaged into a scene's reference: three
 /// unrelated unbiased estimators (the O(N) `exhaustive` where the scene has few enough lights,

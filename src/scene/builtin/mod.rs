@@ -6,6 +6,7 @@ mod dense;
 mod many_mesh;
 mod many_open;
 mod many_rooms;
+mod many_street;
 mod many_util;
 
 use super::Scene;
@@ -70,6 +71,12 @@ pub const BUILTINS: &[Builtin] = &[
         description: "emissive torus of 8192 triangle lights plus strip lights (--light-count)",
         build: many_mesh::many_mesh,
         knobs: &["light-count", "triangles"],
+    },
+    Builtin {
+        name: "many-street",
+        description: "night city of 6x6 blocks, 32.6k emissive triangles (windows, lamps, signs, cars) (--light-count)",
+        build: many_street::many_street,
+        knobs: &["light-count"],
     },
 ];
 
