@@ -6,6 +6,7 @@
 //! gathered in pixel order, so the passes are deterministic under any thread schedule.
 
 use crate::bsdf::{Bsdf, Bxdf, gathers_from};
+use crate::geometry::ray::Ray;
 use crate::geometry::{RayQuery, ShadingGeometry, SurfaceHit};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode};
 use crate::luminance;
@@ -52,7 +53,25 @@ pub fn eye_hit(scene: &Scene, res: UVec2, pixel: u32, rng: &mut Pcg32) -> Option
     let jitter = Vec2::new(next_f32(rng), next_f32(rng));
     let p_raster = Vec2::new(x as f32, y as f32) + jitter;
     let ray = scene.camera.generate_ray(p_raster, res);
-    let hit = scene.geometry.intersect(&ray)?;
+    hit_along(scene, &ray)
+}
+
+/// The next hit after one BSDF sample at `eh`: a secondary vertex, where a path tracer
+/// selects a light too (and where the lights that matter can differ from the eye hits').
+pub fn bounce_hit(scene: &Scene, eh: &EyeHit, rng: &mut Pcg32) -> Option<EyeHit> {
+    let uc = next_f32(rng);
+    let u = Vec2::new(next_f32(rng), next_f32(rng));
+    let s = eh.bsdf.sample(eh.wo_local, uc, u)?;
+    if !(s.pdf > 0.0) {
+        return None;
+    }
+    let wi = eh.frame.to_world(s.wi).try_normalize()?;
+    hit_along(scene, &Ray::new(eh.hit.spawn_origin(wi), wi))
+}
+
+/// The shading set-up at the first hit of `ray`, if its surface has a material.
+fn hit_along(scene: &Scene, ray: &Ray) -> Option<EyeHit> {
+    let hit = scene.geometry.intersect(ray)?;
     let material = scene.materials.get(hit.material as usize)?;
     let g = ShadingGeometry::new(ray.d, hit.ng, hit.ns);
     let bsdf = material.bsdf(&hit, g.front);

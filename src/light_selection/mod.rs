@@ -16,6 +16,7 @@
 
 pub mod adaptive;
 pub mod bvh;
+pub mod defensive;
 pub mod estimate;
 pub mod exhaustive;
 pub mod importance;
@@ -234,16 +235,24 @@ pub fn make_selector(
         SelectorKind::Ris { candidates } => {
             wrap(&|set| Box::new(RisSelector::new(&set.bounds, candidates, seed)))
         }
-        SelectorKind::Wald => {
-            wrap(&|set| Box::new(WaldSelector::new(scene, set, &wald::WaldConfig::new(seed))))
-        }
-        SelectorKind::Spatial => wrap(&|set| Box::new(SpatialSelector::new(scene, set))),
+        // The learned and grid strategies, mixed with power at the share their probes chose
+        // (`defensive.rs`). The margin is what a δ < 1 must gain: little for `wald` (two
+        // alias tables, power's cost), more for the grids (a cell lookup and a binary search
+        // per call, and cells built on first use).
+        SelectorKind::Wald => wrap(&|set| {
+            let inner = WaldSelector::new(scene, set, &wald::WaldConfig::new(seed));
+            let cfg = defensive::ProbeConfig::new(seed, 0.05);
+            Box::new(defensive::Defensive::new(scene, set, inner, &cfg))
+        }),
+        SelectorKind::Spatial => wrap(&|set| {
+            let inner = SpatialSelector::new(scene, set);
+            let cfg = defensive::ProbeConfig::new(seed, 0.2);
+            Box::new(defensive::Defensive::new(scene, set, inner, &cfg))
+        }),
         SelectorKind::Adaptive => wrap(&|set| {
-            Box::new(AdaptiveSelector::new(
-                scene,
-                set,
-                &adaptive::AdaptiveConfig::new(seed),
-            ))
+            let inner = AdaptiveSelector::new(scene, set, &adaptive::AdaptiveConfig::new(seed));
+            let cfg = defensive::ProbeConfig::new(seed, 0.2);
+            Box::new(defensive::Defensive::new(scene, set, inner, &cfg))
         }),
     }
 }
