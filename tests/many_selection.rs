@@ -495,8 +495,17 @@ fn probes_reject_a_bad_table_and_keep_a_good_one() {
     let mut w = vec![1e-4f32; set.finite.len()];
     w[0] = 1.0;
     let cfg = ProbeConfig::new(3, 0.05);
-    let bad = Defensive::new(&scene, &set, OneLight(PowerSelector::from_weights(&w)), &cfg);
-    assert_eq!(bad.share(), 1.0, "a one-light table must fall back to power");
+    let bad = Defensive::new(
+        &scene,
+        &set,
+        OneLight(PowerSelector::from_weights(&w)),
+        &cfg,
+    );
+    assert_eq!(
+        bad.share(),
+        1.0,
+        "a one-light table must fall back to power"
+    );
     let good = Defensive::new(&scene, &set, SpatialSelector::new(&scene, &set), &cfg);
     eprintln!("spatial share of power: {}", good.share());
     assert!(good.share() < 1.0, "spatial should beat power here");
@@ -550,6 +559,9 @@ fn learned_selectors_do_not_depend_on_threads() {
         SelectorKind::Spatial,
         SelectorKind::Adaptive,
     ] {
-        assert!(pmfs(1, kind) == pmfs(4, kind), "{kind}: pmf depends on threads");
+        assert!(
+            pmfs(1, kind) == pmfs(4, kind),
+            "{kind}: pmf depends on threads"
+        );
     }
 }

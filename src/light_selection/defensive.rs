@@ -7,9 +7,15 @@
 //! estimator is at most 1/δ of power selection's, which bounds the tails (a light the
 //! learning never saw lit is not left at a near-zero probability).
 //!
-//! δ is picked from [`SHARES`] to minimise the second moment Σ_l c_l²/p(l) of the one-light
-//! estimator over the image, where c_l is light l's measured contribution f·Li·cos/pdf_ω
-//! (shadow ray included, so occlusion counts). That sum is estimated from *probes*: light
+//! δ is picked from [`SHARES`] to minimise the second moment of the direct-light estimator
+//! over the image. Under MIS with the power heuristic (the renderer's default), one light
+//! sample and one BSDF sample at a vertex have second moment ∫ f²·(p₁³ + p₂³)/(p₁² + p₂²)²,
+//! with p₁ = p(l)·pdf_ω the light sample's density and p₂ = pdf_BSDF; per light sample of
+//! measured contribution c = f·Li·cos/pdf_ω (shadow ray included, so occlusion counts) that is
+//! c²·(p³ + r³)/(p² + r²)² with r = pdf_BSDF/pdf_ω: where BSDF sampling already finds a light
+//! (large r, e.g. big emitters), its selection probability matters little, and the probes
+//! see that. (Without MIS the term is c²/p, which the same choice also bounds through the
+//! floor.) The sum is estimated from *probes*: light
 //! samples at the hits of low-resolution eye rays and at one BSDF bounce after them (the
 //! secondary vertices a path tracer also selects lights at), drawn from the defensive
 //! proposal q = ½·p_Φ + ½·p_S with seeds no learning pass used, so S is not judged on the
@@ -20,7 +26,9 @@
 //! Every probe is a pure function of (seed, pixel, draw) and the sums run in pixel order, so
 //! δ — and the image — is the same whatever the thread count.
 
-use super::estimate::{EyeHit, bounce_hit, contribution, estimate_resolution, eye_hit, pixel_rng};
+use super::estimate::{
+    EyeHit, bounce_hit, contribution_mis, estimate_resolution, eye_hit, pixel_rng,
+};
 use super::power::PowerSelector;
 use super::{FiniteSelector, LightSet, ONE_MINUS_EPS, ShadingPoint};
 use crate::sampling::hash::next_f32;
@@ -66,11 +74,14 @@ impl ProbeConfig {
     }
 }
 
-/// One probe: c²/q for the light drawn, and its power and strategy probabilities.
+/// One probe: c²/q for the light drawn, its BSDF-to-light density ratio and its power and
+/// strategy probabilities.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Probe {
     /// Squared measured contribution over the proposal's probability.
     pub c2_over_q: f64,
+    /// pdf_BSDF / pdf_ω at the sampled direction (0 for delta lights and without MIS).
+    pub r: f32,
     /// p_Φ of the light.
     pub p_power: f32,
     /// p_S of the light at the probed point.
@@ -84,7 +95,13 @@ pub fn second_moment(probes: &[Probe], delta: f32) -> f64 {
         .iter()
         .map(|p| {
             let m = delta as f64 * p.p_power as f64 + (1.0 - delta as f64) * p.p_learned as f64;
-            if m > 0.0 { p.c2_over_q / m } else { 0.0 }
+            let r = p.r as f64;
+            let d = m * m + r * r;
+            if d > 0.0 {
+                p.c2_over_q * (m * m * m + r * r * r) / (d * d)
+            } else {
+                0.0
+            }
         })
         .sum()
 }
@@ -100,7 +117,11 @@ pub fn choose_share(probes: &[Probe], margin: f64, min_hits: usize) -> f32 {
         .iter()
         .map(|&d| (d, second_moment(probes, d)))
         .fold((1.0, power), |a, b| if b.1 < a.1 { b } else { a });
-    if m < (1.0 - margin) * power { best } else { 1.0 }
+    if m < (1.0 - margin) * power {
+        best
+    } else {
+        1.0
+    }
 }
 
 /// Probes of `learned` against `power` on `scene`'s finite lights `set`, in pixel order.
@@ -129,10 +150,12 @@ pub fn probe(
             let Some(i) = picked else { continue };
             let (pp, pl) = (power.prob(i), learned.pmf(&eh.sp, i));
             let q = 0.5 * pp as f64 + 0.5 * pl as f64;
-            let c = contribution(scene, eh, set.finite[i as usize], lu) as f64;
+            let (c, r) = contribution_mis(scene, eh, set.finite[i as usize], lu);
+            let c = c as f64;
             if c > 0.0 && q > 0.0 {
                 out.push(Probe {
                     c2_over_q: c * c / q,
+                    r,
                     p_power: pp,
                     p_learned: pl,
                 });
@@ -226,6 +249,7 @@ mod tests {
         c.iter()
             .map(|&(c2_over_q, p_power, p_learned)| Probe {
                 c2_over_q,
+                r: 0.0,
                 p_power,
                 p_learned,
             })

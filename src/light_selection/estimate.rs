@@ -94,33 +94,43 @@ fn hit_along(scene: &Scene, ray: &Ray) -> Option<EyeHit> {
 /// Luminance of one light-sampling estimate f·Li·cos/pdf_ω of scene light `light` at `eh`
 /// (not divided by any selection probability), zero if occluded.
 pub fn contribution(scene: &Scene, eh: &EyeHit, light: u32, u: Vec2) -> f32 {
+    contribution_mis(scene, eh, light, u).0
+}
+
+/// [`contribution`] and, for MIS, the ratio r = pdf_BSDF(wi) / pdf_ω(wi) of BSDF sampling's
+/// density to the light sample's at the sampled direction (0 for delta lights).
+pub fn contribution_mis(scene: &Scene, eh: &EyeHit, light: u32, u: Vec2) -> (f32, f32) {
     let Some(l) = scene.lights.get(light as usize) else {
-        return 0.0;
+        return (0.0, 0.0);
     };
     let ctx = LightSampleContext {
         p: eh.hit.p,
         n: eh.n,
     };
     let Some(ls) = l.sample_li(&ctx, u, SamplingMode::SolidAngle) else {
-        return 0.0;
+        return (0.0, 0.0);
     };
     let wi_local = eh.frame.to_local(ls.wi);
     // The integrator's hemisphere rule, so the estimate measures what it will gather.
     if (ls.pdf.is_nan() || ls.pdf <= 0.0)
         || !gathers_from(eh.bsdf.transmits(), ls.wi.dot(eh.n), wi_local.z)
     {
-        return 0.0;
+        return (0.0, 0.0);
     }
     let v = luminance(eh.bsdf.f(eh.wo_local, wi_local) * ls.li) * wi_local.z.abs() / ls.pdf;
     if (v.is_nan() || v <= 0.0) || !v.is_finite() {
-        return 0.0;
+        return (0.0, 0.0);
     }
     // The renderer's shadow ray: from just off the surface to just short of the light point.
     if scene.geometry.occluded(&eh.hit.spawn_ray_to(ls.p_light)) {
+        return (0.0, 0.0);
+    }
+    let r = if ls.delta {
         0.0
     } else {
-        v
-    }
+        eh.bsdf.pdf(eh.wo_local, wi_local) / ls.pdf
+    };
+    (v, if r.is_finite() && r > 0.0 { r } else { 0.0 })
 }
 
 /// Two uniform numbers.

@@ -61,12 +61,7 @@ pub struct WaldSelector {
 
 /// Per-light maxima of one pass (f32 values, compared as is) and how often each light was
 /// tested.
-fn pass_maxima(
-    scene: &Scene,
-    set: &LightSet,
-    cfg: &WaldConfig,
-    pass: u32,
-) -> (Vec<f32>, Vec<u32>) {
+fn pass_maxima(scene: &Scene, set: &LightSet, cfg: &WaldConfig, pass: u32) -> (Vec<f32>, Vec<u32>) {
     let res = estimate_resolution(scene, cfg.resolution);
     let n = set.finite.len();
     let pixels = res.x * res.y;
