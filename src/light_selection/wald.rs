@@ -6,12 +6,14 @@
 //!
 //! Unbiasedness and tails: lights the passes never saw (or saw only occluded) would get
 //! probability 0, so the estimate is mixed with power selection: p = (1 − ε)·p_est + ε·p_Φ
-//! with ε = max([`WaldConfig::floor`] (default 10%), power mass of the lights no pass tested):
+//! with ε = max([`WaldConfig::floor`], power mass of the lights no pass tested):
 //! the estimate only takes over the probability of lights it has an opinion about. A light
-//! tested only where it is dark (a spot light whose cone the 16 random tests per pixel
-//! missed) still falls to ε·p_Φ, which gave `wald` its heavy tails; `make_selector` therefore
-//! mixes it once more with power selection at a share chosen by held-out probes
-//! ([`super::defensive`]), up to power alone where the estimate does not pay. The pmf does not
+//! tested only where it is dark (a spot light whose cone the random tests missed) gets no
+//! share of the estimate; with the former fixed 10 % floor it was then drawn at 1/10 of
+//! power's rate where it does shine, which gave `wald` its heavy tails. `make_selector`
+//! mixes the estimate with power selection at a share δ ≥ 10 % chosen by held-out probes
+//! ([`super::defensive`]): more power where the estimate misses light, power alone where the
+//! estimate does not pay. The pmf does not
 //! depend on the shading point.
 
 use super::estimate::{contribution, estimate_resolution, eye_hit, next_2d, pixel_rng};
@@ -30,20 +32,23 @@ pub struct WaldConfig {
     pub passes: u32,
     /// Lights tested (shadow rays) per estimation pixel and pass.
     pub lights_per_pixel: u32,
-    /// Share ε of power-proportional selection mixed in for unseen lights.
+    /// Share ε of power-proportional selection mixed in for unseen lights (at least the power
+    /// mass of the untested lights). 0 by default: `make_selector` mixes the estimate with
+    /// power selection again at a probed share of at least `DEFENSIVE_FLOOR`, which is the
+    /// floor every light keeps; a second 10 % here would only dilute the estimate.
     pub floor: f32,
     /// Seed (the render's seed).
     pub seed: u64,
 }
 
 impl WaldConfig {
-    /// Defaults: 64-pixel estimation image, 4 passes, 16 lights per pixel, 10% floor.
+    /// Defaults: 64-pixel estimation image, 4 passes, 16 lights per pixel, no floor of its own.
     pub fn new(seed: u64) -> Self {
         Self {
             resolution: 64,
             passes: 4,
             lights_per_pixel: 16,
-            floor: 0.1,
+            floor: 0.0,
             seed,
         }
     }
