@@ -43,10 +43,8 @@ impl TriangleLight {
 }
 
 impl LightSource for TriangleLight {
-    // Always inlined: into `Light::sample_li`'s dispatch (one call level and one copy of the
-    // returned sample fewer on every light sample of a triangle-lit scene), and into the
-    // integrator's lane kernel, which vectorises only if the whole lane body is inline (with
-    // plain `#[inline]`, LLVM sometimes kept it as a call there, one lane at a time).
+    // Always inlined: a call leaves the lane kernel one lane at a time (51e942d, 1-thread
+    // 256² 64 spp light-area 0.55 → 0.34 s).
     #[inline(always)]
     fn sample_li(
         &self,
