@@ -3,6 +3,9 @@
 //! the same image for any thread count, no NaN/Inf in any strategy × integrator × built-in
 //! scene, and the default Cornell box against Mitsuba 3's converged `path` render.
 
+mod furnace_support;
+
+use furnace_support::{STRATEGIES, furnace_scene, mean_se};
 use glam::UVec2;
 use penumbra::image::Image;
 use penumbra::image::io::read_image;
@@ -25,19 +28,7 @@ Shape "trianglemesh" "point3 P" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 
   "integer indices" [0 1 2 0 2 3  4 6 5 4 7 6  0 4 5 0 5 1  3 2 6 3 6 7  0 3 7 0 7 4  1 5 6 1 6 2]
 "#
     );
-    let parsed = penumbra::scene::pbrt::parse_pbrt_str("furnace.pbrt", &src, Path::new("."))
-        .expect("furnace scene parses");
-    let (b, cam, film, _) = parsed.into_builder().expect("furnace scene converts");
-    b.build(cam, film).expect("furnace scene builds")
-}
-
-/// Mean and standard error over the pixels (independent estimates) of the red channel.
-fn mean_se(img: &Image) -> (f64, f64) {
-    let px: Vec<f64> = img.pixels.iter().map(|p| p.x as f64).collect();
-    let n = px.len() as f64;
-    let mean = px.iter().sum::<f64>() / n;
-    let var = px.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
+    furnace_scene(&src)
 }
 
 fn path_opts(strategy: Strategy, mis: MisHeuristic, depth: u32, roulette: bool) -> RenderOptions {
@@ -52,14 +43,6 @@ fn path_opts(strategy: Strategy, mis: MisHeuristic, depth: u32, roulette: bool) 
         ..RenderOptions::default()
     }
 }
-
-const STRATEGIES: [(Strategy, MisHeuristic); 5] = [
-    (Strategy::Bsdf, MisHeuristic::Power),
-    (Strategy::LightArea, MisHeuristic::Power),
-    (Strategy::LightSolidAngle, MisHeuristic::Power),
-    (Strategy::Mis, MisHeuristic::Power),
-    (Strategy::Mis, MisHeuristic::Balance),
-];
 
 #[test]
 fn white_furnace_matches_the_geometric_series_for_every_strategy() {
