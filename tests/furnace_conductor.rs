@@ -16,11 +16,11 @@
 //!   after N terms, computed on θ-bins. Multiple bounces, and next-event estimation on the
 //!   sphere light from points of the sphere itself.
 
-mod furnace_support;
+mod render_support;
 
-use furnace_support::{STRATEGIES, furnace_scene, mean_se};
 use glam::{UVec2, Vec3};
 use penumbra::integrator::{IntegratorKind, RenderOptions, render};
+use render_support::{STRATEGIES, mean_se, pbrt_scene};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 const ALPHA: f64 = 0.3;
@@ -186,7 +186,7 @@ Shape "trianglemesh" "point3 P" [ -1000 -1000 0  1000 -1000 0  1000 1000 0  -100
         y = -10.0 * theta.sin(),
         z = 10.0 * theta.cos(),
     );
-    let s = furnace_scene(&src);
+    let s = pbrt_scene(&src);
     let want = albedo(ALPHA, theta.cos());
     let mut failures = Vec::new();
     for (strategy, mis) in STRATEGIES {
@@ -289,7 +289,7 @@ AttributeBegin
 AttributeEnd
 "#
     );
-    let s = furnace_scene(&src);
+    let s = pbrt_scene(&src);
     let depth = 6;
     let want = cavity(ALPHA, 1.0, depth, (180, 3, 192));
     let mut failures = Vec::new();

@@ -6,12 +6,12 @@
 //! earlier ones. A smooth-glass slab (lossless, two interfaces) seen through the same rule:
 //! every strategy must agree with BSDF sampling at the same max depth.
 
-mod furnace_support;
+mod render_support;
 
-use furnace_support::{STRATEGIES, furnace_scene, mean_se};
 use glam::UVec2;
 use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy, render};
 use penumbra::scene::Scene;
+use render_support::{STRATEGIES, mean_se, pbrt_scene};
 
 fn scene(material: &str, slab: bool) -> Scene {
     let theta = 50f64.to_radians();
@@ -35,7 +35,7 @@ Shape "trianglemesh" "point3 P" [ -1000 -1000 0  1000 -1000 0  1000 1000 0  -100
         y = -10.0 * theta.sin(),
         z = 10.0 * theta.cos(),
     );
-    furnace_scene(&src)
+    pbrt_scene(&src)
 }
 
 fn opts(

@@ -1,13 +1,13 @@
 //! White furnace through a rough-glass slab (two interfaces: needs path tracing). The expected
-//! radiance is derived in tests/furnace_support/slab.rs (an angular integral equation solved on
-//! a grid); here the solver is checked against the closed form of two diffuse-transmission
+//! radiance is derived in tests/furnace_support (an angular integral equation solved on a
+//! grid); here the solver is checked against the closed form of two diffuse-transmission
 //! sheets and for convergence on rough glass, the furnace scene's interfaces are checked to
 //! face the right way, and the path tracer (`penumbra render --integrator path`, the file's
 //! maxdepth 1000) is compared with the derived answer.
 
 mod furnace_support;
 
-use furnace_support::slab::{slab_furnace, slab_scene_mu, slab_scene_pbrt};
+use furnace_support::{slab_furnace, slab_scene_mu, slab_scene_pbrt};
 use glam::{Vec2, Vec3};
 use penumbra::bsdf::{Bsdf, Bxdf, Dielectric};
 use penumbra::geometry::{Ray, RayQuery};

@@ -5,12 +5,12 @@
 //! The light alone: at a point of the wall (normal inward) the whole hemisphere is the
 //! sphere, so the irradiance is π L in both sampling modes.
 
-mod furnace_support;
+mod render_support;
 
-use furnace_support::{STRATEGIES, furnace_scene, mean_se};
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::integrator::{IntegratorKind, RenderOptions, render};
 use penumbra::lights::{Emitter, LightSampleContext, LightSource, SamplingMode, SphereLight};
+use render_support::{STRATEGIES, mean_se, pbrt_scene};
 
 struct Rng(u64);
 impl Rng {
@@ -97,7 +97,7 @@ AttributeBegin
 AttributeEnd
 "#
     );
-    let scene = furnace_scene(&src);
+    let scene = pbrt_scene(&src);
     let mut failures = Vec::new();
     for (strategy, mis) in STRATEGIES {
         for (depth, roulette) in [(1, false), (4, false), (12, true)] {

@@ -3,15 +3,15 @@
 //! the same image for any thread count, no NaN/Inf in any strategy × integrator × built-in
 //! scene, and the default Cornell box against Mitsuba 3's converged `path` render.
 
-mod furnace_support;
+mod render_support;
 
-use furnace_support::{STRATEGIES, furnace_scene, mean_se};
 use glam::UVec2;
 use penumbra::image::Image;
 use penumbra::image::io::read_image;
 use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy, render};
 use penumbra::scene::Scene;
 use penumbra::scene::load::{LoadOptions, load};
+use render_support::{STRATEGIES, mean_se, pbrt_scene};
 use std::path::{Path, PathBuf};
 
 /// A closed cube (12 triangles, normals either way: the emission is two-sided) of diffuse
@@ -28,7 +28,7 @@ Shape "trianglemesh" "point3 P" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 
   "integer indices" [0 1 2 0 2 3  4 6 5 4 7 6  0 4 5 0 5 1  3 2 6 3 6 7  0 3 7 0 7 4  1 5 6 1 6 2]
 "#
     );
-    furnace_scene(&src)
+    pbrt_scene(&src)
 }
 
 fn path_opts(strategy: Strategy, mis: MisHeuristic, depth: u32, roulette: bool) -> RenderOptions {
