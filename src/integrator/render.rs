@@ -327,7 +327,7 @@ impl CameraLanes {
         }
     }
 
-    /// [`CameraLanes::rays`] as plain loops over the lanes, which the compiler vectorises.
+    /// [`CameraLanes::rays`] as plain loops over the lanes, compiled for each instruction set.
     #[inline(always)]
     fn rays_portable(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
         let o = Ray::new(camera.origin(), Vec3::Z);
