@@ -3,7 +3,7 @@
 //! so a chunk of 16 values is integer permutation rounds, integer hashes, one exact conversion
 //! and one IEEE division per value — the same f32s as the definition in `stratified.rs`
 //! (tests/pat_golden.rs). Plain loops over the chunk's 16 lanes, compiled for every instruction
-//! set the CPU runs (`Cpu::dispatch`); on AVX-512 the intrinsics form of `avx512.rs` serves instead.
+//! set the CPU runs (`Cpu::dispatch`); on AVX-512 the intrinsics of `avx512.rs` serve instead.
 
 use glam::Vec2;
 
