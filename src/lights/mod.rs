@@ -358,6 +358,20 @@ pub(crate) trait Planar: LightSource {
     /// samples by area. `sample_li` and `pdf_li` decide by this one rule and use this Ω, so
     /// a sample and its pdf agree.
     fn spherical_omega(&self, p: Vec3, mode: SamplingMode) -> Option<f32>;
+
+    /// The light-BVH bounds of this emitter inside the box `min`..`max`: one normal
+    /// (cos θo = 1) and diffuse emission over its hemisphere (cos θe = 0).
+    fn planar_bounds(&self, min: Vec3, max: Vec3) -> Option<LightBounds> {
+        Some(LightBounds {
+            min,
+            max,
+            w: self.normal(),
+            phi: self.power(),
+            cos_theta_o: 1.0,
+            cos_theta_e: 0.0,
+            two_sided: self.is_two_sided(),
+        })
+    }
 }
 
 impl<T: Planar> Emitter for T {

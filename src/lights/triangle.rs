@@ -87,15 +87,7 @@ impl LightSource for TriangleLight {
     fn bounds(&self) -> Option<LightBounds> {
         let min = self.p[0].min(self.p[1]).min(self.p[2]);
         let max = self.p[0].max(self.p[1]).max(self.p[2]);
-        Some(LightBounds {
-            min,
-            max,
-            w: self.n,
-            phi: self.power(),
-            cos_theta_o: 1.0,
-            cos_theta_e: 0.0,
-            two_sided: self.two_sided,
-        })
+        self.planar_bounds(min, max)
     }
 }
 
