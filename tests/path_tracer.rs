@@ -11,7 +11,7 @@ use penumbra::image::io::read_image;
 use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy, render};
 use penumbra::scene::Scene;
 use penumbra::scene::load::{LoadOptions, load};
-use render_support::{STRATEGIES, mean_se, pbrt_scene};
+use render_support::{STRATEGIES, mean_se, pbrt_scene, rel_mse};
 use std::path::{Path, PathBuf};
 
 /// A closed cube (12 triangles, normals either way: the emission is two-sided) of diffuse
@@ -195,18 +195,6 @@ fn no_nan_or_inf_in_any_strategy_integrator_and_builtin_scene() {
             }
         }
     }
-}
-
-fn rel_mse(a: &Image, b: &Image) -> f64 {
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    let mut s = 0.0f64;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        for c in 0..3 {
-            let (x, y) = (p[c] as f64, q[c] as f64);
-            s += (x - y) * (x - y) / (y * y + 0.01);
-        }
-    }
-    s / (3.0 * a.pixels.len() as f64)
 }
 
 #[test]

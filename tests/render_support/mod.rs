@@ -58,3 +58,17 @@ pub fn assert_fraction(what: &str, under: (f64, f64), open: (f64, f64), want: f6
         5.0 * sigma
     );
 }
+
+/// Relative MSE of `a` against the reference `b`: the mean over pixels and channels of
+/// (a − b)² / (b² + 0.01), written out here independently of `penumbra::image::metrics`.
+pub fn rel_mse(a: &Image, b: &Image) -> f64 {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let mut s = 0.0f64;
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
+        for c in 0..3 {
+            let (x, y) = (p[c] as f64, q[c] as f64);
+            s += (x - y) * (x - y) / (y * y + 0.01);
+        }
+    }
+    s / (3.0 * a.pixels.len() as f64)
+}
