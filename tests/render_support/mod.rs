@@ -1,6 +1,7 @@
 //! Small pbrt-v4 scenes rendered and measured (`mod render_support;`): the scene of a file's
 //! text, the strategy/heuristic pairs an unbiased answer must not depend on, the pixel mean
-//! with its standard error, and the check of a transmitted fraction (a ratio of two means).
+//! with its standard error, the check of a transmitted fraction (a ratio of two means), and
+//! the relative MSE against a reference image.
 #![allow(dead_code)] // Each test file uses part of this module.
 
 use penumbra::image::Image;
