@@ -97,7 +97,7 @@ impl RayShear4 {
     #[inline(always)]
     pub fn new(o: Vec3, d: Vec3) -> Self {
         let k = shear_axes(d);
-        // Arrays, not `Vec3` indexing: glam's runtime `Index` is a `match` (a jump table).
+        // Arrays, not `Vec3` indexing: glam's runtime `Index` is a `match` per access.
         let (oa, da) = (o.to_array(), d.to_array());
         let dz = da[k[2]];
         // One vector division instead of three scalar ones: IEEE quotients are the same, and
@@ -182,7 +182,7 @@ impl RayShear4 {
         if h.hit | h.redo == 0 {
             return None;
         }
-        // Arrays, not `Vec4` indexing by a runtime lane (glam's `Index` is a jump table).
+        // Arrays, not `Vec4` indexing by a runtime lane (glam's `Index` is a `match`).
         let t = h.t.to_array();
         let mut best_t = t_max;
         // The best lane, with its barycentrics only if the scalar redo produced them: those
