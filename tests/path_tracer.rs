@@ -268,7 +268,11 @@ fn integrator_directive_maps_to_path_with_its_depth_and_light_sampler() {
             .count();
         assert_eq!(n, 1, "{other}: {:?}", s.warnings);
     }
-    for (name, want) in [("uniform", "uniform"), ("bvh", "bvh")] {
+    for (name, want) in [
+        ("uniform", "uniform"),
+        ("bvh", "bvh"),
+        ("exhaustive", "exhaustive"),
+    ] {
         let s = parse(&format!(
             r#"Integrator "path" "string lightsampler" "{name}""#
         ));
