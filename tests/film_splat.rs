@@ -75,7 +75,10 @@ fn splatted_images_do_not_depend_on_the_thread_count() {
     };
     let one = bits(&run(1));
     for threads in [2, 3] {
-        assert!(one == bits(&run(threads)), "{threads} threads differ from 1");
+        assert!(
+            one == bits(&run(threads)),
+            "{threads} threads differ from 1"
+        );
     }
 }
 
