@@ -818,6 +818,7 @@ impl Parser {
                     Some("uniform") => Some(crate::light_selection::SelectorKind::Uniform),
                     Some("power") => Some(crate::light_selection::SelectorKind::Power),
                     Some("bvh") => Some(crate::light_selection::SelectorKind::Bvh),
+                    Some("exhaustive") => Some(crate::light_selection::SelectorKind::Exhaustive),
                     Some(other) => {
                         self.warn("lightsampler", &loc, format!("lightsampler \"{other}\" unknown: light selection by the --light-selection default"));
                         None
