@@ -377,7 +377,7 @@ fn street_segment(
     };
     let half_road = STREET * 0.5 - SIDEWALK;
     for (k, along) in [6.0, 18.0, 30.0].into_iter().enumerate() {
-        let s = if (k as u32 + i + j) % 2 == 0 {
+        let s = if (k as u32 + i + j).is_multiple_of(2) {
             1.0
         } else {
             -1.0
