@@ -490,21 +490,70 @@ fn read_with_image_crate(path: &Path, srgb: bool) -> anyhow::Result<Image> {
 /// Largest image the readers accept (16384², 3 GB as linear RGB).
 pub const MAX_READ_PIXELS: usize = 1 << 28;
 
-/// First RGB(A) layer of an EXR; falls back to a luminance-only ("Y") layer as grey.
-fn read_exr(path: &Path) -> anyhow::Result<Image> {
-    use exr::prelude::{RgbaChannels, Vec2, read_first_rgba_layer_from_file};
-    // The header's size is allocated before any pixel is decoded: a corrupt or hostile header
-    // must be an error, not an allocation abort (found by fuzz/, target `image`).
-    let meta =
-        exr::meta::MetaData::read_from_file(path, false).map_err(|e| anyhow::anyhow!("{e}"))?;
+/// The most uncompressed bytes one byte of an EXR file can hold under `compression`: the
+/// format's worst case, so that no real file is refused (deflate expands at most 1032:1, EXR's
+/// RLE 64:1 (128 bytes from a count and a value), PXR24 stores a float in 3 bytes before
+/// deflating, B44A a flat 4×4 half block in 3 bytes, DWA run-length codes then deflates).
+/// `None` for the methods the reader cannot decode.
+fn exr_max_expansion(compression: exr::compression::Compression) -> Option<u64> {
+    use exr::compression::Compression::*;
+    match compression {
+        Uncompressed => Some(1),
+        RLE => Some(64),
+        // PIZ's Huffman stage spends ≥ 9 bits on a run of ≤ 255 samples (~453:1).
+        ZIP1 | ZIP16 | PIZ => Some(1032),
+        PXR24 => Some(1032 * 4 / 3),
+        B44 | B44A => Some(11),
+        DWAA(_) | DWAB(_) => Some(64 * 1032),
+        _ => None,
+    }
+}
+
+/// Refuse an EXR whose headers declare more pixels than penumbra reads, or more pixel data
+/// than a file of `file_len` bytes can hold: the reader allocates the whole image from the
+/// header before it decodes a chunk, so a few hundred bytes could otherwise claim gigabytes
+/// (found by fuzz/, target `image`).
+fn check_exr_sizes(meta: &exr::meta::MetaData, file_len: u64) -> anyhow::Result<()> {
     for h in &meta.headers {
-        let (w, h) = (h.layer_size.width(), h.layer_size.height());
-        if w.saturating_mul(h) > MAX_READ_PIXELS {
+        let (w, ht) = (h.layer_size.width(), h.layer_size.height());
+        if w.saturating_mul(ht) > MAX_READ_PIXELS {
             bail!(
-                "the header claims {w}x{h} pixels, more than the {MAX_READ_PIXELS} penumbra reads"
+                "the header claims {w}x{ht} pixels, more than the {MAX_READ_PIXELS} penumbra reads"
+            );
+        }
+        let Some(expansion) = exr_max_expansion(h.compression) else {
+            bail!("{} compression is not supported", h.compression);
+        };
+        // Rows and tiles each cost an offset-table entry and a chunk header in the file.
+        let min_chunk_bytes = 16u64;
+        let chunks = h.chunk_count as u64;
+        if chunks.saturating_mul(min_chunk_bytes) > file_len {
+            bail!(
+                "the header of {w}x{ht} pixels needs {chunks} chunks, at least {} bytes,                  but the file has {file_len} bytes",
+                chunks.saturating_mul(min_chunk_bytes)
+            );
+        }
+        // Every channel of every pixel must come out of the file's bytes; the linear RGB image
+        // made from them is then at most 6 times that (one half channel as RGB f32).
+        let per_pixel = (h.channels.bytes_per_pixel as u64).max(1);
+        let declared = (w as u64 * ht as u64).saturating_mul(per_pixel);
+        let most = file_len.saturating_mul(expansion);
+        if declared > most {
+            bail!(
+                "the header claims {w}x{ht} pixels of {per_pixel} bytes ({declared} bytes),                  more than a {file_len}-byte file can hold with {} compression                  (at most {most} bytes)",
+                h.compression
             );
         }
     }
+    Ok(())
+}
+
+/// First RGB(A) layer of an EXR; falls back to a luminance-only ("Y") layer as grey.
+fn read_exr(path: &Path) -> anyhow::Result<Image> {
+    use exr::prelude::{RgbaChannels, Vec2, read_first_rgba_layer_from_file};
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| anyhow::anyhow!("{e}"))?;
+    check_exr_sizes(&meta, std::fs::metadata(path)?.len())?;
     let rgba = read_first_rgba_layer_from_file(
         path,
         |res: Vec2<usize>, _: &RgbaChannels| {
