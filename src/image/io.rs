@@ -529,7 +529,8 @@ fn check_exr_sizes(meta: &exr::meta::MetaData, file_len: u64) -> anyhow::Result<
         let chunks = h.chunk_count as u64;
         if chunks.saturating_mul(min_chunk_bytes) > file_len {
             bail!(
-                "the header of {w}x{ht} pixels needs {chunks} chunks, at least {} bytes,                  but the file has {file_len} bytes",
+                "the header of {w}x{ht} pixels needs {chunks} chunks, at least {} bytes, \
+                 but the file has {file_len} bytes",
                 chunks.saturating_mul(min_chunk_bytes)
             );
         }
@@ -540,7 +541,9 @@ fn check_exr_sizes(meta: &exr::meta::MetaData, file_len: u64) -> anyhow::Result<
         let most = file_len.saturating_mul(expansion);
         if declared > most {
             bail!(
-                "the header claims {w}x{ht} pixels of {per_pixel} bytes ({declared} bytes),                  more than a {file_len}-byte file can hold with {} compression                  (at most {most} bytes)",
+                "the header claims {w}x{ht} pixels of {per_pixel} bytes ({declared} bytes), \
+                 more than the file's {file_len} bytes can hold (compression: {}, which \
+                 expands at most {expansion}:1)",
                 h.compression
             );
         }
