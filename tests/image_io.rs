@@ -314,6 +314,12 @@ fn an_exr_header_cannot_make_the_reader_allocate_what_the_file_does_not_hold() {
             "{name}: the error should say what the header claims against the file: {err}"
         );
     }
+    // DWA's worst case (run-length coding, then deflate) lets 18 kB claim 1.2 GB: such a
+    // file passes the size check, and its image must still grow only as chunks decode.
+    let p = dir.join("dwaa-big.exr");
+    std::fs::write(&p, exr_header_only(14000, 14000, 8, None, 20_000)).unwrap();
+    let err = format!("{:#}", read_image(&p).unwrap_err());
+    assert!(err.contains("dwaa-big.exr"), "{err}");
     if let Some(peak) = peak_rss() {
         assert!(peak < PEAK_RSS_LIMIT, "peak memory {} MB", peak >> 20);
     }
@@ -360,9 +366,7 @@ fn highly_compressed_exrs_still_read() {
         ("pxr24.exr", Compression::PXR24),
         ("b44a.exr", Compression::B44A),
     ] {
-        let channels = SpecificChannels::rgb(|_: Vec2<usize>| {
-            (half_one(), half_one(), half_one())
-        });
+        let channels = SpecificChannels::rgb(|_: Vec2<usize>| (half_one(), half_one(), half_one()));
         let encoding = Encoding {
             compression,
             blocks: exr::image::Blocks::ScanLines,
@@ -375,7 +379,10 @@ fn highly_compressed_exrs_still_read() {
             channels,
         );
         let p = dir.join(name);
-        exr::image::Image::from_layer(layer).write().to_file(&p).unwrap();
+        exr::image::Image::from_layer(layer)
+            .write()
+            .to_file(&p)
+            .unwrap();
         let img = read_image(&p).unwrap_or_else(|e| panic!("{name}: {e:#}"));
         assert_eq!((img.width, img.height), (n as u32, n as u32));
         assert_eq!(img.get(17, 900), Rgb::ONE, "{name}");
@@ -384,4 +391,48 @@ fn highly_compressed_exrs_still_read() {
 
 fn half_one() -> exr::prelude::f16 {
     exr::prelude::f16::from_f32(1.0)
+}
+
+#[test]
+fn bottom_up_and_grey_exrs_read() {
+    // Rows stored bottom to top arrive last row first: the image must still be whole.
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Encoding, FlatSamples, LineOrder, SpecificChannels, Text, Vec2,
+        WritableImage,
+    };
+    let dir = scratch("exrorder");
+    let (w, h) = (5usize, 40usize);
+    let value = |x: usize, y: usize| (y * w + x) as f32;
+    let channels =
+        SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| (value(x, y), 2.0 * value(x, y), 0.5));
+    let encoding = Encoding {
+        line_order: LineOrder::Decreasing,
+        ..Encoding::FAST_LOSSLESS
+    };
+    let layer = exr::image::Layer::new(
+        (w, h),
+        exr::meta::header::LayerAttributes::default(),
+        encoding,
+        channels,
+    );
+    let p = dir.join("decreasing.exr");
+    exr::image::Image::from_layer(layer)
+        .write()
+        .to_file(&p)
+        .unwrap();
+    let img = read_image(&p).unwrap();
+    for (x, y) in [(0, 0), (4, 0), (2, 17), (4, 39)] {
+        let v = value(x, y);
+        assert_eq!(img.get(x as u32, y as u32), Rgb::new(v, 2.0 * v, 0.5));
+    }
+    // A luminance-only file reads as grey.
+    let y_channel = AnyChannel::new(
+        Text::from("Y"),
+        FlatSamples::F32((0..w * h).map(|i| i as f32).collect()),
+    );
+    let grey = exr::image::Image::from_channels((w, h), AnyChannels::sort(vec![y_channel].into()));
+    let p = dir.join("grey.exr");
+    grey.write().to_file(&p).unwrap();
+    let img = read_image(&p).unwrap();
+    assert_eq!(img.get(3, 2), Rgb::splat(value(3, 2)));
 }

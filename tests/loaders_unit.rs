@@ -1021,7 +1021,10 @@ fn camera_flags_keep_an_orthographic_or_spherical_cameras_projection_and_lens() 
             "\"orthographic\" \"float lensradius\" 0.1 \"float focaldistance\" 4",
             Projection::Orthographic,
         ),
-        ("\"spherical\"", Projection::Spherical(penumbra::camera::SphericalMapping::EqualArea)),
+        (
+            "\"spherical\"",
+            Projection::Spherical(penumbra::camera::SphericalMapping::EqualArea),
+        ),
     ] {
         let src = format!(
             "LookAt 0 0 5  0 0 0  0 1 0\nCamera {camera}\nWorldBegin\n\

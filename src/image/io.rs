@@ -557,19 +557,32 @@ fn read_exr(path: &Path) -> anyhow::Result<Image> {
     let meta =
         exr::meta::MetaData::read_from_file(path, false).map_err(|e| anyhow::anyhow!("{e}"))?;
     check_exr_sizes(&meta, std::fs::metadata(path)?.len())?;
+    // The image grows as decoded pixels arrive (rows in file order) rather than being
+    // allocated whole from the header: a file whose chunks are missing or broken fails before
+    // it costs the memory its header claims.
     let rgba = read_first_rgba_layer_from_file(
         path,
-        |res: Vec2<usize>, _: &RgbaChannels| {
-            (res.width(), vec![Rgb::ZERO; res.width() * res.height()])
-        },
-        |(w, px): &mut (usize, Vec<Rgb>), pos: Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
-            px[pos.y() * *w + pos.x()] = Rgb::new(r, g, b);
+        |res: Vec2<usize>, _: &RgbaChannels| (res.width(), res.height(), Vec::<Rgb>::new()),
+        |(w, _, px): &mut (usize, usize, Vec<Rgb>),
+         pos: Vec2<usize>,
+         (r, g, b, _a): (f32, f32, f32, f32)| {
+            let i = pos.y() * *w + pos.x();
+            if i >= px.len() {
+                px.resize(i + 1, Rgb::ZERO);
+            }
+            px[i] = Rgb::new(r, g, b);
         },
     );
+    // Only a first layer with a luminance channel is worth the second, grey, decode.
+    let has_y = meta
+        .headers
+        .first()
+        .is_some_and(|h| h.channels.list.iter().any(|c| c.name.to_string() == "Y"));
     match rgba {
         Ok(img) => {
             let size = img.layer_data.size;
-            let (_, pixels) = img.layer_data.channel_data.pixels;
+            let (w, h, mut pixels) = img.layer_data.channel_data.pixels;
+            pixels.resize(w * h, Rgb::ZERO);
             Ok(Image {
                 width: u32::try_from(size.width())?,
                 height: u32::try_from(size.height())?,
@@ -577,7 +590,8 @@ fn read_exr(path: &Path) -> anyhow::Result<Image> {
             })
         }
         // exr's errors print their io cause in their own message: keep that one only.
-        Err(rgba_err) => read_exr_grey(path).map_err(|_| anyhow::anyhow!("{rgba_err}")),
+        Err(rgba_err) if has_y => read_exr_grey(path).map_err(|_| anyhow::anyhow!("{rgba_err}")),
+        Err(rgba_err) => Err(anyhow::anyhow!("{rgba_err}")),
     }
 }
 
