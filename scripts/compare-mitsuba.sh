@@ -5,6 +5,11 @@
 # (Mitsuba's `path`, max depth -1; penumbra's `--integrator path`, the file's maxdepth 65, MIS)
 # against ../shared/reference/cornell-path-4096spp.exr. MODES="mis emitter bsdf path" picks.
 #
+# Both films splat: Mitsuba's hdrfilm adds each sample to every pixel its tent filter reaches
+# and divides by the weight sum; penumbra does the same with --splat (FILM=fis for its filter
+# importance sampling, which counts each sample in one pixel: the same mean, more noise per
+# pixel).
+#
 # Needs a Mitsuba venv (python3 -m venv V && V/bin/pip install mitsuba numpy) and Debian's
 # libllvm19. Usage: scripts/compare-mitsuba.sh [VENV] [PROFILE]   (defaults: /work/mitsuba-venv, release)
 set -euo pipefail
@@ -39,9 +44,10 @@ for mode in ${MODES:-mis emitter bsdf path}; do
   # Uniform light selection, as in the README's table: the box's one quad is two equal
   # triangles, so it draws what Mitsuba's power-weighted emitter choice draws, without the
   # default light BVH's per-sample cost (docs/many-lights.md).
+  film=""; [ "${FILM:-splat}" = splat ] && film="--splat"
   # shellcheck disable=SC2086
   /usr/bin/time -f "penumbra TIME %e s wall, %U s user, %S s sys (load $(cut -d' ' -f1-3 /proc/loadavg))" \
-    $BIN render cornell --spp 64 --seed 1 --quiet --light-selection uniform $ours \
+    $BIN render cornell --spp 64 --seed 1 --quiet --light-selection uniform $ours $film \
     -o "$OUT/penumbra-$mode.exr"
   echo "mitsuba $mode vs reference:";  $BIN compare "$OUT/mitsuba-$mode.exr" "$REF" | grep relMSE
   echo "penumbra $mode vs reference:"; $BIN compare "$OUT/penumbra-$mode.exr" "$REF" | grep relMSE

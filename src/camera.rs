@@ -226,9 +226,10 @@ impl CameraRays {
 
     /// The unit direction of a pinhole perspective camera's ray through raster position `p`:
     /// the one definition of the pinhole math. Plain f32 arithmetic (no 4-lane matrix code),
-    /// so that a loop over many positions vectorises lane by lane; the transform multiplies
+    /// so a packet's 16 camera rays are made lane by lane at once; the transform multiplies
     /// and adds in the order of glam's `Mat4::transform_vector3` (x, then + y, then + z), so
     /// the bits are those of `camera_to_world.vector(d).normalize()`.
+    // Lane by lane over 16 rays: 1-thread mis-area 256² 64 spp 0.746 → 0.666 s (dea89ab).
     #[inline(always)]
     pub fn direction(&self, p: Vec2) -> Vec3 {
         let d = self.screen(p) * self.tan_half;

@@ -5,6 +5,8 @@
 //! kept hits carry the hit record of the same quad without a mask; and through the pbrt
 //! loader a direct-lighting render under a cut-out roof is 1 − c of the unshadowed one.
 
+mod render_support;
+
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::interaction::NO_LIGHT;
 use penumbra::geometry::{
@@ -12,6 +14,7 @@ use penumbra::geometry::{
 };
 use penumbra::integrator::{RenderOptions, render};
 use penumbra::sampling::{PatternKind, make_pattern};
+use render_support::{assert_fraction, mean_se, pbrt_scene_in};
 use std::sync::Arc;
 
 /// The quad [-1, 1]² at height z as triangles of mesh `mesh` (uv = ((x+1)/2, (y+1)/2)).
@@ -240,18 +243,11 @@ fn roof_scene(alpha: Option<f32>) -> String {
 }
 
 fn render_mean(alpha: Option<f32>) -> (f64, f64) {
-    let parsed = penumbra::scene::pbrt::parse_pbrt_str(
-        "roof.pbrt",
-        &roof_scene(alpha),
-        std::path::Path::new("."),
-    )
-    .unwrap();
-    let (b, cam, film, warnings) = parsed.into_builder().unwrap();
+    let (scene, warnings) = pbrt_scene_in(&roof_scene(alpha), std::path::Path::new("."));
     assert!(
         !warnings.iter().any(|w| w.contains("alpha")),
         "alpha warned about: {warnings:?}"
     );
-    let scene = b.build(cam, film).unwrap();
     let opts = RenderOptions {
         spp: 16,
         seed: 5,
@@ -259,34 +255,23 @@ fn render_mean(alpha: Option<f32>) -> (f64, f64) {
         ..RenderOptions::default()
     };
     let (img, _) = render(&scene, UVec2::new(24, 24), &opts).unwrap();
-    let v: Vec<f64> = img.pixels.iter().map(|p| p.x as f64).collect();
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
+    mean_se(&img)
 }
 
 #[test]
 fn pbrt_cut_out_roof_passes_one_minus_coverage_of_the_sun() {
-    let (open, open_err) = render_mean(None);
-    assert!(open > 0.01, "unshadowed ground is black: {open}");
+    let open = render_mean(None);
     let c = 0.35;
-    let (under, err) = render_mean(Some(c));
-    let ratio = under / open;
-    let sigma = (err * err + (ratio * open_err).powi(2)).sqrt() / open;
-    eprintln!(
-        "roof of coverage {c}: ground {under:.5} ± {err:.5} vs open {open:.5}: ratio {ratio:.4} ± {sigma:.4}"
-    );
-    assert!(sigma > 0.0 && sigma < 0.02, "σ {sigma}");
-    assert!(
-        (ratio - (1.0 - c as f64)).abs() <= 5.0 * sigma,
-        "ratio {ratio} is not {} within 5σ = {}",
+    let under = render_mean(Some(c));
+    assert_fraction(
+        &format!("roof of coverage {c}"),
+        under,
+        open,
         1.0 - c as f64,
-        5.0 * sigma
     );
     // An opaque roof (alpha 1 is no cut-out) blocks the sun entirely.
     let (shut, _) = render_mean(Some(1.0));
-    assert!(shut < 1e-6 * open, "opaque roof lets {shut} through");
+    assert!(shut < 1e-6 * open.0, "opaque roof lets {shut} through");
 }
 
 /// A leaf over the quad's uv square: inside |v − ½| < ½·sin(πu) (area 2/π), outside nothing.

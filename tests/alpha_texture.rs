@@ -7,18 +7,18 @@
 //! far finer than a pixel, so every pixel's expectation is the pattern's mean; the bounds are
 //! 5σ of the measured pixel variance.
 
+mod render_support;
+
+mod texture_support;
+
 use glam::UVec2;
 use penumbra::Rgb;
 use penumbra::image::Image;
 use penumbra::image::io::write_image;
 use penumbra::integrator::{RenderOptions, render};
-use std::path::{Path, PathBuf};
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("penumbra-atex-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use render_support::{assert_fraction, mean_se, pbrt_scene_in};
+use std::path::Path;
+use texture_support::tmpdir;
 
 /// The roof's alpha: none, a checkerboard texture, or a tiled 2×2 image.
 #[derive(Clone, Copy)]
@@ -76,16 +76,13 @@ fn write_coverage(dir: &Path) {
 
 /// Mean of the red channel over the image and its standard error.
 fn render_mean(roof: Roof, above: bool, dir: &Path) -> (f64, f64) {
-    let parsed = penumbra::scene::pbrt::parse_pbrt_str("roof.pbrt", &scene(roof, above), dir)
-        .unwrap_or_else(|e| panic!("{e:#}"));
-    let (b, cam, film, warnings) = parsed.into_builder().unwrap();
+    let (scene, warnings) = pbrt_scene_in(&scene(roof, above), dir);
     assert!(
         !warnings
             .iter()
             .any(|w| w.contains("alpha") || w.contains("texture")),
         "alpha or textures warned about: {warnings:?}"
     );
-    let scene = b.build(cam, film).unwrap();
     let opts = RenderOptions {
         spp: 16,
         seed: 9,
@@ -93,26 +90,14 @@ fn render_mean(roof: Roof, above: bool, dir: &Path) -> (f64, f64) {
         ..RenderOptions::default()
     };
     let (img, _) = render(&scene, UVec2::new(24, 24), &opts).unwrap();
-    let v: Vec<f64> = img.pixels.iter().map(|p| p.x as f64).collect();
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
+    mean_se(&img)
 }
 
+/// Assert that the roof passes `want` of the open ground's radiance.
 fn check(what: &str, roof: Roof, above: bool, want: f64, dir: &Path) {
-    let (open, open_err) = render_mean(Roof::Open, above, dir);
-    assert!(open > 0.01, "unshadowed ground is black: {open}");
-    let (under, err) = render_mean(roof, above, dir);
-    let ratio = under / open;
-    let sigma = (err * err + (ratio * open_err).powi(2)).sqrt() / open;
-    eprintln!("{what}: ratio {ratio:.4} ± {sigma:.4}, expected {want:.4}");
-    assert!(sigma > 0.0 && sigma < 0.02, "{what}: σ {sigma}");
-    assert!(
-        (ratio - want).abs() <= 5.0 * sigma,
-        "{what}: ratio {ratio} is not {want} within 5σ = {}",
-        5.0 * sigma
-    );
+    let open = render_mean(Roof::Open, above, dir);
+    let under = render_mean(roof, above, dir);
+    assert_fraction(what, under, open, want);
 }
 
 #[test]
@@ -159,9 +144,7 @@ fn coarse_checker_alpha_cuts_where_it_is_zero() {
             "\"float tex1\" 0.7 \"float tex2\" 0.1",
             "\"float tex1\" 1 \"float tex2\" 0",
         );
-    let parsed = penumbra::scene::pbrt::parse_pbrt_str("roof.pbrt", &src, &dir).unwrap();
-    let (b, cam, film, _) = parsed.into_builder().unwrap();
-    let scene = b.build(cam, film).unwrap();
+    let (scene, _) = pbrt_scene_in(&src, &dir);
     let opts = RenderOptions {
         spp: 4,
         seed: 1,

@@ -1,11 +1,14 @@
 //! The built-in Cornell box against Mitsuba 3's converged direct-lighting render
 //! (../shared/reference, tolerances from its README: relMSE at 64 spp, mean within 0.5% / 2%).
 
+mod render_support;
+
 use glam::UVec2;
 use penumbra::image::Image;
 use penumbra::image::io::read_image;
 use penumbra::integrator::{RenderOptions, Strategy, render};
 use penumbra::scene::load::{LoadOptions, load};
+use render_support::rel_mse;
 use std::path::PathBuf;
 
 fn reference() -> Image {
@@ -17,18 +20,6 @@ fn reference() -> Image {
         p.display()
     );
     read_image(&p).expect("reading the reference EXR")
-}
-
-fn rel_mse(a: &Image, b: &Image) -> f64 {
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    let mut s = 0.0f64;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        for c in 0..3 {
-            let (x, y) = (p[c] as f64, q[c] as f64);
-            s += (x - y) * (x - y) / (y * y + 0.01);
-        }
-    }
-    s / (3.0 * a.pixels.len() as f64)
 }
 
 fn check(strategy: Strategy, max_rel_mse: f64, mean_tol: f64) {

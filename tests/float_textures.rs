@@ -4,53 +4,26 @@
 //! constant-roughness conductor of each texel's value) and as the factor of a spectrum `scale`
 //! texture (a diffuse plane of reflectance 0.2 | 0.8 under irradiance π renders 0.2 | 0.8).
 
+mod texture_support;
+
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::Rgb;
-use penumbra::geometry::SurfaceHit;
 use penumbra::image::Image;
 use penumbra::image::io::{srgb_to_linear, write_image};
 use penumbra::integrator::{RenderOptions, render};
 use penumbra::material::{FloatTexture, Material, Texture};
 use penumbra::scene::pbrt::materials::to_material;
 use penumbra::scene::pbrt::{PbrtScene, parse_pbrt_str};
-use std::path::{Path, PathBuf};
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("penumbra-ftex-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use std::path::Path;
+use texture_support::{halves, hit_at, tmpdir};
 
 fn parse(src: &str, dir: &Path) -> PbrtScene {
     parse_pbrt_str("t.pbrt", src, dir).unwrap_or_else(|e| panic!("{e:#}"))
 }
 
-/// An 8×1 image whose left four texels are `a` and right four `b` (all channels).
-fn halves(path: &Path, a: f32, b: f32) {
-    let mut img = Image::new(8, 1);
-    for (i, p) in img.pixels.iter_mut().enumerate() {
-        *p = Rgb::splat(if i < 4 { a } else { b });
-    }
-    write_image(&img, path, 0.0).unwrap();
-}
-
 fn material(s: &PbrtScene, i: usize) -> Material {
     let mut w = Vec::new();
     to_material(&s.materials[i], &s.images, &mut w).unwrap()
-}
-
-fn hit_at(uv: Vec2) -> SurfaceHit {
-    SurfaceHit {
-        t: 1.0,
-        p: Vec3::ZERO,
-        ng: Vec3::Z,
-        ns: Vec3::Z,
-        uv,
-        p_error: 0.0,
-        prim: 0,
-        material: 0,
-        light: 0,
-    }
 }
 
 /// The float texture behind diffuse material `i`'s reflectance (white × float).

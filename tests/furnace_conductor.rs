@@ -16,12 +16,12 @@
 //!   after N terms, computed on θ-bins. Multiple bounces, and next-event estimation on the
 //!   sphere light from points of the sphere itself.
 
+mod render_support;
+
 use glam::{UVec2, Vec3};
-use penumbra::image::Image;
-use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy, render};
-use penumbra::scene::Scene;
+use penumbra::integrator::{IntegratorKind, RenderOptions, render};
+use render_support::{STRATEGIES, mean_se, pbrt_scene};
 use std::f64::consts::{FRAC_PI_2, PI};
-use std::path::Path;
 
 const ALPHA: f64 = 0.3;
 
@@ -167,32 +167,8 @@ fn penumbra_conductor_is_the_ggx_written_here() {
     }
 }
 
-fn scene(src: &str) -> Scene {
-    let parsed = penumbra::scene::pbrt::parse_pbrt_str("furnace.pbrt", src, Path::new("."))
-        .expect("furnace scene parses");
-    let (b, cam, film, _) = parsed.into_builder().expect("furnace scene converts");
-    b.build(cam, film).expect("furnace scene builds")
-}
-
 const METAL: &str = r#"Material "conductor" "rgb eta" [ 1 1 1 ] "rgb k" [ 1000 1000 1000 ]
     "float roughness" [ 0.3 ] "bool remaproughness" false"#;
-
-/// Mean and standard error over the pixels (independent estimates) of the red channel.
-fn mean_se(img: &Image) -> (f64, f64) {
-    let px: Vec<f64> = img.pixels.iter().map(|p| p.x as f64).collect();
-    let n = px.len() as f64;
-    let mean = px.iter().sum::<f64>() / n;
-    let var = px.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
-}
-
-const STRATEGIES: [(Strategy, MisHeuristic); 5] = [
-    (Strategy::Bsdf, MisHeuristic::Power),
-    (Strategy::LightArea, MisHeuristic::Power),
-    (Strategy::LightSolidAngle, MisHeuristic::Power),
-    (Strategy::Mis, MisHeuristic::Power),
-    (Strategy::Mis, MisHeuristic::Balance),
-];
 
 #[test]
 fn rough_conductor_plane_under_a_uniform_sky_has_its_directional_albedo() {
@@ -210,7 +186,7 @@ Shape "trianglemesh" "point3 P" [ -1000 -1000 0  1000 -1000 0  1000 1000 0  -100
         y = -10.0 * theta.sin(),
         z = 10.0 * theta.cos(),
     );
-    let s = scene(&src);
+    let s = pbrt_scene(&src);
     let want = albedo(ALPHA, theta.cos());
     let mut failures = Vec::new();
     for (strategy, mis) in STRATEGIES {
@@ -313,7 +289,7 @@ AttributeBegin
 AttributeEnd
 "#
     );
-    let s = scene(&src);
+    let s = pbrt_scene(&src);
     let depth = 6;
     let want = cavity(ALPHA, 1.0, depth, (180, 3, 192));
     let mut failures = Vec::new();

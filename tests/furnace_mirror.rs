@@ -6,19 +6,12 @@
 //! earlier ones. A smooth-glass slab (lossless, two interfaces) seen through the same rule:
 //! every strategy must agree with BSDF sampling at the same max depth.
 
+mod render_support;
+
 use glam::UVec2;
-use penumbra::image::Image;
 use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy, render};
 use penumbra::scene::Scene;
-use std::path::Path;
-
-const STRATEGIES: [(Strategy, MisHeuristic); 5] = [
-    (Strategy::Bsdf, MisHeuristic::Power),
-    (Strategy::LightArea, MisHeuristic::Power),
-    (Strategy::LightSolidAngle, MisHeuristic::Power),
-    (Strategy::Mis, MisHeuristic::Power),
-    (Strategy::Mis, MisHeuristic::Balance),
-];
+use render_support::{STRATEGIES, mean_se, pbrt_scene};
 
 fn scene(material: &str, slab: bool) -> Scene {
     let theta = 50f64.to_radians();
@@ -42,18 +35,7 @@ Shape "trianglemesh" "point3 P" [ -1000 -1000 0  1000 -1000 0  1000 1000 0  -100
         y = -10.0 * theta.sin(),
         z = 10.0 * theta.cos(),
     );
-    let parsed =
-        penumbra::scene::pbrt::parse_pbrt_str("mirror.pbrt", &src, Path::new(".")).expect("parses");
-    let (b, cam, film, _) = parsed.into_builder().unwrap();
-    b.build(cam, film).unwrap()
-}
-
-fn mean_se(img: &Image) -> (f64, f64) {
-    let px: Vec<f64> = img.pixels.iter().map(|p| p.x as f64).collect();
-    let n = px.len() as f64;
-    let mean = px.iter().sum::<f64>() / n;
-    let var = px.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
+    pbrt_scene(&src)
 }
 
 fn opts(

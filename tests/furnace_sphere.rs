@@ -5,11 +5,12 @@
 //! The light alone: at a point of the wall (normal inward) the whole hemisphere is the
 //! sphere, so the irradiance is π L in both sampling modes.
 
+mod render_support;
+
 use glam::{UVec2, Vec2, Vec3};
-use penumbra::image::Image;
-use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy, render};
+use penumbra::integrator::{IntegratorKind, RenderOptions, render};
 use penumbra::lights::{Emitter, LightSampleContext, LightSource, SamplingMode, SphereLight};
-use std::path::Path;
+use render_support::{STRATEGIES, mean_se, pbrt_scene};
 
 struct Rng(u64);
 impl Rng {
@@ -80,14 +81,6 @@ fn inward_sphere_light_seen_from_its_own_surface_gives_pi_l() {
     assert!(failures.is_empty(), "{failures:?}");
 }
 
-fn mean_se(img: &Image) -> (f64, f64) {
-    let px: Vec<f64> = img.pixels.iter().map(|p| p.x as f64).collect();
-    let n = px.len() as f64;
-    let mean = px.iter().sum::<f64>() / n;
-    let var = px.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
-}
-
 #[test]
 fn diffuse_sphere_furnace_for_every_strategy() {
     let rho = 0.5f64;
@@ -104,18 +97,9 @@ AttributeBegin
 AttributeEnd
 "#
     );
-    let parsed =
-        penumbra::scene::pbrt::parse_pbrt_str("sphere.pbrt", &src, Path::new(".")).expect("parses");
-    let (b, cam, film, _) = parsed.into_builder().unwrap();
-    let scene = b.build(cam, film).unwrap();
+    let scene = pbrt_scene(&src);
     let mut failures = Vec::new();
-    for (strategy, mis) in [
-        (Strategy::Bsdf, MisHeuristic::Power),
-        (Strategy::LightArea, MisHeuristic::Power),
-        (Strategy::LightSolidAngle, MisHeuristic::Power),
-        (Strategy::Mis, MisHeuristic::Power),
-        (Strategy::Mis, MisHeuristic::Balance),
-    ] {
+    for (strategy, mis) in STRATEGIES {
         for (depth, roulette) in [(1, false), (4, false), (12, true)] {
             let opts = RenderOptions {
                 spp: 32,

@@ -3,7 +3,10 @@
 //! is wrong, or a load that says what it did with a warning — never a silent black or changed
 //! image, never a panic, never panic text on the terminal.
 
+mod gltf_support;
+
 use glam::Vec3;
+use gltf_support::base64;
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, Loaded, load};
 use penumbra::scene::view::ViewOptions;
@@ -60,24 +63,6 @@ const TRI: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
 const PBRT: &str =
     "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n";
 const PBRT_TRI: &str = "Shape \"trianglemesh\" \"point3 P\" [-1 -1 0 1 -1 0 0 1 0]\n";
-
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16
-            | (*c.get(1).unwrap_or(&0) as u32) << 8
-            | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            if k <= c.len() {
-                out.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
-}
 
 /// One triangle (3 × vec3 f32 at 0, 3 × u16 indices at 36) and, if given, a KHR punctual
 /// light in front of it: `position` and `indices` are the accessors' JSON, `material` is

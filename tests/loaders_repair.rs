@@ -4,7 +4,10 @@
 //! empty meshes, and says so in one warning per mesh naming file and line with the counts. A
 //! mesh with nothing left is dropped; a scene with nothing left at all is still an error.
 
+mod gltf_support;
+
 use glam::{UVec2, Vec3};
+use gltf_support::base64;
 use penumbra::geometry::{Ray, RayQuery};
 use penumbra::integrator::{RenderOptions, render};
 use penumbra::scene::Scene;
@@ -314,24 +317,6 @@ fn gltf_with_bad_normals() -> Vec<u8> {
     )
     .replace(r#""scenes": [{"nodes": [0]}]"#, r#""scenes": [{"nodes": [0, 1]}]"#)
     .into_bytes()
-}
-
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16
-            | (*c.get(1).unwrap_or(&0) as u32) << 8
-            | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            if k <= c.len() {
-                out.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
 }
 
 #[test]

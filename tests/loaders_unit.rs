@@ -1,7 +1,10 @@
 //! Loader unit tests on small generated files: glTF camera conversion, photometric units,
 //! the Ka-emission flag, automatic framing and broken inputs (errors must name the file).
 
+mod gltf_support;
+
 use glam::{Mat4, Quat, UVec2, Vec2, Vec3};
+use gltf_support::base64;
 use penumbra::lights::Light;
 use penumbra::scene::gltf::{LUMENS_PER_WATT, gltf_camera, load_gltf, punctual_light};
 use penumbra::scene::load::{LoadOptions, load};
@@ -384,24 +387,6 @@ fn gltf_json(buffer: &str) -> String {
   ]
 }}"#
     )
-}
-
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16
-            | (*c.get(1).unwrap_or(&0) as u32) << 8
-            | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            if k <= c.len() {
-                out.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
 }
 
 /// A GLB container around `json` and `bin`.

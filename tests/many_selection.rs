@@ -2,10 +2,11 @@
 //! draws from it (chi² on the light indices), `sample` and `pmf` agree, renders agree with
 //! uniform selection within noise, and the light BVH never loses a light that contributes.
 
+mod selection_support;
+
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::Rgb;
 use penumbra::camera::Camera;
-use penumbra::image::Image;
 use penumbra::integrator::{RenderOptions, render};
 use penumbra::light_selection::bvh::BvhSelector;
 use penumbra::light_selection::{
@@ -20,22 +21,10 @@ use penumbra::sampling::chi2::{Chi2Config, chi2_discrete};
 use penumbra::sampling::hash::{next_f32, pcg_from_keys};
 use penumbra::scene::{AreaEmission, FilmSpec, Filter, Scene, SceneBuilder};
 use rand_pcg::Pcg32;
+use selection_support::{mean_and_variance, u, unit};
 
 /// Chi² tests in this file (Šidák correction): 2 shading points × every strategy.
 const NUM_CHI2: usize = 2 * 7;
-
-fn u(rng: &mut Pcg32, a: f32, b: f32) -> f32 {
-    a + (b - a) * next_f32(rng)
-}
-
-fn unit(rng: &mut Pcg32) -> Vec3 {
-    loop {
-        let v = Vec3::new(u(rng, -1.0, 1.0), u(rng, -1.0, 1.0), u(rng, -1.0, 1.0));
-        if v.length_squared() > 0.01 && v.length_squared() <= 1.0 {
-            return v.normalize();
-        }
-    }
-}
 
 /// A small many-light scene: a floor, two boxes, 150 area lights of random size, orientation
 /// and power (some two-sided), a point light, a spot light and a dim uniform sky.
@@ -393,23 +382,6 @@ fn bvh_is_compact() {
         "{} B/light",
         bvh.bytes_per_light()
     );
-}
-
-/// Mean of all channels of all pixels, and the variance of that mean from the per-pixel
-/// difference of two independent renders (noise only, not the image's own variation).
-fn mean_and_variance(a: &Image, b: &Image) -> (f64, f64) {
-    let n = (a.pixels.len() * 3) as f64;
-    let (mut sum, mut d2) = (0.0f64, 0.0f64);
-    for (x, y) in a.pixels.iter().zip(&b.pixels) {
-        for c in 0..3 {
-            sum += (x[c] + y[c]) as f64 * 0.5;
-            let d = (x[c] - y[c]) as f64;
-            d2 += d * d;
-        }
-    }
-    // Var(pixel) ≈ E[(a − b)²] / 2; the mean of the two renders halves it again.
-    let var_pixel = d2 / n / 2.0;
-    (sum / n, var_pixel / n / 2.0)
 }
 
 #[test]

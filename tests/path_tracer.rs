@@ -3,12 +3,15 @@
 //! the same image for any thread count, no NaN/Inf in any strategy × integrator × built-in
 //! scene, and the default Cornell box against Mitsuba 3's converged `path` render.
 
+mod render_support;
+
 use glam::UVec2;
 use penumbra::image::Image;
 use penumbra::image::io::read_image;
 use penumbra::integrator::{IntegratorKind, MisHeuristic, RenderOptions, Strategy, render};
 use penumbra::scene::Scene;
 use penumbra::scene::load::{LoadOptions, load};
+use render_support::{STRATEGIES, mean_se, pbrt_scene, rel_mse};
 use std::path::{Path, PathBuf};
 
 /// A closed cube (12 triangles, normals either way: the emission is two-sided) of diffuse
@@ -25,19 +28,7 @@ Shape "trianglemesh" "point3 P" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 
   "integer indices" [0 1 2 0 2 3  4 6 5 4 7 6  0 4 5 0 5 1  3 2 6 3 6 7  0 3 7 0 7 4  1 5 6 1 6 2]
 "#
     );
-    let parsed = penumbra::scene::pbrt::parse_pbrt_str("furnace.pbrt", &src, Path::new("."))
-        .expect("furnace scene parses");
-    let (b, cam, film, _) = parsed.into_builder().expect("furnace scene converts");
-    b.build(cam, film).expect("furnace scene builds")
-}
-
-/// Mean and standard error over the pixels (independent estimates) of the red channel.
-fn mean_se(img: &Image) -> (f64, f64) {
-    let px: Vec<f64> = img.pixels.iter().map(|p| p.x as f64).collect();
-    let n = px.len() as f64;
-    let mean = px.iter().sum::<f64>() / n;
-    let var = px.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
+    pbrt_scene(&src)
 }
 
 fn path_opts(strategy: Strategy, mis: MisHeuristic, depth: u32, roulette: bool) -> RenderOptions {
@@ -52,14 +43,6 @@ fn path_opts(strategy: Strategy, mis: MisHeuristic, depth: u32, roulette: bool) 
         ..RenderOptions::default()
     }
 }
-
-const STRATEGIES: [(Strategy, MisHeuristic); 5] = [
-    (Strategy::Bsdf, MisHeuristic::Power),
-    (Strategy::LightArea, MisHeuristic::Power),
-    (Strategy::LightSolidAngle, MisHeuristic::Power),
-    (Strategy::Mis, MisHeuristic::Power),
-    (Strategy::Mis, MisHeuristic::Balance),
-];
 
 #[test]
 fn white_furnace_matches_the_geometric_series_for_every_strategy() {
@@ -214,18 +197,6 @@ fn no_nan_or_inf_in_any_strategy_integrator_and_builtin_scene() {
     }
 }
 
-fn rel_mse(a: &Image, b: &Image) -> f64 {
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    let mut s = 0.0f64;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        for c in 0..3 {
-            let (x, y) = (p[c] as f64, q[c] as f64);
-            s += (x - y) * (x - y) / (y * y + 0.01);
-        }
-    }
-    s / (3.0 * a.pixels.len() as f64)
-}
-
 #[test]
 fn cornell_path_matches_mitsuba_path_reference() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/reference");
@@ -297,7 +268,11 @@ fn integrator_directive_maps_to_path_with_its_depth_and_light_sampler() {
             .count();
         assert_eq!(n, 1, "{other}: {:?}", s.warnings);
     }
-    for (name, want) in [("uniform", "uniform"), ("bvh", "bvh")] {
+    for (name, want) in [
+        ("uniform", "uniform"),
+        ("bvh", "bvh"),
+        ("exhaustive", "exhaustive"),
+    ] {
         let s = parse(&format!(
             r#"Integrator "path" "string lightsampler" "{name}""#
         ));

@@ -1,13 +1,15 @@
 //! pbrt-v3 files read through pbrt-v4's `--upgrade` mapping (`scene::pbrt::upgrade`): each v3
 //! material, light and film becomes the v4 one `pbrt --upgrade` writes, with one warning per kind.
 
+mod render_support;
+
 use glam::{UVec2, Vec2};
 use penumbra::Rgb;
-use penumbra::image::Image;
 use penumbra::integrator::{RenderOptions, render};
 use penumbra::scene::pbrt::materials::MaterialDesc;
 use penumbra::scene::pbrt::textures::TextureDesc;
 use penumbra::scene::pbrt::{load_pbrt, parse_pbrt_str};
+use render_support::rel_mse;
 use std::path::{Path, PathBuf};
 
 const TRI: &str = r#"Shape "trianglemesh" "point P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 2]"#;
@@ -139,17 +141,6 @@ fn cornell_v3(v4: &str) -> String {
     .replace("\"point2 uv\"", "\"float uv\"")
     .replace("\"point3 P\"", "\"point P\"")
         + "WorldEnd\n"
-}
-
-fn rel_mse(a: &Image, b: &Image) -> f64 {
-    let mut s = 0.0f64;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        for c in 0..3 {
-            let (x, y) = (p[c] as f64, q[c] as f64);
-            s += (x - y) * (x - y) / (y * y + 0.01);
-        }
-    }
-    s / (3.0 * a.pixels.len() as f64)
 }
 
 #[test]

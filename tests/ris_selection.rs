@@ -3,6 +3,8 @@
 //! against the exhaustive sum for random light sets, shading points and K, with the bound from
 //! the measured variance; a render with `--strategy light` agrees with `exhaustive`.
 
+mod selection_support;
+
 use glam::{UVec2, Vec3};
 use penumbra::integrator::{RenderOptions, Strategy, render};
 use penumbra::light_selection::{
@@ -13,19 +15,7 @@ use penumbra::sampling::hash::{next_f32, pcg_from_keys};
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
 use rand_pcg::Pcg32;
-
-fn u(rng: &mut Pcg32, a: f32, b: f32) -> f32 {
-    a + (b - a) * next_f32(rng)
-}
-
-fn unit(rng: &mut Pcg32) -> Vec3 {
-    loop {
-        let v = Vec3::new(u(rng, -1.0, 1.0), u(rng, -1.0, 1.0), u(rng, -1.0, 1.0));
-        if v.length_squared() > 0.01 && v.length_squared() <= 1.0 {
-            return v.normalize();
-        }
-    }
-}
+use selection_support::{mean_and_variance, u, unit};
 
 /// Random small emitters: boxes of random size, axis and power (some two-sided).
 fn random_bounds(rng: &mut Pcg32, n: usize) -> Vec<LightBounds> {
@@ -164,22 +154,11 @@ fn ris_light_strategy_render_matches_exhaustive() {
         };
         render(&scene, res, &o).unwrap().0
     };
-    let stats = |a: &penumbra::image::Image, b: &penumbra::image::Image| {
-        let n = (a.pixels.len() * 3) as f64;
-        let (mut sum, mut d2) = (0.0f64, 0.0f64);
-        for (x, y) in a.pixels.iter().zip(&b.pixels) {
-            for c in 0..3 {
-                sum += (x[c] + y[c]) as f64 * 0.5;
-                d2 += ((x[c] - y[c]) as f64).powi(2);
-            }
-        }
-        (sum / n, d2 / n / 4.0 / n)
-    };
     for strategy in [Strategy::LightSolidAngle, Strategy::Mis] {
         let ex = SelectorKind::Exhaustive;
-        let (me, ve) = stats(&run(ex, strategy, 1), &run(ex, strategy, 2));
+        let (me, ve) = mean_and_variance(&run(ex, strategy, 1), &run(ex, strategy, 2));
         let ris = SelectorKind::Ris { candidates: 4 };
-        let (mr, vr) = stats(&run(ris, strategy, 3), &run(ris, strategy, 4));
+        let (mr, vr) = mean_and_variance(&run(ris, strategy, 3), &run(ris, strategy, 4));
         let sigma = (ve + vr).sqrt();
         eprintln!(
             "{strategy}: ris mean {mr:.6} vs exhaustive {me:.6}: {:.2} σ (σ {sigma:.2e})",

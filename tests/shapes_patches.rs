@@ -419,11 +419,13 @@ fn curved_curves_match_the_brute_force_distance() {
     assert_eq!(agree, total, "{agree} of {total} agree");
 }
 
-/// Under a mirroring transform a cylinder's normal still points outward (pbrt-v4 flips its
-/// render-space ∂p/∂u × ∂p/∂v back for a handedness swap); ReverseOrientation turns it in.
+/// Under a mirroring transform a cylinder's normal points inward, as pbrt-v4's: its
+/// `Cylinder::InteractionFromIntersection` negates the object-space ∂p/∂u × ∂p/∂v for
+/// ReverseOrientation XOR a handedness swap before carrying it to render space as a normal
+/// (which keeps its side); ReverseOrientation turns it back out.
 #[test]
-fn mirrored_cylinder_keeps_its_outward_normal() {
-    for (extra, outward) in [("", true), ("ReverseOrientation\n", false)] {
+fn mirrored_cylinder_faces_inward_as_in_pbrt_v4() {
+    for (extra, outward) in [("", false), ("ReverseOrientation\n", true)] {
         let (scene, _) = load(&format!(
             "AttributeBegin\nScale -1 1 1\n{extra}Shape \"cylinder\" \"float radius\" 0.5\nAttributeEnd"
         ));

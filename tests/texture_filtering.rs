@@ -10,9 +10,10 @@
 //! half-and-half image textures evaluates, at each half, exactly the constant-parameter
 //! material of that half's values.
 
+mod texture_support;
+
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::Rgb;
-use penumbra::geometry::SurfaceHit;
 use penumbra::image::Image;
 use penumbra::image::io::write_image;
 use penumbra::integrator::{RenderOptions, render};
@@ -20,14 +21,9 @@ use penumbra::material::texture::{ImageRgb, MipFilter, MipMap, Wrap, checkerboar
 use penumbra::material::{Material, TexCoord};
 use penumbra::scene::pbrt::materials::to_material;
 use penumbra::scene::pbrt::parse_pbrt_str;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("penumbra-tfilt-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use texture_support::{halves, hit_at, tmpdir};
 
 /// A 4×4 image whose texel (x, y) (row 0 at the top) holds 10·y + x in every channel.
 fn numbered() -> ImageRgb {
@@ -301,29 +297,6 @@ fn wrap_and_filter_are_parsed_and_unknown_ones_rejected() {
         let e = parse_pbrt_str("t.pbrt", &with(bad), &dir).unwrap_err();
         assert!(format!("{e:#}").contains("t.pbrt:2"), "{e:#}");
     }
-}
-
-fn hit_at(uv: Vec2) -> SurfaceHit {
-    SurfaceHit {
-        t: 1.0,
-        p: Vec3::ZERO,
-        ng: Vec3::Z,
-        ns: Vec3::Z,
-        uv,
-        p_error: 0.0,
-        prim: 0,
-        material: 0,
-        light: 0,
-    }
-}
-
-/// An 8×1 image: left half `a`, right half `b`.
-fn halves(path: &Path, a: f32, b: f32) {
-    let mut img = Image::new(8, 1);
-    for (i, p) in img.pixels.iter_mut().enumerate() {
-        *p = Rgb::splat(if i < 4 { a } else { b });
-    }
-    write_image(&img, path, 0.0).unwrap();
 }
 
 #[test]

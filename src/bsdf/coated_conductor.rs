@@ -18,19 +18,9 @@ pub fn coated_conductor(
     alpha: Vec2,
     params: LayerParams,
 ) -> Layered {
-    let ce = if coat_eta.is_finite() && coat_eta > 0.0 {
-        coat_eta
-    } else {
-        1.5
-    };
-    Layered::new(
-        Coat {
-            eta: ce,
-            alpha: coat_alpha,
-        },
-        Base::Conductor(Conductor::new(eta / ce, k / ce, alpha)),
-        params,
-    )
+    let coat = coat(coat_eta, coat_alpha);
+    let base = Base::Conductor(Conductor::new(eta / coat.eta, k / coat.eta, alpha));
+    Layered::new(coat, base, params)
 }
 
 /// pbrt-v4's layered `coateddiffuse`: a coat over a Lambertian base of `reflectance`.
@@ -40,17 +30,20 @@ pub fn layered_diffuse(
     coat_alpha: Vec2,
     params: LayerParams,
 ) -> Layered {
-    let ce = if coat_eta.is_finite() && coat_eta > 0.0 {
+    let base = Base::Diffuse(reflectance.clamp(Rgb::ZERO, Rgb::ONE));
+    Layered::new(coat(coat_eta, coat_alpha), base, params)
+}
+
+/// The coat of index `coat_eta` (1.5 where that is not a positive finite number) and GGX
+/// widths `coat_alpha`.
+fn coat(coat_eta: f32, coat_alpha: Vec2) -> Coat {
+    let eta = if coat_eta.is_finite() && coat_eta > 0.0 {
         coat_eta
     } else {
         1.5
     };
-    Layered::new(
-        Coat {
-            eta: ce,
-            alpha: coat_alpha,
-        },
-        Base::Diffuse(reflectance.clamp(Rgb::ZERO, Rgb::ONE)),
-        params,
-    )
+    Coat {
+        eta,
+        alpha: coat_alpha,
+    }
 }

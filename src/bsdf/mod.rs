@@ -162,8 +162,7 @@ pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
 
 /// Draw `wi` from a mode-dependent hemisphere density and evaluate `bsdf` there: the shared
 /// sampling path of every non-importance [`LobeSampling`] mode.
-// Always inlined (as `Lambert::sample`): the integrator's lane kernel vectorises only if its
-// whole body is inline.
+// Always inlined, like `TriangleLight::sample_li` (whose comment has the measurement).
 #[inline(always)]
 fn sample_by_hemisphere(
     bsdf: &impl Bxdf,

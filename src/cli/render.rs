@@ -58,6 +58,11 @@ pub struct Args {
     /// Path tracing without Russian roulette (every path runs to --max-depth).
     #[arg(long)]
     pub no_roulette: bool,
+    /// Splat each sample into every pixel its filter reaches (a weighted mean per pixel, as
+    /// Mitsuba's film does) instead of filter importance sampling: less noise per pixel,
+    /// correlated between neighbours
+    #[arg(long)]
+    pub splat: bool,
     /// Estimator at every path vertex: bsdf, light-area, light-solid-angle or mis.
     #[arg(long, default_value = "mis")]
     pub strategy: Strategy,
@@ -262,6 +267,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         integrator: choice.kind,
         max_depth: choice.max_depth,
         roulette: !args.no_roulette,
+        splat: args.splat,
         progress: !args.quiet,
         sample_range: args.spp_range.clone(),
         ..RenderOptions::default()

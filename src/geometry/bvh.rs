@@ -51,8 +51,8 @@ impl Node {
     }
 }
 
-/// Branch-free min (one `minss`); `f32::min`'s NaN handling costs three more instructions, and
-/// NaN cannot occur here (ray directions are made non-zero, boxes are finite).
+/// Branch-free min, without `f32::min`'s NaN handling: NaN cannot occur here (ray directions
+/// are made non-zero, boxes are finite).
 #[inline(always)]
 fn min(a: f32, b: f32) -> f32 {
     if a < b { a } else { b }

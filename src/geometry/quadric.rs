@@ -21,6 +21,31 @@ pub enum QuadricKind {
         /// Radius.
         radius: f32,
     },
+    /// pbrt-v4's partial sphere: the sphere of `radius` cut to z in [zmin, zmax] (within
+    /// [−radius, radius]) and φ in [0, phimax], uv = (φ/phimax, (θ − θ_zmin)/(θ_zmax − θ_zmin))
+    /// with θ_z = acos(z/radius).
+    SphereCut {
+        /// Radius.
+        radius: f32,
+        /// Lower cut.
+        zmin: f32,
+        /// Upper cut.
+        zmax: f32,
+        /// Sweep in radians.
+        phimax: f32,
+    },
+    /// pbrt-v4's annulus / partial disk in the plane z = `height`: inner ≤ r ≤ radius and φ in
+    /// [0, phimax], normal +z, uv = (φ/phimax, (radius − r)/(radius − inner)).
+    DiskCut {
+        /// Plane height.
+        height: f32,
+        /// Outer radius.
+        radius: f32,
+        /// Inner radius.
+        inner: f32,
+        /// Sweep in radians.
+        phimax: f32,
+    },
     /// pbrt-v4's cylinder: x² + y² = radius² for z in [zmin, zmax] and φ in [0, phimax],
     /// outward normal (x, y, 0), uv = (φ/phimax, (z − zmin)/(zmax − zmin)).
     Cylinder {
@@ -76,11 +101,14 @@ impl Quadric {
     pub fn bounds(&self) -> (Vec3, Vec3) {
         let (lo, hi) = match self.kind {
             QuadricKind::Sphere { radius } => (Vec3::splat(-radius), Vec3::splat(radius)),
-            QuadricKind::Disk { height, radius } => (
+            QuadricKind::Disk { height, radius } | QuadricKind::DiskCut { height, radius, .. } => (
                 Vec3::new(-radius, -radius, height),
                 Vec3::new(radius, radius, height),
             ),
             QuadricKind::Cylinder {
+                radius, zmin, zmax, ..
+            }
+            | QuadricKind::SphereCut {
                 radius, zmin, zmax, ..
             } => (
                 Vec3::new(-radius, -radius, zmin),
@@ -132,6 +160,35 @@ impl Quadric {
                 }
                 t
             }
+            QuadricKind::SphereCut {
+                radius,
+                zmin,
+                zmax,
+                phimax,
+            } => sphere_cut_t(oo, dd, radius as f64, [zmin, zmax, phimax], t_max as f64)?,
+            QuadricKind::DiskCut {
+                height,
+                radius,
+                inner,
+                phimax,
+            } => {
+                if dd.z == 0.0 {
+                    return None;
+                }
+                let t = (height as f64 - oo.z) / dd.z;
+                if t <= 0.0 || t >= t_max as f64 {
+                    return None;
+                }
+                let p = oo + dd * t;
+                let r2 = p.x * p.x + p.y * p.y;
+                if r2 > (radius as f64).powi(2) || r2 < (inner as f64).powi(2) {
+                    return None;
+                }
+                if !within_phi(p, phimax) {
+                    return None;
+                }
+                t
+            }
             QuadricKind::Cylinder {
                 radius,
                 zmin,
@@ -167,7 +224,9 @@ impl Quadric {
                 let pf = p.as_vec3();
                 let phi = pf.y.atan2(pf.x).rem_euclid(2.0 * PI);
                 let cos_theta = (pf.z / radius).clamp(-1.0, 1.0);
-                (pf, Vec2::new(phi / (2.0 * PI), cos_theta.acos() / PI))
+                // pbrt-v4's v = (θ − θ_zmin)/(θ_zmax − θ_zmin) with θ_zmin = π: 0 at the
+                // bottom pole, 1 at the top.
+                (pf, Vec2::new(phi / (2.0 * PI), 1.0 - cos_theta.acos() / PI))
             }
             QuadricKind::Disk { height, radius } => {
                 p.z = height as f64;
@@ -177,6 +236,52 @@ impl Quadric {
                 (
                     Vec3::Z,
                     Vec2::new(phi / (2.0 * PI), 1.0 - r / radius.max(f32::MIN_POSITIVE)),
+                )
+            }
+            QuadricKind::SphereCut {
+                radius,
+                zmin,
+                zmax,
+                phimax,
+            } => {
+                let len = p.length();
+                if len > 0.0 {
+                    p *= radius as f64 / len;
+                }
+                let pf = p.as_vec3();
+                let phi = pf.y.atan2(pf.x).rem_euclid(2.0 * PI);
+                let theta = |z: f32| (z / radius).clamp(-1.0, 1.0).acos();
+                let (t0, t1) = (theta(zmin), theta(zmax));
+                let dt = t1 - t0;
+                (
+                    pf,
+                    Vec2::new(
+                        phi / phimax.max(f32::MIN_POSITIVE),
+                        if dt != 0.0 {
+                            (theta(pf.z) - t0) / dt
+                        } else {
+                            0.0
+                        },
+                    ),
+                )
+            }
+            QuadricKind::DiskCut {
+                height,
+                radius,
+                inner,
+                phimax,
+            } => {
+                p.z = height as f64;
+                let pf = p.as_vec3();
+                let r = (pf.x * pf.x + pf.y * pf.y).sqrt();
+                let phi = pf.y.atan2(pf.x).rem_euclid(2.0 * PI);
+                let dr = radius - inner;
+                (
+                    Vec3::Z,
+                    Vec2::new(
+                        phi / phimax.max(f32::MIN_POSITIVE),
+                        if dr > 0.0 { (radius - r) / dr } else { 0.0 },
+                    ),
                 )
             }
             QuadricKind::Cylinder {
@@ -404,6 +509,57 @@ fn cylinder_t(
     } else {
         None
     }
+}
+
+/// Whether object-space point `p` lies within the sweep φ ∈ [0, phimax].
+#[inline]
+fn within_phi(p: DVec3, phimax: f32) -> bool {
+    let tau = 2.0 * std::f64::consts::PI;
+    phimax as f64 >= tau || p.y.atan2(p.x).rem_euclid(tau) <= phimax as f64
+}
+
+/// Nearest root of |o + t d|² = r² in (0, t_max) whose point lies within the cuts
+/// z ∈ [zmin, zmax] and φ ∈ [0, phimax] (pbrt-v4 tries the far root when the near one is
+/// cut away, so the inside of a partial sphere is visible through the gap).
+fn sphere_cut_t(
+    o: DVec3,
+    d: DVec3,
+    r: f64,
+    [zmin, zmax, phimax]: [f32; 3],
+    t_max: f64,
+) -> Option<f64> {
+    let a = d.length_squared();
+    if a == 0.0 {
+        return None;
+    }
+    let b = o.dot(d);
+    let f = o - d * (b / a);
+    let disc = r * r - f.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let s = (a * disc).sqrt();
+    let q = if b < 0.0 { -b + s } else { -b - s };
+    let (mut t0, mut t1) = (
+        q / a,
+        if q != 0.0 {
+            (o.length_squared() - r * r) / q
+        } else {
+            0.0
+        },
+    );
+    if t0 > t1 {
+        std::mem::swap(&mut t0, &mut t1);
+    }
+    let keep = |t: f64| {
+        if !(t > 0.0 && t < t_max) {
+            return false;
+        }
+        let p = o + d * t;
+        let p = p * (r / p.length());
+        !(p.z < zmin as f64 || p.z > zmax as f64) && within_phi(p, phimax)
+    };
+    [t0, t1].into_iter().find(|&t| keep(t))
 }
 
 /// Smallest root of |o + t d|² = r² in (0, t_max).

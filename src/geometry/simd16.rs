@@ -8,7 +8,7 @@
 //! operand unless the first is strictly smaller/larger. Hence a lane computes exactly what the
 //! scalar (`Vec4`) code computes for that ray.
 
-// Lane loops `for i in 0..PACKET` over several arrays at once are what LLVM vectorises.
+// Lane loops `for i in 0..PACKET` index several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
 use super::Ray;
@@ -148,7 +148,7 @@ fn ray_arrays(rays: &[Ray; LANES]) -> [Lanes; 7] {
     a
 }
 
-/// Sixteen lanes of the portable backend: plain lane loops (what LLVM makes of them). `pub`
+/// Sixteen lanes of the portable backend: plain lane loops. `pub`
 /// only because the public token [`Portable`] implements [`Simd`] (the module is private).
 #[derive(Clone, Copy)]
 pub struct PV(Lanes);
@@ -828,9 +828,9 @@ mod tests {
         (a, b)
     }
 
-    /// The bit patterns of the lanes of `f`, NaNs as one pattern: LLVM may fold the portable
-    /// lanes at compile time with other NaN bits than x86's default NaN, and a NaN's sign and
-    /// payload never decide a ray query (every comparison with a NaN lane fails).
+    /// The bit patterns of the lanes of `f`, NaNs as one pattern: the portable lanes may carry
+    /// other NaN bits than x86's default NaN (Rust leaves them unspecified), and a NaN's sign
+    /// and payload never decide a ray query (every comparison with a NaN lane fails).
     fn lane_bits<S: Simd>(f: S::F) -> [u32; LANES] {
         let mut a = [0.0; LANES];
         S::store(f, &mut a);
@@ -839,9 +839,8 @@ mod tests {
 
     /// `x`'s bits, with every NaN as `f32::NAN` (see [`lane_bits`]).
     fn canon(x: f32) -> u32 {
-        // The NaN test on the integer bits: a float `is_nan` select can be folded away (LLVM
-        // leaves NaN signs and payloads unspecified, so it may keep `x`'s bits as they are,
-        // and did in some builds).
+        // The NaN test on the integer bits: a float `is_nan` select may keep `x`'s NaN bits
+        // (it did in some builds).
         let b = x.to_bits();
         if b & 0x7fff_ffff > 0x7f80_0000 {
             f32::NAN.to_bits()

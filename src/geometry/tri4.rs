@@ -97,7 +97,7 @@ impl RayShear4 {
     #[inline(always)]
     pub fn new(o: Vec3, d: Vec3) -> Self {
         let k = shear_axes(d);
-        // Arrays, not `Vec3` indexing: glam's runtime `Index` is a `match` (a jump table).
+        // Arrays, not `Vec3` indexing: glam's runtime `Index` is a `match` per access.
         let (oa, da) = (o.to_array(), d.to_array());
         let dz = da[k[2]];
         // One vector division instead of three scalar ones: IEEE quotients are the same, and
@@ -182,7 +182,7 @@ impl RayShear4 {
         if h.hit | h.redo == 0 {
             return None;
         }
-        // Arrays, not `Vec4` indexing by a runtime lane (glam's `Index` is a jump table).
+        // Arrays, not `Vec4` indexing by a runtime lane (glam's `Index` is a `match`).
         let t = h.t.to_array();
         let mut best_t = t_max;
         // The best lane, with its barycentrics only if the scalar redo produced them: those
@@ -239,9 +239,8 @@ impl RayShear4 {
 }
 
 /// The scalar test of triangle `lane` of `pk` against `ray` (an exact-zero edge function in
-/// f32). Cold and not inlined: otherwise the compiler hoists its per-ray setup (splats of the
-/// ray) out of the traversal loop, paying for it on every ray although it almost never runs.
-/// It takes the ray by value, not the `RayShear4`, which would then have to live in memory.
+/// f32). Cold and out of line: it almost never runs, and no ray should pay for its per-ray
+/// setup; it takes the ray by value, not the `RayShear4` (ed2cc26, d907286).
 #[cold]
 #[inline(never)]
 fn redo_lane(

@@ -151,10 +151,10 @@ pub fn shear_axes(d: Vec3) -> [usize; 3] {
     let x_gt_y = a.x > a.y;
     let x_max = x_gt_y & (a.x > a.z);
     let y_max = !x_gt_y & (a.y > a.z);
-    // A `static` table is one load; a literal array is built on the stack at every call.
+    // A `static` table, built once (a literal array would be built again for every ray).
     static KZ: [usize; 4] = [2, 1, 0, 0];
     let kz = KZ[(x_max as usize) << 1 | y_max as usize];
-    // `d[kz] < 0` from one vector compare (an indexed array would go through the stack).
+    // `d[kz] < 0` from one vector compare: mis-area 2717 → 2713 Ir/sample (558ef04).
     let neg = (Vec3A::from(d).cmplt(Vec3A::ZERO).bitmask() as usize >> kz) & 1;
     // (kx, ky) = (kz + 1, kz + 2) mod 3, swapped when d[kz] < 0.
     const AXES: [[usize; 3]; 8] = [

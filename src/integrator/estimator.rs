@@ -76,8 +76,8 @@ pub(super) fn light_estimate(
     if transmits && !gathers_from(true, ls.wi.dot(ctx.n), wi_local.z) {
         return None;
     }
-    // Under MIS the BSDF pdf is needed too: one dispatch evaluates both (for the few
-    // occluded samples it is wasted, cheaper than a second call for all the others).
+    // Under MIS the BSDF pdf is needed too: one evaluation yields both (wasted on the few
+    // occluded samples, cheaper than evaluating twice for all the others).
     let weigh = if ls.delta { None } else { mis };
     let (f, bsdf_pdf) = if weigh.is_some() {
         bsdf.f_pdf(wo_local, wi_local)

@@ -220,7 +220,7 @@ impl TriangleLightLanes {
         }
     }
 
-    /// The lane loop; inlined into each caller with `mis` and `mode` constants.
+    /// The lane loop, specialised in each caller for its `mis` and `mode`.
     #[inline(always)]
     fn body(
         &mut self,
@@ -240,8 +240,7 @@ impl TriangleLightLanes {
                 two_sided: self.two_sided[k],
             };
             let u = Vec2::new(u[0][k], u[1][k]);
-            // A match, not `and_then`: the closure is not always inlined, and one call in
-            // the loop keeps it from vectorising.
+            // A match, not `and_then`: the closure cost mis-area 0.38 → 0.50 s (dbcda06).
             let est = match tri.sample_li(&ctx, u, mode) {
                 Some(ls) => light_estimate(
                     &ls,
@@ -317,7 +316,7 @@ impl DiffuseBsdfLanes {
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let u = Vec2::new(u[0][k], u[1][k]);
-            // A match, not `and_then`, as in the light kernel: the closure may be outlined.
+            // A match, not `and_then`, as in the light kernel (measured there).
             let b = match lambert.sample(wo_local, 0.0, u) {
                 Some(bs) => bsdf_ray_of(&bs, &frame, ctx.n, &hit),
                 None => None,
@@ -437,8 +436,8 @@ mod tests {
 
     #[test]
     fn light_kernel_lanes_equal_the_per_lane_functions_on_every_isa() {
-        // The kernel's loop must compile to exactly the per-lane functions' float operations
-        // on every instruction set (no contraction, no reassociation, nothing dropped).
+        // The kernel's lanes must be bit for bit the per-lane functions on every instruction
+        // set (no fused multiply-adds, no reordered sums, nothing dropped).
         let mut checked = 0;
         for isa in Isa::available() {
             for round in 0..24u64 {

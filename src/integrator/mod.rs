@@ -177,6 +177,11 @@ pub struct RenderOptions {
     pub max_depth: u32,
     /// Russian roulette on the path throughput (pbrt-v4's rule; unbiased).
     pub roulette: bool,
+    /// Reconstruct pixels by splatting (see `render`): each sample, uniform over its pixel,
+    /// adds its radiance weighted by the filter to every pixel the filter reaches, and a
+    /// pixel is the weighted mean of what it received (Mitsuba's film). Off: filter
+    /// importance sampling, each sample counted by its own pixel only.
+    pub splat: bool,
     /// Show a progress bar.
     pub progress: bool,
     /// Render only sample indices `[start, end)` of the `spp` of every pixel (a part of a
@@ -239,6 +244,7 @@ impl Default for RenderOptions {
             integrator: IntegratorKind::Direct,
             max_depth: 5,
             roulette: true,
+            splat: false,
             progress: false,
             sample_range: None,
             cancel: None,

@@ -29,6 +29,9 @@ const TILE: u32 = 16;
 /// compacted together at each depth.
 const WAVE: usize = 64;
 
+/// The most pixels along each axis one splatted sample reaches (filter radius ≤ 8).
+const SPLAT_SPAN: usize = 17;
+
 /// What a render thread reuses from tile to tile.
 struct TileWork {
     /// One per pixel of a tile (a pixel's slot is its index in the tile).
@@ -37,6 +40,8 @@ struct TileWork {
     cams: Vec<CameraPacket>,
     /// Per camera packet: its lanes' filter weights.
     weights: Vec<[f32; PACKET]>,
+    /// Per camera packet: its lanes' positions in their pixels (splatting only).
+    us: Vec<[Vec2; PACKET]>,
     /// Per path of the wave: its radiance.
     radiance: Vec<Rgb>,
     queues: Queues,
@@ -51,6 +56,7 @@ impl TileWork {
                 .collect(),
             cams: Vec::with_capacity(WAVE),
             weights: Vec::with_capacity(WAVE),
+            us: Vec::with_capacity(WAVE),
             radiance: vec![Rgb::ZERO; WAVE * PACKET],
             queues: Queues::new(),
             wave: Wave::new(),
@@ -108,7 +114,32 @@ pub fn render(
         roulette: opts.roulette,
     };
     let camera = scene.camera.rays(res);
-    let filter = FilterSampler::new(&scene.film.filter)?;
+    // Splatting draws each sample uniformly over its pixel (a box of radius ½) and weighs it
+    // by the film's filter afterwards, into every pixel within the filter's radius: `apron`
+    // pixels around each tile receive its samples too.
+    let splat = opts.splat;
+    let film_filter = scene.film.filter;
+    let filter = if splat {
+        FilterSampler::new(&Filter::Box {
+            radius: Vec2::splat(0.5),
+        })?
+    } else {
+        FilterSampler::new(&film_filter)?
+    };
+    let apron = if splat {
+        film_filter.radius().max_element().ceil().max(0.0) as u32
+    } else {
+        0
+    };
+    let tent = match film_filter {
+        Filter::Triangle { radius } => Some(radius),
+        _ => None,
+    };
+    anyhow::ensure!(
+        (2 * apron + 1) as usize <= SPLAT_SPAN,
+        "--splat: the pixel filter's radius {} is wider than splatting supports",
+        film_filter.radius().max_element()
+    );
     let cpu = scene.geometry.cpu();
     let tiles_x = res.x.div_ceil(TILE);
     let tiles_y = res.y.div_ceil(TILE);
@@ -131,7 +162,7 @@ pub fn render(
         .map(|_| std::sync::Mutex::new(None))
         .collect();
     let start = Instant::now();
-    let tiles: Vec<Vec<Rgb>> = (0..tiles_x * tiles_y)
+    let tiles: Vec<TileOut> = (0..tiles_x * tiles_y)
         .into_par_iter()
         // Per worker thread: one PixelSamples per pixel of a tile (filled in place) and the
         // wave's queues, made once and reused from tile to tile (rayon's `map_init` would make
@@ -151,23 +182,87 @@ pub fn render(
             // order, exactly as one loop per pixel would, whatever order the wave's paths
             // finish in.
             let mut sums = vec![Rgb::ZERO; (w * h) as usize];
+            // Splatting: per pixel of the tile and its apron (row-major, `aw` wide), the
+            // filter-weighted radiance and the sum of the weights.
+            let aw = w + 2 * apron;
+            let mut splats = if splat {
+                vec![(Rgb::ZERO, 0.0f32); (aw * (h + 2 * apron)) as usize]
+            } else {
+                Vec::new()
+            };
             let TileWork {
                 pxs,
                 cams,
                 weights,
+                us,
                 radiance,
                 queues,
                 wave,
             } = work;
             cams.clear();
             weights.clear();
+            us.clear();
             let mut cam = CameraPacket::new();
             let (mut tile_rays, mut tile_bad) = (RayCounts::default(), 0u64);
             let mut flush = |cams: &mut Vec<CameraPacket>,
                              weights: &mut Vec<[f32; PACKET]>,
+                             us: &mut Vec<[Vec2; PACKET]>,
                              pxs: &[PixelSamples]| {
                 let counts = est.li_wave(pxs, cams, radiance, queues, wave);
                 tile_rays.add(&counts);
+                if splat {
+                    for (i, (cam, u)) in cams.iter().zip(us.iter()).enumerate() {
+                        for k in 0..cam.n {
+                            let l = radiance[i * PACKET + k];
+                            if !l.is_finite() {
+                                tile_bad += 1;
+                                continue;
+                            }
+                            // The filter is separable: its weight in the pixel `d` columns
+                            // and `e` rows away is gx[d]·gy[e], each the profile at the
+                            // sample's offset from that pixel's centre.
+                            let n = (2 * apron + 1) as usize;
+                            let (mut gx, mut gy) = ([0.0f32; SPLAT_SPAN], [0.0f32; SPLAT_SPAN]);
+                            for d in 0..n {
+                                let c = d as f32 - apron as f32 + 0.5;
+                                let (ox, oy) = (u[k].x - c, u[k].y - c);
+                                // The tent (the default filter) inline, in f32.
+                                (gx[d], gy[d]) = match tent {
+                                    Some(r) => {
+                                        ((r.x - ox.abs()).max(0.0), (r.y - oy.abs()).max(0.0))
+                                    }
+                                    None => (
+                                        film_filter.profile(0, ox as f64) as f32,
+                                        film_filter.profile(1, oy as f64) as f32,
+                                    ),
+                                };
+                            }
+                            let slot = cam.pixel[k] as u32;
+                            // The top-left pixel of the sample's neighbourhood, in the apron's
+                            // coordinates.
+                            let corner = (slot / w) * aw + slot % w;
+                            for (e, &wy) in gy[..n].iter().enumerate() {
+                                if wy == 0.0 {
+                                    continue;
+                                }
+                                let row = corner as usize + e * aw as usize;
+                                for (d, &wx) in gx[..n].iter().enumerate() {
+                                    let f = wx * wy;
+                                    if f == 0.0 {
+                                        continue;
+                                    }
+                                    let s = &mut splats[row + d];
+                                    s.0 += l * f;
+                                    s.1 += f;
+                                }
+                            }
+                        }
+                    }
+                    cams.clear();
+                    weights.clear();
+                    us.clear();
+                    return;
+                }
                 for (i, (cam, weight)) in cams.iter().zip(weights.iter()).enumerate() {
                     for k in 0..cam.n {
                         // Filters with negative lobes weight their samples (mean weight
@@ -187,6 +282,7 @@ pub fn render(
                 }
                 cams.clear();
                 weights.clear();
+                us.clear();
             };
             // Per lane: the pixel and filter draw; the camera rays of a full packet are then
             // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
@@ -214,9 +310,10 @@ pub fn render(
                             lanes.rays(cpu, &camera, &filter, &mut cam.rays);
                             cams.push(cam);
                             weights.push(lanes.weight);
+                            us.push(lanes.u);
                             cam.clear();
                             if cams.len() == WAVE {
-                                flush(cams, weights, pxs);
+                                flush(cams, weights, us, pxs);
                             }
                         }
                     }
@@ -226,11 +323,16 @@ pub fn render(
                 lanes.rays(cpu, &camera, &filter, &mut cam.rays);
                 cams.push(cam);
                 weights.push(lanes.weight);
+                us.push(lanes.u);
             }
             if !cams.is_empty() {
-                flush(cams, weights, pxs);
+                flush(cams, weights, us, pxs);
             }
-            let out: Vec<Rgb> = sums.iter().map(|&s| s / samples.len() as f32).collect();
+            let out = if splat {
+                TileOut::Splats(splats)
+            } else {
+                TileOut::Pixels(sums.iter().map(|&s| s / samples.len() as f32).collect())
+            };
             rays.fetch_add(tile_rays.total(), Ordering::Relaxed);
             if let Ok(mut c) = counts.lock() {
                 c.add(&tile_rays);
@@ -246,13 +348,42 @@ pub fn render(
     }
     let time = start.elapsed();
     let mut img = Image::new(res.x, res.y);
+    // Splats are summed tile by tile in tile order, so a pixel that receives samples from
+    // several tiles adds them in the same order for any thread count.
+    let mut received = if splat {
+        vec![(Rgb::ZERO, 0.0f32); (res.x * res.y) as usize]
+    } else {
+        Vec::new()
+    };
     for (t, tile) in tiles.iter().enumerate() {
         let t = t as u32;
         let (x0, y0) = ((t % tiles_x) * TILE, (t / tiles_x) * TILE);
         let w = (x0 + TILE).min(res.x) - x0;
-        for (i, px) in tile.iter().enumerate() {
-            let (x, y) = (x0 + i as u32 % w, y0 + i as u32 / w);
-            img.pixels[(y * res.x + x) as usize] = *px;
+        match tile {
+            TileOut::Pixels(pixels) => {
+                for (i, px) in pixels.iter().enumerate() {
+                    let (x, y) = (x0 + i as u32 % w, y0 + i as u32 / w);
+                    img.pixels[(y * res.x + x) as usize] = *px;
+                }
+            }
+            TileOut::Splats(splats) => {
+                let aw = w + 2 * apron;
+                for (i, s) in splats.iter().enumerate() {
+                    let x = (x0 + i as u32 % aw) as i64 - apron as i64;
+                    let y = (y0 + i as u32 / aw) as i64 - apron as i64;
+                    if x < 0 || y < 0 || x >= res.x as i64 || y >= res.y as i64 {
+                        continue;
+                    }
+                    let r = &mut received[(y as u32 * res.x + x as u32) as usize];
+                    r.0 += s.0;
+                    r.1 += s.1;
+                }
+            }
+        }
+    }
+    if splat {
+        for (px, (l, wsum)) in img.pixels.iter_mut().zip(&received) {
+            *px = if *wsum > 0.0 { *l / *wsum } else { Rgb::ZERO };
         }
     }
     let stats = RenderStats {
@@ -271,6 +402,13 @@ pub fn render(
 }
 
 /// The camera samples of a packet's lanes before their rays are made.
+/// A finished tile: its pixels, or (splatting) the weighted radiance and weight sums of its
+/// pixels and apron.
+enum TileOut {
+    Pixels(Vec<Rgb>),
+    Splats(Vec<(Rgb, f32)>),
+}
+
 struct CameraLanes {
     /// Per lane: the pixel.
     pixel: [UVec2; PACKET],
@@ -327,7 +465,7 @@ impl CameraLanes {
         }
     }
 
-    /// [`CameraLanes::rays`] as plain loops over the lanes, which the compiler vectorises.
+    /// [`CameraLanes::rays`] as plain loops over the lanes, compiled for each instruction set.
     #[inline(always)]
     fn rays_portable(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
         let o = Ray::new(camera.origin(), Vec3::Z);

@@ -269,10 +269,9 @@ fn retire(
     }
 }
 
-/// The shading state at a hit, as the per-lane estimators read it. The parts whose address
-/// goes to out-of-line calls (hit, BSDF, light context) are borrowed from separate places: a
-/// struct with one field passed by address is kept whole in memory, so owning them would force
-/// every other field (frame, wo) through the stack too.
+/// The shading state at a hit, as the per-lane estimators read it: the hit, BSDF and light
+/// context borrowed from where they live, the frame and `wo` owned.
+// Borrowed, not owned: mis-area 3791 → 3769 Ir/sample (24eb8e6).
 struct Shading<'h> {
     hit: &'h SurfaceHit,
     bsdf: &'h Bsdf,
@@ -487,9 +486,9 @@ impl<'a> Integrator<'a> {
     /// lets the CPU overlap them instead of waiting on each behind a ray query; the lobe choice
     /// is drawn later, only for receivers whose BSDF has lobes to choose (values are pure
     /// functions of pixel, dimension and index, so skipping it changes nothing).
-    // Forced inline: out of line, the draws came back through memory after a call.
     /// `go_on`: the round's BSDF ray may continue the path (so it is drawn whatever the
     /// techniques).
+    // Forced inline: mis-area 2821 → 2808 Ir/sample (60f7c18).
     #[inline(always)]
     fn draw(
         &self,
@@ -597,8 +596,8 @@ impl<'a> Integrator<'a> {
         let scene = self.scene;
         q.tri_lanes.active = 0;
         q.lone_light = 0;
-        // Uniform picks ignore the shading point: pick inline, without a ShadingPoint or a
-        // virtual call per sample.
+        // Uniform picks ignore the shading point: pick here, without a ShadingPoint or the
+        // selector per sample.
         let uniform =
             (self.selector.kind() == SelectorKind::Uniform).then_some(scene.lights.len() as u32);
         for k in bits(q.shaded) {
@@ -821,10 +820,8 @@ impl<'a> Integrator<'a> {
             *lane = None;
             return l;
         };
-        // The BSDF is stored straight into the lane: a diffuse one from registers, any other
-        // by the out-of-line constructor. (Both paths through one local, the copy out of it
-        // read 16-byte pieces before the smaller stores that wrote them had landed: a
-        // store-forwarding stall on every hit.)
+        // The BSDF is stored straight into the lane, a diffuse one built here, any other by
+        // the general constructor (not through one local: a slow copy per hit, 04e0d80).
         let ctx = LightSampleContext { p: hit.p, n: g.n };
         let lane = match material.lambert(hit) {
             Some(b) => lane.insert(LaneShading {
@@ -887,8 +884,7 @@ impl<'a> Integrator<'a> {
     /// One BSDF sample (per-lane path) as a ray with its weight f·cos / pdf (`None` when the
     /// estimate is zero without tracing it).
     fn bsdf_ray(&self, sh: &Shading, lobe: f32, u: Vec2) -> Option<BsdfRay> {
-        // Lambert inline: `Bsdf::sample` carries every BSDF and stays out of line, so the
-        // common diffuse hit paid a call and a `BsdfSample` returned through memory.
+        // Lambert here, the rest through `Bsdf::sample`: mis-area 2863 → 2821 Ir/sample (7943ee0).
         let (bs, transmits) = match sh.bsdf {
             Bsdf::Lambert(b) => (b.sample(sh.wo_local, lobe, u), false),
             other => (other.sample(sh.wo_local, lobe, u), other.transmits()),

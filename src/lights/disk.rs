@@ -78,15 +78,7 @@ impl LightSource for DiskLight {
             (1.0 - n.y * n.y).max(0.0).sqrt(),
             (1.0 - n.z * n.z).max(0.0).sqrt(),
         ) * self.radius;
-        Some(LightBounds {
-            min: self.center - ext,
-            max: self.center + ext,
-            w: n,
-            phi: self.power(),
-            cos_theta_o: 1.0,
-            cos_theta_e: 0.0,
-            two_sided: self.two_sided,
-        })
+        self.planar_bounds(self.center - ext, self.center + ext)
     }
 }
 

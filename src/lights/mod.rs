@@ -291,7 +291,7 @@ pub(crate) fn triangle_solid_angle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
 /// The connection from `p` to `p_light`, a point drawn with area density `pdf_area` on an
 /// emitter of radiance `l` whose normal there is `n_light`: the one place where a sampled point
 /// on an area light becomes a [`LightLiSample`] with a solid-angle pdf.
-// Always inlined: the integrator's lane kernel vectorises only if its whole body is inline.
+// Always inlined, like `TriangleLight::sample_li` (whose comment has the measurement).
 #[inline(always)]
 pub(crate) fn area_sample(
     p: Vec3,
@@ -358,6 +358,20 @@ pub(crate) trait Planar: LightSource {
     /// samples by area. `sample_li` and `pdf_li` decide by this one rule and use this Ω, so
     /// a sample and its pdf agree.
     fn spherical_omega(&self, p: Vec3, mode: SamplingMode) -> Option<f32>;
+
+    /// The light-BVH bounds of this emitter inside the box `min`..`max`: one normal
+    /// (cos θo = 1) and diffuse emission over its hemisphere (cos θe = 0).
+    fn planar_bounds(&self, min: Vec3, max: Vec3) -> Option<LightBounds> {
+        Some(LightBounds {
+            min,
+            max,
+            w: self.normal(),
+            phi: self.power(),
+            cos_theta_o: 1.0,
+            cos_theta_e: 0.0,
+            two_sided: self.is_two_sided(),
+        })
+    }
 }
 
 impl<T: Planar> Emitter for T {

@@ -111,15 +111,7 @@ impl LightSource for QuadLight {
         ];
         let min = c[0].min(c[1]).min(c[2]).min(c[3]);
         let max = c[0].max(c[1]).max(c[2]).max(c[3]);
-        Some(LightBounds {
-            min,
-            max,
-            w: self.n,
-            phi: self.power(),
-            cos_theta_o: 1.0,
-            cos_theta_e: 0.0,
-            two_sided: self.two_sided,
-        })
+        self.planar_bounds(min, max)
     }
 }
 

@@ -1,8 +1,9 @@
 //! Diffuse emissive sphere. Seen from outside, solid-angle sampling draws a direction uniformly in
 //! the cone the sphere subtends ([`crate::sampling::uniform_cone_sin2`], accurate for tiny
 //! cones); area sampling draws a point uniformly on the whole sphere and rejects the far side.
-//! From inside (only an inward-emitting sphere lights its interior) every point is visible and
-//! area sampling is used in both modes.
+//! From inside (only an inward-emitting or two-sided sphere lights its interior) every point is
+//! visible and area sampling is used in both modes. A two-sided sphere is an outward one to
+//! receivers outside and an inward one to receivers inside.
 
 use super::{
     Emitter, LightBounds, LightLiSample, LightSampleContext, LightSource, SamplingMode,
@@ -28,6 +29,8 @@ pub struct SphereLight {
     pub l: Rgb,
     /// Emits toward the inside instead of the outside.
     pub inward: bool,
+    /// Emits to both sides (pbrt-v4's `twosided`): `inward` is then ignored.
+    pub two_sided: bool,
 }
 
 /// Where a receiver is relative to the sphere, which decides the sampling technique.
@@ -52,7 +55,23 @@ impl SphereLight {
             radius,
             l,
             inward,
+            two_sided: false,
         })
+    }
+
+    /// The same sphere emitting to both sides when `two_sided`.
+    pub fn with_two_sided(self, two_sided: bool) -> Self {
+        Self { two_sided, ..self }
+    }
+
+    /// Whether the sphere acts as an inward emitter for a receiver at `p`: a two-sided one
+    /// lights its inside from the inside and its outside from the outside.
+    fn inward_for(&self, p: Vec3) -> bool {
+        if self.two_sided {
+            (self.center - p).length_squared() <= self.radius * self.radius
+        } else {
+            self.inward
+        }
     }
 
     /// Technique for a receiver at `p`; shared by `sample_li` and `pdf_li` so they agree.
@@ -60,14 +79,15 @@ impl SphereLight {
         let to_c = self.center - p;
         let d2 = to_c.length_squared();
         let r2 = self.radius * self.radius;
+        let inward = self.inward_for(p);
         // A receiver on an inward sphere (a hit on the light's own surface, its rounding on
         // either side) sees the interior: it used to count as outside half the time.
-        let outside = if self.inward {
+        let outside = if inward {
             d2 > r2 * (1.0 + ON_SPHERE)
         } else {
             d2 > r2
         };
-        match (outside, self.inward) {
+        match (outside, inward) {
             (true, false) if mode == SamplingMode::SolidAngle => View::Cone {
                 frame: Frame::from_normal(to_c / d2.sqrt()),
                 sin2: self.radius * self.radius / d2,
@@ -94,7 +114,7 @@ impl SphereLight {
         // Roots −b ± s; the near one from outside (c > 0), the far one from inside. An inward
         // sphere is seen from inside (or from its own surface, `view`): always the far one,
         // else a receiver on the sphere rounded outside found itself (t ≈ 0).
-        let t = if c > 0.0 && !self.inward {
+        let t = if c > 0.0 && !self.inward_for(p) {
             -b - s
         } else {
             -b + s
@@ -139,14 +159,19 @@ impl LightSource for SphereLight {
                 let s = area_sample(ctx.p, p_light, n_out, self.pdf_area(), self.l)?;
                 // Only points whose emitting side faces the receiver: the far side of an outward
                 // sphere is hidden behind its near side.
-                let n_emit = if self.inward { -n_out } else { n_out };
+                let n_emit = if self.inward_for(ctx.p) {
+                    -n_out
+                } else {
+                    n_out
+                };
                 (n_emit.dot(s.wi) < 0.0).then_some(s)
             }
         }
     }
 
     fn power(&self) -> f32 {
-        luminance(self.l) * PI * 4.0 * PI * self.radius * self.radius
+        let sides = if self.two_sided { 2.0 } else { 1.0 };
+        sides * luminance(self.l) * PI * 4.0 * PI * self.radius * self.radius
     }
 
     fn bounds(&self) -> Option<LightBounds> {
@@ -159,7 +184,7 @@ impl LightSource for SphereLight {
             // Normals point everywhere.
             cos_theta_o: -1.0,
             cos_theta_e: 0.0,
-            two_sided: false,
+            two_sided: self.two_sided,
         })
     }
 }
@@ -192,7 +217,7 @@ impl Emitter for SphereLight {
     /// orientation of the caller's `n` does not matter.
     fn radiance(&self, p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
         let out = (p - self.center).dot(w) > 0.0;
-        if out != self.inward {
+        if self.two_sided || out != self.inward {
             self.l
         } else {
             Rgb::ZERO

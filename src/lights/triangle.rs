@@ -43,10 +43,8 @@ impl TriangleLight {
 }
 
 impl LightSource for TriangleLight {
-    // Always inlined: into `Light::sample_li`'s dispatch (one call level and one copy of the
-    // returned sample fewer on every light sample of a triangle-lit scene), and into the
-    // integrator's lane kernel, which vectorises only if the whole lane body is inline (with
-    // plain `#[inline]`, LLVM sometimes kept it as a call there, one lane at a time).
+    // Always inlined: a call leaves the lane kernel one lane at a time (51e942d, 1-thread
+    // 256² 64 spp light-area 0.55 → 0.34 s).
     #[inline(always)]
     fn sample_li(
         &self,
@@ -89,15 +87,7 @@ impl LightSource for TriangleLight {
     fn bounds(&self) -> Option<LightBounds> {
         let min = self.p[0].min(self.p[1]).min(self.p[2]);
         let max = self.p[0].max(self.p[1]).max(self.p[2]);
-        Some(LightBounds {
-            min,
-            max,
-            w: self.n,
-            phi: self.power(),
-            cos_theta_o: 1.0,
-            cos_theta_e: 0.0,
-            two_sided: self.two_sided,
-        })
+        self.planar_bounds(min, max)
     }
 }
 

@@ -114,8 +114,8 @@ pub enum Material {
     },
 }
 
-/// The Lambertian BSDF of a `diffuse` material (reflectance clamped to [0, 1]); inlined into the
-/// hot path of [`Material::bsdf`] and shared with its general arm.
+/// The Lambertian BSDF of a `diffuse` material (reflectance clamped to [0, 1]): the hot path
+/// of [`Material::bsdf`], shared with its general arm.
 #[inline(always)]
 fn diffuse(reflectance: &Texture, hit: &SurfaceHit) -> Lambert {
     Lambert::new(reflectance.eval(hit.uv).clamp(Rgb::ZERO, Rgb::ONE))
@@ -130,8 +130,7 @@ impl Material {
     /// (transmissive materials need it to orient their index of refraction).
     #[inline]
     pub fn bsdf(&self, hit: &SurfaceHit, front: bool) -> Bsdf {
-        // The diffuse case (most surfaces of most scenes) is built inline at the hit, without
-        // a call that returns the BSDF through memory; every other material goes out of line.
+        // Diffuse (most surfaces) here, the rest out of line: mis-area 3769 → 3750 Ir/sample.
         match self.lambert(hit) {
             Some(b) => Bsdf::Lambert(b),
             None => self.bsdf_general(hit, front),
@@ -139,8 +138,7 @@ impl Material {
     }
 
     /// The Lambertian BSDF of a diffuse material at `hit` (`None` for other materials):
-    /// small enough to come back in registers, so a caller can store it straight where it
-    /// goes.
+    /// for callers that store it straight into a lane rather than through a [`Bsdf`].
     #[inline]
     pub fn lambert(&self, hit: &SurfaceHit) -> Option<Lambert> {
         match self {

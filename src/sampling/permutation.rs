@@ -107,7 +107,7 @@ impl Permutation {
 
 impl Permutation {
     /// The images of the `N` consecutive indices `base..base + N` (each < n), computed in one
-    /// loop that the compiler can vectorise: for a power of two n (no cycle-walking) the three
+    /// loop over all `N` lanes: for a power of two n (no cycle-walking) the three
     /// rounds once; otherwise every lane walks its cycle until all lanes are inside [0, n)
     /// (lanes already inside keep their value, so each is the scalar [`Permutation::apply_wrapped`]).
     /// Entries for indices ≥ n (when base + N > n) are unspecified.

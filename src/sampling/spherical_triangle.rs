@@ -4,6 +4,10 @@
 //! the vertex Ĉ on arc AC; ξ₂ then picks the point on arc BĈ with the right conditional density
 //! (uniform in 1 − cos of the arc length from B). All the trigonometry runs in f64, because for
 //! small triangles it cancels catastrophically in f32.
+//!
+//! Branch-free throughout (validity flags and selects, libm-free trigonometry), so the
+//! integrator's solid-angle lane kernel draws 16 samples at once (with that kernel, dbcda06:
+//! light-solid-angle cornell 256² 64 spp 0.79 → 0.37 s).
 
 use super::warps::DIRECTION_SLACK;
 use glam::{DVec3, Vec2, Vec3};
@@ -33,8 +37,7 @@ pub struct SphericalTriangle {
 
 /// Solid angle of the spherical triangle of unit vectors (Van Oosterom & Strackee 1983);
 /// accurate for tiny triangles, unlike the angle excess α + β + γ − π.
-/// The atan2 is [`super::warps::atan2_f64`] (arithmetic and selects), so this inlines and
-/// vectorises in lane loops.
+/// The atan2 is [`super::warps::atan2_f64`] (arithmetic and selects, no libm call).
 #[inline(always)]
 fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let num = a.dot(b.cross(c)).abs();
@@ -44,7 +47,7 @@ fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 
 /// `v` normalised, and whether that is possible: `DVec3::try_normalize`'s arithmetic (the same
 /// bits) with a flag instead of an `Option`, so callers combine flags by select rather than
-/// branch on each (which would keep lane loops from vectorising).
+/// branch on each (lanes of the solid-angle kernel take different branches).
 #[inline(always)]
 fn unit(v: DVec3) -> (DVec3, bool) {
     let rcp = v.length_recip();
@@ -71,8 +74,8 @@ pub struct SphericalProjection {
 
 impl SphericalProjection {
     /// Unit directions from `p` to (v0, v1, v2); `None` if a vertex coincides with `p`.
-    /// Everything is computed and the flags combined at the end (no early return), so lane
-    /// loops over it if-convert and vectorise.
+    /// Everything is computed and the flags combined at the end (no early return), so all 16
+    /// lanes of the solid-angle kernel run it together, whichever of them fail.
     #[inline(always)]
     pub fn new(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<Self> {
         let p = p.as_dvec3();
@@ -159,7 +162,7 @@ struct Arvo {
 
 impl Arvo {
     /// Unit direction uniformly distributed in the spherical triangle. Branch-free (selects
-    /// only) and always inlined, so a loop over lanes vectorises.
+    /// only), so 16 lanes of the solid-angle kernel sample at once.
     #[inline(always)]
     fn sample(&self, u: Vec2) -> Vec3 {
         let (a, b) = (self.a, self.b);

@@ -23,7 +23,7 @@ pub fn spherical_direction(cos_theta: f32, phi: f32) -> Vec3 {
 }
 
 /// `(sin 2πt, cos 2πt)` for a fraction of a turn `t` in [0, 1] (the warps' azimuth 2πξ), without
-/// the libm `sincosf` call (≈ 45 instructions plus a call per warp on the hot path).
+/// a libm `sincosf` call (on the hot path of every BSDF sample).
 ///
 /// Reduction is exact: s = 4t, q = nearest quadrant, r = s − q ∈ [−½, ½] (Sterbenz), so the
 /// polynomials only ever see |2πt − qπ/2| ≤ π/4; their minimax fits (Lawson iteration) are off by
@@ -60,8 +60,8 @@ pub fn sin_cos_turn(t: f32) -> (f32, f32) {
 }
 
 /// `(sin x, cos x)` in f64 for 0 ≤ x ≤ 8 only (the caller guarantees the range; outside it
-/// the result is inaccurate, never UB). Pure arithmetic and selects, always inlined, so a loop
-/// over lanes of Arvo's sampler (x = ξ₁Ω ∈ [0, 2π]) vectorises.
+/// the result is inaccurate, never UB). Pure arithmetic and selects, so Arvo's sampler
+/// (x = ξ₁Ω ∈ [0, 2π]) runs in the solid-angle lane kernel without a libm call per lane.
 ///
 /// Cody–Waite reduction by π/2 to the nearest quadrant q, in two parts (the high part has 8
 /// trailing zero bits, so q·hi is exact for the q ≤ 5 that occur), then Taylor series on
@@ -73,9 +73,8 @@ pub fn sin_cos_0_8_f64(x: f64) -> (f64, f64) {
     // The zeroed bits, plus π/2 − FRAC_PI_2 (the part of π/2 that f64 cannot hold).
     const PIO2_LO: f64 = (std::f64::consts::FRAC_PI_2 - PIO2_HI) + 6.123_233_995_736_766e-17;
     // The nearest quadrant q by the 1.5·2⁵² trick: adding it rounds x·2/π to an integer
-    // (ulp 1 there) whose low bits are q's, and subtracting it again gives q exactly. No
-    // float → int conversion: Rust's saturating `as` does not vectorise (one scalar
-    // conversion per lane), this is one add, one sub and integer ops on the bits.
+    // (ulp 1 there) whose low bits are q's, and subtracting it again gives q exactly.
+    // Not `as i32`: its saturation was 16 scalar conversions per kernel loop (dbcda06).
     const SHIFT: f64 = 6_755_399_441_055_744.0;
     let shifted = x * std::f64::consts::FRAC_2_PI + SHIFT;
     let q = shifted.to_bits();
@@ -121,9 +120,9 @@ pub fn sin_cos_0_8_f64(x: f64) -> (f64, f64) {
 }
 
 /// `atan2(y, x)` in f64 (angle of (x, y) in [−π, π]) from plain arithmetic and selects: no
-/// libm call and no branch, so it inlines and vectorises in lane loops (the spherical
-/// triangle's solid angle, 2·atan2(|triple product|, 1 + a·b + b·c + c·a), on every
-/// solid-angle light sample and MIS pdf). Within 2 ulp of libm over the whole domain
+/// libm call and no branch, so 16 lanes of the spherical triangle's solid angle,
+/// 2·atan2(|triple product|, 1 + a·b + b·c + c·a), run at once on every solid-angle light
+/// sample and MIS pdf. Within 2 ulp of libm over the whole domain
 /// (zeros, subnormals, huge and infinite values, both signs; tested); NaN in, NaN out.
 ///
 /// Reduction: the octant swap gives t = n/d ∈ [0, 1] (n = min(|x|, |y|), d = max), then

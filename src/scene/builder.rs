@@ -15,6 +15,10 @@ use glam::Vec3;
 /// Segments around an emissive cylinder's tessellation ([`SceneBuilder::add_cylinder`]).
 pub const CYLINDER_LIGHT_SEGMENTS: u32 = 64;
 
+/// Grid (along φ, along the other parameter) of an emissive partial sphere's or disk's
+/// tessellation ([`SceneBuilder::add_partial_sphere`], [`SceneBuilder::add_partial_disk`]).
+pub const PARTIAL_LIGHT_GRID: (u32, u32) = (64, 16);
+
 /// Accumulates shapes, materials and lights, then builds the BVH once.
 #[derive(Default)]
 pub struct SceneBuilder {
@@ -311,6 +315,98 @@ impl SceneBuilder {
         self.add_quadric(q, material, emission)
     }
 
+    /// Add pbrt-v4's partial sphere `[zmin, zmax, phimax (radians)]` of `radius` in
+    /// `to_world`'s object space. An emissive one becomes a [`PARTIAL_LIGHT_GRID`] mesh of
+    /// triangle lights with the sphere's normals (the loader warns).
+    pub fn add_partial_sphere(
+        &mut self,
+        to_world: Transform,
+        radius: f32,
+        [zmin, zmax, phimax]: [f32; 3],
+        material: u32,
+        emission: Option<AreaEmission>,
+        reverse_orientation: bool,
+    ) -> anyhow::Result<()> {
+        ensure!(
+            radius.is_finite() && radius > 0.0,
+            "sphere radius must be positive and finite, got {radius}"
+        );
+        let (zmin, zmax) = (
+            zmin.min(zmax).clamp(-radius, radius),
+            zmin.max(zmax).clamp(-radius, radius),
+        );
+        ensure!(
+            zmin < zmax && phimax > 0.0 && phimax.is_finite(),
+            "partial sphere needs zmin < zmax within the radius and phimax > 0 (z {zmin}..{zmax}, phimax {phimax})"
+        );
+        let flip = reverse_orientation ^ to_world.swaps_handedness();
+        if let Some(e) = emission {
+            let (t0, t1) = ((zmin / radius).acos(), (zmax / radius).acos());
+            let mesh = tessellate(&to_world, flip, |u, v| {
+                let (theta, phi) = (t0 + (t1 - t0) * v, u * phimax);
+                let n = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                );
+                (n * radius, n)
+            });
+            return self.add_mesh_repaired(mesh, material, Some(e)).map(|_| ());
+        }
+        let q = Quadric {
+            kind: QuadricKind::SphereCut {
+                radius,
+                zmin,
+                zmax,
+                phimax,
+            },
+            to_world,
+            flip,
+        };
+        self.add_quadric(q, material, None)
+    }
+
+    /// Add pbrt-v4's annulus / partial disk (`inner` ≤ r ≤ `radius`, φ in [0, `phimax`]) in the
+    /// z = `height` plane of `to_world`'s object space. An emissive one becomes a
+    /// [`PARTIAL_LIGHT_GRID`] mesh of triangle lights (the loader warns).
+    pub fn add_partial_disk(
+        &mut self,
+        to_world: Transform,
+        height: f32,
+        [radius, inner, phimax]: [f32; 3],
+        material: u32,
+        emission: Option<AreaEmission>,
+        reverse_orientation: bool,
+    ) -> anyhow::Result<()> {
+        ensure!(
+            radius.is_finite() && radius > 0.0 && height.is_finite(),
+            "disk radius must be positive and finite (radius {radius}, height {height})"
+        );
+        ensure!(
+            (0.0..radius).contains(&inner) && phimax > 0.0 && phimax.is_finite(),
+            "partial disk needs 0 ≤ innerradius < radius and phimax > 0 (inner {inner}, phimax {phimax})"
+        );
+        let flip = reverse_orientation ^ to_world.swaps_handedness();
+        if let Some(e) = emission {
+            let mesh = tessellate(&to_world, flip, |u, v| {
+                let (r, phi) = (radius - (radius - inner) * v, u * phimax);
+                (Vec3::new(r * phi.cos(), r * phi.sin(), height), Vec3::Z)
+            });
+            return self.add_mesh_repaired(mesh, material, Some(e)).map(|_| ());
+        }
+        let q = Quadric {
+            kind: QuadricKind::DiskCut {
+                height,
+                radius,
+                inner,
+                phimax,
+            },
+            to_world,
+            flip,
+        };
+        self.add_quadric(q, material, None)
+    }
+
     /// Add pbrt-v4's cylinder `[radius, zmin, zmax, phimax (radians)]` of `to_world`'s object
     /// space (axis z). An emissive one becomes a mesh of
     /// [`CYLINDER_LIGHT_SEGMENTS`] × 2 triangle lights with the cylinder's normals (the
@@ -331,11 +427,10 @@ impl SceneBuilder {
             zmin < zmax && phimax > 0.0 && phimax.is_finite(),
             "cylinder needs zmin < zmax and phimax > 0 (z {zmin}..{zmax}, phimax {phimax})"
         );
-        // The object-space normal (x, y, 0) through the inverse transpose is already the
-        // outward one under a mirroring transform (pbrt-v4 crosses the render-space ∂p/∂u,
-        // ∂p/∂v, which a mirror turns inward, and flips them back): only
-        // ReverseOrientation flips it.
-        let flip = reverse_orientation;
+        // pbrt-v4's quadric rule, as for spheres and disks: the object-space ∂p/∂u × ∂p/∂v
+        // is negated for ReverseOrientation XOR a handedness swap, then carried to world
+        // space as a normal, so a mirrored cylinder faces inward.
+        let flip = reverse_orientation ^ to_world.swaps_handedness();
         if let Some(e) = emission {
             let n = CYLINDER_LIGHT_SEGMENTS;
             let (mut positions, mut normals, mut uvs, mut indices) =
@@ -419,9 +514,8 @@ impl SceneBuilder {
         let q = Quadric {
             kind: QuadricKind::Curve(segment),
             to_world,
-            // As the cylinder's: the normal through the inverse transpose needs no
-            // handedness flip.
-            flip: reverse_orientation,
+            // pbrt-v4's curves flip as its quadrics do.
+            flip: reverse_orientation ^ to_world.swaps_handedness(),
         };
         self.add_quadric(q, material, None)
     }
@@ -527,6 +621,44 @@ fn emitter_geometry(prims: &[Primitive], meshes: &[MeshShading], quadrics: &[Qua
     Geometry::new(own_prims, own_meshes, own_quadrics)
 }
 
+/// A [`PARTIAL_LIGHT_GRID`] triangle mesh of the object-space surface `f(u, v) → (point,
+/// normal)` over [0, 1]², in world space, with the surface's normals (negated with `flip`) and
+/// uv = (u, v); wound so the triangles' normals agree with the vertex normals.
+fn tessellate(
+    to_world: &Transform,
+    flip: bool,
+    f: impl Fn(f32, f32) -> (Vec3, Vec3),
+) -> TriangleMesh {
+    let (nu, nv) = PARTIAL_LIGHT_GRID;
+    let nt = to_world.m_inv.transpose();
+    let (mut positions, mut normals, mut uvs, mut indices) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for i in 0..=nu {
+        for j in 0..=nv {
+            let (u, v) = (i as f32 / nu as f32, j as f32 / nv as f32);
+            let (p, n) = f(u, v);
+            positions.push(to_world.point(p));
+            let n = nt.transform_vector3(n).normalize_or_zero();
+            normals.push(if flip { -n } else { n });
+            uvs.push(glam::Vec2::new(u, v));
+        }
+    }
+    let at = |i: u32, j: u32| i * (nv + 1) + j;
+    for i in 0..nu {
+        for j in 0..nv {
+            indices.extend_from_slice(&[at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            indices.extend_from_slice(&[at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    TriangleMesh {
+        positions,
+        normals: Some(normals),
+        uvs: Some(uvs),
+        indices,
+        flip_normals: flip,
+    }
+}
+
 fn check_emission(e: &AreaEmission) -> anyhow::Result<()> {
     ensure!(
         e.l.is_finite() && e.l.min_element() >= 0.0,
@@ -551,7 +683,8 @@ fn quadric_light(q: &Quadric, e: &AreaEmission) -> anyhow::Result<Light> {
     let light = match q.kind {
         QuadricKind::Sphere { radius } => {
             let c = q.to_world.point(Vec3::ZERO);
-            SphereLight::new(c, radius * sx, e.l, q.flip).map(Light::Sphere)
+            SphereLight::new(c, radius * sx, e.l, q.flip)
+                .map(|s| Light::Sphere(s.with_two_sided(e.two_sided)))
         }
         QuadricKind::Disk { height, radius } => {
             let c = q.to_world.point(Vec3::new(0.0, 0.0, height));
@@ -561,7 +694,11 @@ fn quadric_light(q: &Quadric, e: &AreaEmission) -> anyhow::Result<Light> {
             }
             DiskLight::new(c, n, radius * sx, e.l, e.two_sided).map(Light::Disk)
         }
-        QuadricKind::Cylinder { .. } | QuadricKind::Bilinear { .. } | QuadricKind::Curve(_) => None,
+        QuadricKind::Cylinder { .. }
+        | QuadricKind::SphereCut { .. }
+        | QuadricKind::DiskCut { .. }
+        | QuadricKind::Bilinear { .. }
+        | QuadricKind::Curve(_) => None,
     };
     light.ok_or_else(|| anyhow::anyhow!("degenerate emissive shape"))
 }

@@ -294,9 +294,8 @@ impl Geometry {
             }
     }
 
-    /// [`Self::other_t`] kept out of line for the wide traversal: inlined, the compiler
-    /// hoists its per-ray setup (splats of the ray) out of the traversal loop, which every ray
-    /// pays for although triangle-only scenes never run it.
+    /// [`Self::other_t`] kept out of line for the wide traversal, so that the rays of
+    /// triangle-only scenes, which never run it, do not pay for its per-ray setup.
     #[inline(never)]
     pub(super) fn other_t_outlined(&self, id: usize, o: Vec3, d: Vec3, t_max: f32) -> f32 {
         self.other_t(id, o, d, t_max)
@@ -378,7 +377,7 @@ impl Geometry {
 /// `v.normalize_or_zero()`, bit for bit (same length, reciprocal and product), but with the
 /// validity test 0 < 1/|v| < ∞ as one integer compare: the positive finite non-zero floats
 /// are exactly the bit patterns 1..=0x7f7f_ffff (zero wraps below, +∞, NaN and negative
-/// values lie above), while the float form compiles to a dozen-instruction class test.
+/// values lie above). Over the float compares: mis-area 2731 → 2721 Ir/sample (2fe2695).
 #[inline(always)]
 fn unit_or_zero(v: Vec3) -> Vec3 {
     let rcp = 1.0 / v.dot(v).sqrt();
@@ -467,8 +466,8 @@ impl Geometry {
         }
     }
 
-    /// [`RayQuery::intersect`] after the cheap pre-test, out of line: its frame (traversal
-    /// stack, six saved registers) is not set up for rays that the pre-test rejects.
+    /// [`RayQuery::intersect`] after the cheap pre-test, out of line, so that rays the
+    /// pre-test rejects skip its setup (mis-area 2771 → 2731 Ir/sample, c225f85).
     #[inline(never)]
     pub(super) fn intersect_full(&self, ray: &Ray) -> Option<SurfaceHit> {
         let (id, t, b) = match &self.accel {
@@ -494,8 +493,7 @@ impl RayQuery for Geometry {
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
-        // The default backend by a compare; the others out of line (inline, LLVM folds all
-        // four into a jump table that every shadow ray pays for).
+        // The default backend by a compare, the others out of line: mis-area 2721 → 2717 Ir/sample.
         if let Accel::Wide(bvh) = &self.accel {
             return bvh.any(ray.o, ray.d, ray.t_max, |id| {
                 self.other_t_outlined(id, ray.o, ray.d, ray.t_max) < ray.t_max

@@ -78,8 +78,7 @@ impl Geometry {
     ) {
         let active = active & PACKET_MASK;
         *out = [None; PACKET];
-        // Only hits are stored below: copying a whole `None` (68 bytes of which 4 were just
-        // written) stalls on store forwarding.
+        // Only hits are stored below: whole `None`s cost 2657 vs 2643 Ir/sample (f592b8a).
         let Some(bvh) = self.wide() else {
             for i in bits(active) {
                 if let Some(h) = self.intersect(&rays.ray(i)) {

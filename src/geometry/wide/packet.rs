@@ -285,10 +285,9 @@ struct TriLanes<S: Simd> {
     inv: S::F,
 }
 
-/// Ray-space vertex `j` of triangle `lane` of `pk` (a function, not a closure: out of line it
-/// would miss the caller's target features). The coordinates are broadcast straight from the
-/// packet: copied to a stack array first, they were read back before the copy's narrower
-/// stores could be forwarded (a stall that cost a tenth of the any-hit kernel).
+/// Ray-space vertex `j` of triangle `lane` of `pk` (a function, not a closure, so it keeps the
+/// caller's target features). The coordinates are broadcast straight from the packet, not
+/// through a copy (dc42e56: 1-thread 256² 64 spp light-area 0.307 → 0.287 s).
 #[inline(always)]
 fn shear<S: Simd>(
     pk: &TriPacket,

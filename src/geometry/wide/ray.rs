@@ -16,7 +16,7 @@ impl Node4 {
     /// Entry distances of the four child boxes and the mask of those entered before `t_max`.
     #[inline(always)]
     fn hit(&self, r: &RayBox, t_max: f32) -> (Vec4, u32) {
-        // `& 1` lets the compiler drop the bounds checks of the runtime plane choice.
+        // `side & 1`: the plane index is 0 or 1 by construction, so no check per node.
         let t = |side: usize, axis: usize| (self.b[side & 1][axis] - r.o[axis]) * r.inv[axis];
         let near = t(r.near[0], 0)
             .max(t(r.near[1], 1))
@@ -34,7 +34,7 @@ struct RayBox {
     inv: [Vec4; 3],
     /// Side (0 = lower, 1 = upper box plane) through which the ray enters, per axis.
     near: [usize; 3],
-    /// The other side per axis (stored, not `near ^ 1` per node: one instruction less each).
+    /// The other side per axis (stored once per ray rather than `near ^ 1` per node).
     far: [usize; 3],
 }
 
@@ -92,7 +92,7 @@ impl SingleLeaf {
 impl WideBvh {
     /// True if the tree is a single leaf whose box the ray (o, d) misses in (0, t_max), so
     /// that [`Self::closest`] would return `None`: a cheap pre-test for callers whose own
-    /// per-query work (a large stack frame) is worth skipping.
+    /// per-query work (setting up a traversal) is worth skipping.
     #[inline(always)]
     pub fn single_leaf_missed(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
         match &self.single_leaf {

@@ -1,7 +1,7 @@
 //! The AVX-512 form of the `stratified` fast path: a pixel's set keys hashed 8 dimensions per
 //! vector ([`RawSets`]), chunks of 16 values as one 16-lane vector per step, and the group
-//! fills of [`PixelSamples`](super::PixelSamples) in raw mode. The same values as the integer form of `fast.rs` and
-//! the definition in `stratified.rs` (tests/pat_golden.rs).
+//! fills of [`PixelSamples`](super::PixelSamples) in raw mode. The same values as the integer
+//! form of `fast.rs` and the definition in `stratified.rs` (tests/pat_golden.rs).
 
 use super::CACHED_DIMS;
 use super::sets::SetKeys;
@@ -87,8 +87,8 @@ impl Pattern {
 
 impl FastStrata {
     /// [`FastStrata::chunk_1d`] on AVX-512, written with intrinsics, one 16-lane vector per
-    /// step (compiled from the portable loops, LLVM split the 16 lanes 8 + 4 + 2 + 1 + 1); any
-    /// count, since the permutation cycle-walks on lane masks.
+    /// step; any count, since the permutation cycle-walks on lane masks.
+    // Over the portable loops: 1-thread 256² 64 spp mis-area 0.778 → 0.744 s (d25f354).
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(super) fn chunk_1d_avx512(&self, t: Avx512, set: &SetKeys, base: u32) -> [f32; CHUNK] {
@@ -290,8 +290,7 @@ fn fixed_wide_avx512(
     use std::arch::x86_64::*;
     // SAFETY: the token proves the CPU runs AVX-512 (F and DQ).
     unsafe {
-        // Eight lanes (a 256-bit half) at a time, unrolled: a closure would be compiled
-        // without the AVX-512 features.
+        // Two 8-lane halves written out: a closure would lose the AVX-512 target features.
         let (s0, j0) = (_mm512_castsi512_si256(strata), _mm512_castsi512_si256(j));
         let (s1, j1) = (
             _mm512_extracti64x4_epi64::<1>(strata),

@@ -2,8 +2,8 @@
 //! a stratum index with its 24-bit jitter appended as fraction bits is one fixed-point number,
 //! so a chunk of 16 values is integer permutation rounds, integer hashes, one exact conversion
 //! and one IEEE division per value — the same f32s as the definition in `stratified.rs`
-//! (tests/pat_golden.rs). Plain loops that vectorise, compiled for every instruction set the
-//! CPU runs (`Cpu::dispatch`); on AVX-512 the intrinsics form of `avx512.rs` serves instead.
+//! (tests/pat_golden.rs). Plain loops over the chunk's 16 lanes, compiled for every instruction
+//! set the CPU runs (`Cpu::dispatch`); on AVX-512 the intrinsics of `avx512.rs` serve instead.
 
 use glam::Vec2;
 
@@ -90,7 +90,7 @@ impl FastStrata {
     }
 
     /// The full 64-bit jitter hashes of indices `base..base + CHUNK` of `set` (x: bits 8..32,
-    /// y: bits 40..64), in a plain loop over u64 lanes that vectorises whole.
+    /// y: bits 40..64), one 64-bit hash per lane.
     #[inline(always)]
     fn jitter_hashes(set: &SetKeys, base: u32) -> [u64; CHUNK] {
         let mut h = [0u64; CHUNK];
@@ -188,8 +188,8 @@ impl FastStrata {
     }
 }
 
-/// (s mod nx, s / nx) for s, nx < 2^24 through an f32 division, which vectorises (a u32
-/// division does not). Exact: s and nx convert exactly; if nx divides s the quotient q is
+/// (s mod nx, s / nx) for s, nx < 2^24 through an f32 division (x86 has no vector integer
+/// division). Exact: s and nx convert exactly; if nx divides s the quotient q is
 /// exact, else s/nx = q + r/nx lies at least 1/nx below q + 1 while half an ulp of it is at
 /// most 2^-24 · s/nx < 1/nx, so the rounded quotient stays in [q, q + 1) and truncates to q.
 #[inline(always)]
@@ -198,8 +198,9 @@ fn split_f32(s: u32, nx: u32) -> (u32, u32) {
     (s - q * nx, q)
 }
 
-/// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form that
-/// vectorises (the same values: the integer is the same and exact either way).
+/// [`in_stratum_fixed`] of a chunk; `small` (every stratum < 2^7) takes an i32 form (the same
+/// values: the integer is the same and exact either way).
+// Measured: the i32 form took mis-area from 3283 to 3278 Ir per sample (2cba393).
 #[inline(always)]
 fn fixed_chunk(strata: &[u32; CHUNK], j: &[u32; CHUNK], div: f32, small: bool) -> [f32; CHUNK] {
     let mut out = [0.0f32; CHUNK];
@@ -230,7 +231,7 @@ const FIX_ONE: f32 = (1u32 << 24) as f32;
 #[inline(always)]
 fn in_stratum_fixed(stratum: u32, j: u32, div: f32) -> f32 {
     let v = (((stratum as u64) << 24) | j as u64) as i64 as f32 / div;
-    // `v` is never NaN, so this is `v.min(ONE_MINUS_EPSILON)` in a single `minss`.
+    // `v` is never NaN, so this is `v.min(ONE_MINUS_EPSILON)` without `min`'s NaN handling.
     if v < ONE_MINUS_EPSILON {
         v
     } else {

@@ -28,7 +28,7 @@
 //! dimensions once ([`PixelSamples`], in `pixel.rs`), which then evaluates each of those sample
 //! sets 16 consecutive indices at a time (integrators walk a pixel's indices in order), so most
 //! samples cost one compare and a load. `stratified` batches run in an integer form (`fast.rs`:
-//! vectorisable permutation rounds; stratum and jitter as one fixed-point number; its portable
+//! lane-parallel permutation rounds; stratum and jitter as one fixed-point number; its portable
 //! loops compiled for every instruction set by `Cpu::dispatch`) or with AVX-512 intrinsics
 //! (`avx512.rs`). The values are bit-identical to those of `sample_1d` / `sample_2d`
 //! (tests/pat_golden.rs).

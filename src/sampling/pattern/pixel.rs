@@ -52,7 +52,7 @@ pub(super) const CHUNK: usize = 16;
 
 /// Precomputed values of consecutive indices [base, base + len) of one sample set for one
 /// count: integrators walk a pixel's indices in order, so a batch evaluated in one tight loop
-/// (keys in registers, no per-call lookups) serves the next `len` requests with one compare.
+/// (keys read once, no per-request lookups) serves the next `len` requests with one compare.
 #[derive(Clone, Debug)]
 pub(super) struct Chunk<T: Copy> {
     /// The count the values belong to.

@@ -145,6 +145,30 @@ impl PbrtScene {
                     s.emission,
                     s.reverse_orientation,
                 ),
+                ShapeGeom::PartialSphere {
+                    to_world,
+                    radius,
+                    cut,
+                } => b.add_partial_sphere(
+                    to_world,
+                    radius,
+                    cut,
+                    s.material,
+                    s.emission,
+                    s.reverse_orientation,
+                ),
+                ShapeGeom::PartialDisk {
+                    to_world,
+                    height,
+                    cut,
+                } => b.add_partial_disk(
+                    to_world,
+                    height,
+                    cut,
+                    s.material,
+                    s.emission,
+                    s.reverse_orientation,
+                ),
                 ShapeGeom::Curves { to_world, segments } => segments
                     .into_iter()
                     .try_for_each(|c| b.add_curve(to_world, c, s.material, s.reverse_orientation)),

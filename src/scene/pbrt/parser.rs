@@ -818,6 +818,7 @@ impl Parser {
                     Some("uniform") => Some(crate::light_selection::SelectorKind::Uniform),
                     Some("power") => Some(crate::light_selection::SelectorKind::Power),
                     Some("bvh") => Some(crate::light_selection::SelectorKind::Bvh),
+                    Some("exhaustive") => Some(crate::light_selection::SelectorKind::Exhaustive),
                     Some(other) => {
                         self.warn("lightsampler", &loc, format!("lightsampler \"{other}\" unknown: light selection by the --light-selection default"));
                         None
@@ -1141,6 +1142,43 @@ impl Parser {
                 format!(
                     "emissive cylinder tessellated into {} triangle lights per side (penumbra samples no analytic cylinder light)",
                     crate::scene::builder::CYLINDER_LIGHT_SEGMENTS * 2
+                ),
+            );
+        }
+        if emission.as_ref().is_some_and(|e| !e.two_sided)
+            && self.gs.ctm.swaps_handedness()
+            && matches!(
+                geom,
+                super::shapes::ShapeGeom::Sphere { .. }
+                    | super::shapes::ShapeGeom::Disk { .. }
+                    | super::shapes::ShapeGeom::PartialSphere { .. }
+                    | super::shapes::ShapeGeom::PartialDisk { .. }
+                    | super::shapes::ShapeGeom::Cylinder { .. }
+            )
+        {
+            // pbrt-v4's quadric intersections flip the normal for the handedness swap but its
+            // shape samples do not, so its own hits and light samples disagree on the side.
+            self.warn(
+                "mirrored-quadric-light",
+                loc,
+                format!(
+                    "one-sided \"{ty}\" light under a mirroring transform emits to the side of pbrt-v4's intersection normal (ReverseOrientation XOR handedness swap) for hits and light samples alike; pbrt-v4's own light samples emit to the other side"
+                ),
+            );
+        }
+        if emission.is_some()
+            && matches!(
+                geom,
+                super::shapes::ShapeGeom::PartialSphere { .. }
+                    | super::shapes::ShapeGeom::PartialDisk { .. }
+            )
+        {
+            let (nu, nv) = crate::scene::builder::PARTIAL_LIGHT_GRID;
+            self.warn(
+                "partial-quadric-light",
+                loc,
+                format!(
+                    "emissive partial \"{ty}\" tessellated into {nu}×{nv}×2 triangle lights (penumbra samples no analytic partial sphere or annulus)"
                 ),
             );
         }

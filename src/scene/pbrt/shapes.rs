@@ -52,6 +52,24 @@ pub enum ShapeGeom {
         /// The segments.
         segments: Vec<CurveSegment>,
     },
+    /// pbrt-v4's partial sphere (object space: z in [zmin, zmax], φ in [0, phimax]).
+    PartialSphere {
+        /// Object-to-world.
+        to_world: Transform,
+        /// Radius in object space.
+        radius: f32,
+        /// zmin, zmax (clamped to ±radius) and phimax in radians.
+        cut: [f32; 3],
+    },
+    /// pbrt-v4's annulus / partial disk at z = height.
+    PartialDisk {
+        /// Object-to-world.
+        to_world: Transform,
+        /// Height in object space.
+        height: f32,
+        /// Outer radius, inner radius and phimax in radians.
+        cut: [f32; 3],
+    },
     /// pbrt-v4's cylinder (object space: axis z, z in [zmin, zmax], φ in [0, phimax]).
     Cylinder {
         /// Object-to-world.
@@ -97,6 +115,17 @@ impl ShapeGeom {
                 zmax,
                 phimax,
             } => phimax * radius * (zmax - zmin).abs() * area_scale(to_world),
+            // pbrt-v4's Sphere::Area and Disk::Area.
+            ShapeGeom::PartialSphere {
+                to_world,
+                radius,
+                cut: [zmin, zmax, phimax],
+            } => phimax * radius * (zmax - zmin).abs() * area_scale(to_world),
+            ShapeGeom::PartialDisk {
+                to_world,
+                cut: [radius, inner, phimax],
+                ..
+            } => phimax * 0.5 * (radius * radius - inner * inner) * area_scale(to_world),
             ShapeGeom::Bilinear { mesh, .. } => mesh
                 .as_ref()
                 .map_or(0.0, |m| ShapeGeom::Mesh(m.clone()).area()),
@@ -159,6 +188,24 @@ impl ShapeGeom {
                         ShapeGeom::Mesh(m) => m,
                         _ => unreachable!(),
                     }),
+            },
+            ShapeGeom::PartialSphere {
+                to_world,
+                radius,
+                cut,
+            } => ShapeGeom::PartialSphere {
+                to_world: t.then_apply_to(to_world),
+                radius: *radius,
+                cut: *cut,
+            },
+            ShapeGeom::PartialDisk {
+                to_world,
+                height,
+                cut,
+            } => ShapeGeom::PartialDisk {
+                to_world: t.then_apply_to(to_world),
+                height: *height,
+                cut: *cut,
             },
             ShapeGeom::Cylinder {
                 to_world,
@@ -475,19 +522,35 @@ pub fn make_shape(
                     format!("sphere: radius must be positive, found {radius}"),
                 ));
             }
-            let partial = params.float("zmin", -radius)? > -radius
-                || params.float("zmax", radius)? < radius
-                || params.float("phimax", 360.0)? < 360.0;
-            if partial {
-                warn(
-                    "partial-sphere",
+            // pbrt-v4's Sphere: z cuts clamped to the radius, phimax to [0, 360] degrees.
+            let (z0, z1) = (
+                params.float("zmin", -radius)?,
+                params.float("zmax", radius)?,
+            );
+            let (zmin, zmax) = (
+                z0.min(z1).clamp(-radius, radius),
+                z0.max(z1).clamp(-radius, radius),
+            );
+            let phimax = params.float("phimax", 360.0)?.clamp(0.0, 360.0);
+            if !(zmin < zmax && phimax > 0.0) {
+                return Err(err_at(
                     loc,
-                    "partial sphere (zmin/zmax/phimax) approximated by a full sphere".into(),
-                );
+                    format!(
+                        "sphere: zmin < zmax and phimax > 0 needed, found z {zmin}..{zmax}, phimax {phimax}"
+                    ),
+                ));
             }
-            ShapeGeom::Sphere {
-                to_world: *ctx.ctm,
-                radius,
+            if zmin > -radius || zmax < radius || phimax < 360.0 {
+                ShapeGeom::PartialSphere {
+                    to_world: *ctx.ctm,
+                    radius,
+                    cut: [zmin, zmax, phimax.to_radians()],
+                }
+            } else {
+                ShapeGeom::Sphere {
+                    to_world: *ctx.ctm,
+                    radius,
+                }
             }
         }
         "disk" => {
@@ -498,17 +561,29 @@ pub fn make_shape(
                     format!("disk: radius must be positive, found {radius}"),
                 ));
             }
-            if params.float("innerradius", 0.0)? > 0.0 || params.float("phimax", 360.0)? < 360.0 {
-                warn(
-                    "partial-disk",
+            let inner = params.float("innerradius", 0.0)?;
+            let phimax = params.float("phimax", 360.0)?.clamp(0.0, 360.0);
+            if !((0.0..radius).contains(&inner) && phimax > 0.0) {
+                return Err(err_at(
                     loc,
-                    "annulus/partial disk approximated by a full disk".into(),
-                );
+                    format!(
+                        "disk: 0 ≤ innerradius < radius and phimax > 0 needed, found innerradius {inner}, phimax {phimax}"
+                    ),
+                ));
             }
-            ShapeGeom::Disk {
-                to_world: *ctx.ctm,
-                height: params.float("height", 0.0)?,
-                radius,
+            let height = params.float("height", 0.0)?;
+            if inner > 0.0 || phimax < 360.0 {
+                ShapeGeom::PartialDisk {
+                    to_world: *ctx.ctm,
+                    height,
+                    cut: [radius, inner, phimax.to_radians()],
+                }
+            } else {
+                ShapeGeom::Disk {
+                    to_world: *ctx.ctm,
+                    height,
+                    radius,
+                }
             }
         }
         "curve" => match curve_shape(params, ctx, warn)? {
