@@ -547,9 +547,25 @@ fn check_exr_sizes(meta: &exr::meta::MetaData, file_len: u64) -> anyhow::Result<
                 h.compression
             );
         }
+        // A chunk's stored size is read into memory before it is checked against the file;
+        // the decoder bounds it by the uncompressed size of a whole row block or tile, which
+        // a tile far larger than the image makes huge (a 4x4 image in 13959232x64 tiles:
+        // 1.7 GB).
+        let block = (h.max_block_byte_size() as u64).max(1);
+        if block > most.max(MAX_EXR_BLOCK_FLOOR) {
+            bail!(
+                "the header's row blocks or tiles of {block} bytes each are more than the \
+                 file's {file_len} bytes can hold (and more than {} MB)",
+                MAX_EXR_BLOCK_FLOOR >> 20
+            );
+        }
     }
     Ok(())
 }
+
+/// Row blocks or tiles up to this size are taken without comparing them to the file (a tile
+/// may be larger than a small image).
+const MAX_EXR_BLOCK_FLOOR: u64 = 256 << 20;
 
 /// First RGB(A) layer of an EXR; falls back to a luminance-only ("Y") layer as grey.
 fn read_exr(path: &Path) -> anyhow::Result<Image> {
