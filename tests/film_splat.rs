@@ -125,3 +125,30 @@ fn cornell_path_splatted_matches_mitsuba_path_reference_with_less_error() {
         mean_rel * 100.0
     );
 }
+
+#[test]
+fn splat_refuses_renders_in_parts() {
+    // A weighted-mean film cannot be combined from parts by sample counts: each such flag must
+    // be refused before any work, not give a subtly different image.
+    for extra in [
+        &["--progressive"][..],
+        &["--time", "1"],
+        &["--spp-range", "0..4"],
+        &["--resume", "part.exr"],
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_penumbra"))
+            .args([
+                "render", "cornell", "--res", "8x8", "--spp", "4", "--splat", "-q",
+            ])
+            .args(extra)
+            .args(["-o", "/nonexistent-dir/x.exr"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{extra:?}");
+        assert!(
+            err.contains("--splat") && err.contains("cannot be used"),
+            "{extra:?}: {err}"
+        );
+    }
+}

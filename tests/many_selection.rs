@@ -9,8 +9,10 @@ use penumbra::Rgb;
 use penumbra::camera::Camera;
 use penumbra::integrator::{RenderOptions, render};
 use penumbra::light_selection::bvh::BvhSelector;
+use penumbra::light_selection::defensive::{DEFENSIVE_FLOOR, Defensive, ProbeConfig};
 use penumbra::light_selection::{
-    ExhaustiveSelector, FiniteSelector, LightSelector, SelectorKind, ShadingPoint, make_selector,
+    ExhaustiveSelector, FiniteSelector, LightSelector, LightSet, PowerSelector, SelectorKind,
+    ShadingPoint, SpatialSelector, make_selector,
 };
 use penumbra::lights::{
     Light, LightBounds, LightSource, PointLight, QuadLight, SpotLight, TriangleLight,
@@ -414,6 +416,124 @@ fn renders_agree_with_uniform_within_noise() {
         assert!(
             (m - mu).abs() < 5.0 * sigma,
             "{name}: mean {m} vs uniform {mu} (σ {sigma})"
+        );
+    }
+}
+
+/// The learned and grid strategies (`wald`, `spatial`, `adaptive`) are mixed defensively with
+/// power selection: every light with power keeps at least `DEFENSIVE_FLOOR` of its power
+/// probability at every shading point, so no light the learning missed is starved.
+#[test]
+fn learned_selectors_keep_a_power_floor() {
+    let scene = test_scene();
+    let n = scene.lights.len() as u32;
+    let power = make_selector(SelectorKind::Power, &scene, 1);
+    for kind in [
+        SelectorKind::Wald,
+        SelectorKind::Spatial,
+        SelectorKind::Adaptive,
+    ] {
+        let sel = make_selector(kind, &scene, 1);
+        for sp in shading_points(40, 21) {
+            let mut sum = 0.0f64;
+            for l in 0..n {
+                let (p, pp) = (sel.pmf(&sp, l), power.pmf(&sp, l));
+                sum += p as f64;
+                assert!(
+                    p >= DEFENSIVE_FLOOR * pp * (1.0 - 1e-5),
+                    "{kind}: light {l} pmf {p} below the floor of power's {pp} at {sp:?}"
+                );
+            }
+            assert!((sum - 1.0).abs() < 1e-4, "{kind}: pmf sum {sum} at {sp:?}");
+        }
+    }
+}
+
+/// A table that piles its probability on one light is judged by the probes and replaced by
+/// power selection; the spatial grid, which helps on this scene, is kept (δ < 1).
+#[test]
+fn probes_reject_a_bad_table_and_keep_a_good_one() {
+    struct OneLight(PowerSelector);
+    impl FiniteSelector for OneLight {
+        fn sample(&self, _: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
+            self.0.pick(u)
+        }
+        fn pmf(&self, _: &ShadingPoint, i: u32) -> f32 {
+            self.0.prob(i)
+        }
+    }
+    let scene = test_scene();
+    let set = LightSet::new(&scene.lights);
+    let mut w = vec![1e-4f32; set.finite.len()];
+    w[0] = 1.0;
+    let cfg = ProbeConfig::new(3, 0.05);
+    let bad = Defensive::new(
+        &scene,
+        &set,
+        OneLight(PowerSelector::from_weights(&w)),
+        &cfg,
+    );
+    assert_eq!(
+        bad.share(),
+        1.0,
+        "a one-light table must fall back to power"
+    );
+    let good = Defensive::new(&scene, &set, SpatialSelector::new(&scene, &set), &cfg);
+    eprintln!("spatial share of power: {}", good.share());
+    assert!(good.share() < 1.0, "spatial should beat power here");
+}
+
+/// The mixture at a fixed share draws from its pmf (chi²), whatever the probes would choose.
+#[test]
+fn chi2_defensive_mixture_matches_pmf() {
+    let scene = test_scene();
+    let set = LightSet::new(&scene.lights);
+    let n = set.finite.len();
+    let power = PowerSelector::new(&set.bounds);
+    let mix = Defensive::with_share(SpatialSelector::new(&scene, &set), power, 0.3);
+    let cfg = Chi2Config {
+        samples: 200_000,
+        num_tests: 2,
+        ..Default::default()
+    };
+    for sp in shading_points(2, 13) {
+        let pmf: Vec<f64> = (0..n as u32).map(|l| mix.pmf(&sp, l) as f64).collect();
+        let sum: f64 = pmf.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-4, "pmf sum {sum}");
+        let r = chi2_discrete(&cfg, &pmf, |u| {
+            mix.sample(&sp, u[0]).map(|(i, _)| i as usize)
+        });
+        eprintln!("defensive spatial 0.3: {}", r.summary());
+        assert!(r.passed, "{}", r.summary());
+    }
+}
+
+/// The probes (and so the learned selectors' pmfs) are the same on one thread and on four.
+#[test]
+fn learned_selectors_do_not_depend_on_threads() {
+    let scene = test_scene();
+    let n = scene.lights.len() as u32;
+    let pmfs = |threads: usize, kind: SelectorKind| -> Vec<u32> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let sel = make_selector(kind, &scene, 7);
+            shading_points(10, 31)
+                .iter()
+                .flat_map(|sp| (0..n).map(|l| sel.pmf(sp, l).to_bits()).collect::<Vec<_>>())
+                .collect()
+        })
+    };
+    for kind in [
+        SelectorKind::Wald,
+        SelectorKind::Spatial,
+        SelectorKind::Adaptive,
+    ] {
+        assert!(
+            pmfs(1, kind) == pmfs(4, kind),
+            "{kind}: pmf depends on threads"
         );
     }
 }

@@ -60,8 +60,9 @@ pub struct Args {
     pub no_roulette: bool,
     /// Splat each sample into every pixel its filter reaches (a weighted mean per pixel, as
     /// Mitsuba's film does) instead of filter importance sampling: less noise per pixel,
-    /// correlated between neighbours
-    #[arg(long)]
+    /// correlated between neighbours. Renders in one pass: a weighted-mean film cannot yet be
+    /// combined from parts, so it excludes --spp-range, --progressive, --resume and --time.
+    #[arg(long, conflicts_with_all = ["spp_range", "progressive", "resume", "time"])]
     pub splat: bool,
     /// Estimator at every path vertex: bsdf, light-area, light-solid-angle or mis.
     #[arg(long, default_value = "mis")]

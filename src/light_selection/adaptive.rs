@@ -10,8 +10,9 @@
 //! Unbiasedness: cells with too little training data use the spatial table alone; trained
 //! cells mix p = β·p_spatial + (1 − β)·p_learned with β = max([`AdaptiveConfig::beta`]
 //! (default 20%), spatial mass of the lights never measured in the cell) — the learned table
-//! only takes over the probability of lights it has measured — and p_spatial itself keeps its
-//! power floor, so every light keeps p > 0.
+//! only takes over the probability of lights it has measured — and `make_selector` mixes the
+//! result with power selection at a probed share of at least 10 % ([`super::defensive`]), so
+//! every light with power keeps p > 0.
 
 use super::estimate::{contribution, estimate_resolution, eye_hit, next_2d, pixel_rng};
 use super::spatial::{CellTable, SpatialSelector};

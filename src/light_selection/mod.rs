@@ -16,6 +16,7 @@
 
 pub mod adaptive;
 pub mod bvh;
+pub mod defensive;
 pub mod estimate;
 pub mod exhaustive;
 pub mod importance;
@@ -208,6 +209,12 @@ impl LightSelector for Selector {
     }
 }
 
+/// Reduction of the second moment the grid strategies (`spatial`, `adaptive`) must show over
+/// power selection before their tables are used at all: their time per sample is about 1.4–2×
+/// power's (a cell lookup and binary searches per call, and each cell scored against every
+/// light when first used), so a smaller gain loses at equal time.
+pub const GRID_MARGIN: f64 = 0.35;
+
 /// Largest f32 below 1: keeps rescaled sample numbers in [0, 1).
 pub const ONE_MINUS_EPS: f32 = 1.0 - f32::EPSILON / 2.0;
 
@@ -234,16 +241,23 @@ pub fn make_selector(
         SelectorKind::Ris { candidates } => {
             wrap(&|set| Box::new(RisSelector::new(&set.bounds, candidates, seed)))
         }
-        SelectorKind::Wald => {
-            wrap(&|set| Box::new(WaldSelector::new(scene, set, &wald::WaldConfig::new(seed))))
-        }
-        SelectorKind::Spatial => wrap(&|set| Box::new(SpatialSelector::new(scene, set))),
+        // The learned and grid strategies, mixed with power at the share their probes chose
+        // (`defensive.rs`). The margin is what a δ < 1 must gain: little for `wald` (two
+        // alias tables, power's cost), more for the grids ([`GRID_MARGIN`]).
+        SelectorKind::Wald => wrap(&|set| {
+            let inner = WaldSelector::new(scene, set, &wald::WaldConfig::new(seed));
+            let cfg = defensive::ProbeConfig::new(seed, 0.05);
+            Box::new(defensive::Defensive::new(scene, set, inner, &cfg))
+        }),
+        SelectorKind::Spatial => wrap(&|set| {
+            let inner = SpatialSelector::new(scene, set);
+            let cfg = defensive::ProbeConfig::new(seed, GRID_MARGIN);
+            Box::new(defensive::Defensive::new(scene, set, inner, &cfg))
+        }),
         SelectorKind::Adaptive => wrap(&|set| {
-            Box::new(AdaptiveSelector::new(
-                scene,
-                set,
-                &adaptive::AdaptiveConfig::new(seed),
-            ))
+            let inner = AdaptiveSelector::new(scene, set, &adaptive::AdaptiveConfig::new(seed));
+            let cfg = defensive::ProbeConfig::new(seed, GRID_MARGIN);
+            Box::new(defensive::Defensive::new(scene, set, inner, &cfg))
         }),
     }
 }

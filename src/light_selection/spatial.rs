@@ -8,8 +8,10 @@
 //!
 //! Each cell keeps its [`SpatialConfig::max_lights`] most important lights. Unbiasedness: every
 //! other light — and any light the bound misjudges — keeps probability through defensive
-//! mixing with power selection, p = α·p_Φ + (1 − α)·p_cell with α = [`SpatialConfig::alpha`]
-//! (default 10%), raised in cells where the left-out lights carry more than α of the bound.
+//! mixing with power selection, p = α·p_Φ + (1 − α)·p_cell with α = [`SpatialConfig::alpha`],
+//! raised in cells where the left-out lights carry more than α of the bound. α is 0 by
+//! default because `make_selector` mixes the grid with power selection again at a probed
+//! share of at least 10 % ([`super::defensive`]): that is the floor every light keeps.
 
 use super::importance::importance_sphere;
 use super::power::PowerSelector;
@@ -27,7 +29,7 @@ pub struct SpatialConfig {
     pub cells: u32,
     /// Lights kept per cell.
     pub max_lights: usize,
-    /// Share α of power selection mixed in everywhere.
+    /// Share α of power selection mixed in everywhere (0 by default: see the module doc).
     pub alpha: f32,
 }
 
@@ -36,7 +38,7 @@ impl Default for SpatialConfig {
         Self {
             cells: 4096,
             max_lights: 512,
-            alpha: 0.1,
+            alpha: 0.0,
         }
     }
 }
