@@ -235,3 +235,204 @@ fn hdr_and_tga_reads() {
     assert!((back.get(0, 1).y - srgb_to_linear(128.0 / 255.0)).abs() < 1e-6);
     assert!((back.get(0, 0).z - srgb_to_linear(64.0 / 255.0)).abs() < 1e-6);
 }
+
+/// An EXR of `w`×`h` half-float R, G, B pixels whose chunks are missing: a header, a
+/// one-entry offset table and `tail` zero bytes. `compression` is the header's code (0 none,
+/// 3 ZIP, 8 DWAA, ...); `tile` makes it a one-level tiled file with that tile size.
+fn exr_header_only(w: i32, h: i32, compression: u8, tile: Option<u32>, tail: usize) -> Vec<u8> {
+    fn attr(out: &mut Vec<u8>, name: &str, kind: &str, value: &[u8]) {
+        for s in [name, kind] {
+            out.extend_from_slice(s.as_bytes());
+            out.push(0);
+        }
+        out.extend_from_slice(&(value.len() as i32).to_le_bytes());
+        out.extend_from_slice(value);
+    }
+    let ints = |v: &[i32]| v.iter().flat_map(|i| i.to_le_bytes()).collect::<Vec<u8>>();
+    let mut out = vec![0x76, 0x2f, 0x31, 0x01];
+    let flags: u32 = if tile.is_some() { 0x200 } else { 0 };
+    out.extend_from_slice(&(2 | flags).to_le_bytes());
+    let mut channels = Vec::new();
+    for name in ["B", "G", "R"] {
+        channels.extend_from_slice(name.as_bytes());
+        channels.push(0);
+        channels.extend_from_slice(&ints(&[1, 0, 1, 1])); // half, pLinear+reserved, sampling 1×1
+    }
+    channels.push(0);
+    attr(&mut out, "channels", "chlist", &channels);
+    attr(&mut out, "compression", "compression", &[compression]);
+    let window = ints(&[0, 0, w - 1, h - 1]);
+    attr(&mut out, "dataWindow", "box2i", &window);
+    attr(&mut out, "displayWindow", "box2i", &window);
+    attr(&mut out, "lineOrder", "lineOrder", &[0]);
+    attr(&mut out, "pixelAspectRatio", "float", &1f32.to_le_bytes());
+    attr(&mut out, "screenWindowCenter", "v2f", &[0; 8]);
+    attr(&mut out, "screenWindowWidth", "float", &1f32.to_le_bytes());
+    if let Some(t) = tile {
+        let mut desc = ints(&[t as i32, t as i32]);
+        desc.push(0);
+        attr(&mut out, "tiles", "tiledesc", &desc);
+    }
+    out.push(0);
+    let first_chunk = out.len() as u64 + 8;
+    out.extend_from_slice(&first_chunk.to_le_bytes());
+    out.resize(out.len() + tail, 0);
+    out
+}
+
+/// Peak resident memory of this process so far (Linux), in bytes.
+fn peak_rss() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Most memory the image tests of this binary may take: the bad files below must fail before
+/// the reader allocates the image their header declares (2.4 GB from 700 bytes, found by the
+/// fuzz target `image`).
+const PEAK_RSS_LIMIT: u64 = 512 << 20;
+
+#[test]
+fn an_exr_header_cannot_make_the_reader_allocate_what_the_file_does_not_hold() {
+    let dir = scratch("exrhuge");
+    // 14000² is under the pixel cap; as linear RGB it is 2.35 GB, which 700 bytes cannot hold
+    // at any compression the format has.
+    for (name, compression, tile) in [
+        ("scan.exr", 0, None),
+        ("tile.exr", 0, Some(16384)),
+        ("zip.exr", 3, None),
+        ("piz.exr", 4, Some(16384)),
+        ("dwaa.exr", 8, None),
+    ] {
+        let p = dir.join(name);
+        std::fs::write(&p, exr_header_only(14000, 14000, compression, tile, 400)).unwrap();
+        let err = format!("{:#}", read_image(&p).unwrap_err());
+        assert!(err.contains(name), "{err}");
+        assert!(
+            err.contains("14000x14000") && err.contains("bytes"),
+            "{name}: the error should say what the header claims against the file: {err}"
+        );
+    }
+    // DWA's worst case (run-length coding, then deflate) lets 18 kB claim 1.2 GB: such a
+    // file passes the size check, and its image must still grow only as chunks decode.
+    let p = dir.join("dwaa-big.exr");
+    std::fs::write(&p, exr_header_only(14000, 14000, 8, None, 20_000)).unwrap();
+    let err = format!("{:#}", read_image(&p).unwrap_err());
+    assert!(err.contains("dwaa-big.exr"), "{err}");
+    if let Some(peak) = peak_rss() {
+        assert!(peak < PEAK_RSS_LIMIT, "peak memory {} MB", peak >> 20);
+    }
+}
+
+#[test]
+fn every_saved_image_fuzz_regression_fails_cleanly_in_bounded_memory() {
+    let dir = scratch("fuzzreg");
+    let saved = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions/image");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&saved).unwrap() {
+        let data = std::fs::read(entry.unwrap().path()).unwrap();
+        let Some((&which, bytes)) = data.split_first() else {
+            continue;
+        };
+        // The fuzz target's first byte picks the format (fuzz/src/harness.rs).
+        let ext = ["exr", "pfm", "png", "hdr"][which as usize % 4];
+        let p = dir.join(format!("input{n}.{ext}"));
+        std::fs::write(&p, bytes).unwrap();
+        if let Err(e) = read_image(&p) {
+            let err = format!("{e:#}");
+            assert!(err.contains(&format!("input{n}.{ext}")), "{err}");
+        }
+        n += 1;
+    }
+    assert!(n > 0, "no regression inputs in {}", saved.display());
+    if let Some(peak) = peak_rss() {
+        assert!(peak < PEAK_RSS_LIMIT, "peak memory {} MB", peak >> 20);
+    }
+}
+
+#[test]
+fn highly_compressed_exrs_still_read() {
+    // A flat 1024² image compresses by ~64:1 (RLE) to ~1000:1 (ZIP): the reader's bound on
+    // what a file can hold must not refuse real files near those ratios.
+    use exr::prelude::{Compression, Encoding, LineOrder, SpecificChannels, Vec2, WritableImage};
+    let dir = scratch("exrflat");
+    let n = 1024;
+    for (name, compression) in [
+        ("rle.exr", Compression::RLE),
+        ("zip.exr", Compression::ZIP16),
+        ("zips.exr", Compression::ZIP1),
+        ("piz.exr", Compression::PIZ),
+        ("pxr24.exr", Compression::PXR24),
+        ("b44a.exr", Compression::B44A),
+    ] {
+        let channels = SpecificChannels::rgb(|_: Vec2<usize>| (half_one(), half_one(), half_one()));
+        let encoding = Encoding {
+            compression,
+            blocks: exr::image::Blocks::ScanLines,
+            line_order: LineOrder::Increasing,
+        };
+        let layer = exr::image::Layer::new(
+            (n, n),
+            exr::meta::header::LayerAttributes::default(),
+            encoding,
+            channels,
+        );
+        let p = dir.join(name);
+        exr::image::Image::from_layer(layer)
+            .write()
+            .to_file(&p)
+            .unwrap();
+        let img = read_image(&p).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+        assert_eq!((img.width, img.height), (n as u32, n as u32));
+        assert_eq!(img.get(17, 900), Rgb::ONE, "{name}");
+    }
+}
+
+fn half_one() -> exr::prelude::f16 {
+    exr::prelude::f16::from_f32(1.0)
+}
+
+#[test]
+fn bottom_up_and_grey_exrs_read() {
+    // Rows stored bottom to top arrive last row first: the image must still be whole.
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Encoding, FlatSamples, LineOrder, SpecificChannels, Text, Vec2,
+        WritableImage,
+    };
+    let dir = scratch("exrorder");
+    let (w, h) = (5usize, 40usize);
+    let value = |x: usize, y: usize| (y * w + x) as f32;
+    let channels =
+        SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| (value(x, y), 2.0 * value(x, y), 0.5));
+    let encoding = Encoding {
+        line_order: LineOrder::Decreasing,
+        ..Encoding::FAST_LOSSLESS
+    };
+    let layer = exr::image::Layer::new(
+        (w, h),
+        exr::meta::header::LayerAttributes::default(),
+        encoding,
+        channels,
+    );
+    let p = dir.join("decreasing.exr");
+    exr::image::Image::from_layer(layer)
+        .write()
+        .to_file(&p)
+        .unwrap();
+    let img = read_image(&p).unwrap();
+    for (x, y) in [(0, 0), (4, 0), (2, 17), (4, 39)] {
+        let v = value(x, y);
+        assert_eq!(img.get(x as u32, y as u32), Rgb::new(v, 2.0 * v, 0.5));
+    }
+    // A luminance-only file reads as grey.
+    let y_channel = AnyChannel::new(
+        Text::from("Y"),
+        FlatSamples::F32((0..w * h).map(|i| i as f32).collect()),
+    );
+    let grey = exr::image::Image::from_channels((w, h), AnyChannels::sort(vec![y_channel].into()));
+    let p = dir.join("grey.exr");
+    grey.write().to_file(&p).unwrap();
+    let img = read_image(&p).unwrap();
+    assert_eq!(img.get(3, 2), Rgb::splat(value(3, 2)));
+}

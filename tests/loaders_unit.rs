@@ -995,3 +995,65 @@ fn gltf_normal_texture_is_linear_scaled_and_follows_the_uv_handedness() {
         loaded.warnings
     );
 }
+
+#[test]
+fn camera_flags_keep_an_orthographic_or_spherical_cameras_projection_and_lens() {
+    use penumbra::camera::Projection;
+    use penumbra::scene::view::ViewOptions;
+    let d = scratch("ortho-flags");
+    for (camera, projection) in [
+        (
+            "\"orthographic\" \"float lensradius\" 0.1 \"float focaldistance\" 4",
+            Projection::Orthographic,
+        ),
+        (
+            "\"spherical\"",
+            Projection::Spherical(penumbra::camera::SphericalMapping::EqualArea),
+        ),
+    ] {
+        let src = format!(
+            "LookAt 0 0 5  0 0 0  0 1 0\nCamera {camera}\nWorldBegin\n\
+             LightSource \"point\" \"rgb I\" [1 1 1]\nShape \"sphere\"\n"
+        );
+        let p = write(&d, "s.pbrt", src.as_bytes());
+        let spec = p.to_str().unwrap();
+        let plain = load(spec, &LoadOptions::default()).expect("load");
+        assert_eq!(
+            std::mem::discriminant(&plain.scene.camera.projection),
+            std::mem::discriminant(&projection)
+        );
+        // Moving the eye moves the camera; it stays the file's kind of camera.
+        let moved = load(
+            spec,
+            &LoadOptions {
+                view: ViewOptions {
+                    look_from: Some(Vec3::new(0.0, 1.0, 5.0)),
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+        )
+        .expect("load");
+        assert_eq!(moved.scene.camera.projection, plain.scene.camera.projection);
+        assert_eq!(moved.scene.camera.lens, plain.scene.camera.lens);
+        // Only a perspective camera has a field of view: --fov elsewhere is refused, not
+        // silently dropped.
+        let err = load(
+            spec,
+            &LoadOptions {
+                view: ViewOptions {
+                    fov: Some(30.0),
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+        )
+        .err()
+        .map(|e| format!("{e:#}"))
+        .unwrap_or_default();
+        assert!(
+            err.contains("--fov") && err.contains("perspective"),
+            "{camera}: {err:?}"
+        );
+    }
+}

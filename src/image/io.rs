@@ -490,34 +490,115 @@ fn read_with_image_crate(path: &Path, srgb: bool) -> anyhow::Result<Image> {
 /// Largest image the readers accept (16384², 3 GB as linear RGB).
 pub const MAX_READ_PIXELS: usize = 1 << 28;
 
-/// First RGB(A) layer of an EXR; falls back to a luminance-only ("Y") layer as grey.
-fn read_exr(path: &Path) -> anyhow::Result<Image> {
-    use exr::prelude::{RgbaChannels, Vec2, read_first_rgba_layer_from_file};
-    // The header's size is allocated before any pixel is decoded: a corrupt or hostile header
-    // must be an error, not an allocation abort (found by fuzz/, target `image`).
-    let meta =
-        exr::meta::MetaData::read_from_file(path, false).map_err(|e| anyhow::anyhow!("{e}"))?;
+/// The most uncompressed bytes one byte of an EXR file can hold under `compression`: the
+/// format's worst case, so that no real file is refused (deflate expands at most 1032:1, EXR's
+/// RLE 64:1 (128 bytes from a count and a value), PXR24 stores a float in 3 bytes before
+/// deflating, B44A a flat 4×4 half block in 3 bytes, DWA run-length codes then deflates).
+/// `None` for the methods the reader cannot decode.
+fn exr_max_expansion(compression: exr::compression::Compression) -> Option<u64> {
+    use exr::compression::Compression::*;
+    match compression {
+        Uncompressed => Some(1),
+        RLE => Some(64),
+        // PIZ's Huffman stage spends ≥ 9 bits on a run of ≤ 255 samples (~453:1).
+        ZIP1 | ZIP16 | PIZ => Some(1032),
+        PXR24 => Some(1032 * 4 / 3),
+        B44 | B44A => Some(11),
+        DWAA(_) | DWAB(_) => Some(64 * 1032),
+        _ => None,
+    }
+}
+
+/// Refuse an EXR whose headers declare more pixels than penumbra reads, or more pixel data
+/// than a file of `file_len` bytes can hold: the reader allocates the whole image from the
+/// header before it decodes a chunk, so a few hundred bytes could otherwise claim gigabytes
+/// (found by fuzz/, target `image`).
+fn check_exr_sizes(meta: &exr::meta::MetaData, file_len: u64) -> anyhow::Result<()> {
     for h in &meta.headers {
-        let (w, h) = (h.layer_size.width(), h.layer_size.height());
-        if w.saturating_mul(h) > MAX_READ_PIXELS {
+        let (w, ht) = (h.layer_size.width(), h.layer_size.height());
+        if w.saturating_mul(ht) > MAX_READ_PIXELS {
             bail!(
-                "the header claims {w}x{h} pixels, more than the {MAX_READ_PIXELS} penumbra reads"
+                "the header claims {w}x{ht} pixels, more than the {MAX_READ_PIXELS} penumbra reads"
+            );
+        }
+        let Some(expansion) = exr_max_expansion(h.compression) else {
+            bail!("{} compression is not supported", h.compression);
+        };
+        // Rows and tiles each cost an offset-table entry and a chunk header in the file.
+        let min_chunk_bytes = 16u64;
+        let chunks = h.chunk_count as u64;
+        if chunks.saturating_mul(min_chunk_bytes) > file_len {
+            bail!(
+                "the header of {w}x{ht} pixels needs {chunks} chunks, at least {} bytes, \
+                 but the file has {file_len} bytes",
+                chunks.saturating_mul(min_chunk_bytes)
+            );
+        }
+        // Every channel of every pixel must come out of the file's bytes; the linear RGB image
+        // made from them is then at most 6 times that (one half channel as RGB f32).
+        let per_pixel = (h.channels.bytes_per_pixel as u64).max(1);
+        let declared = (w as u64 * ht as u64).saturating_mul(per_pixel);
+        let most = file_len.saturating_mul(expansion);
+        if declared > most {
+            bail!(
+                "the header claims {w}x{ht} pixels of {per_pixel} bytes ({declared} bytes), \
+                 more than the file's {file_len} bytes can hold (compression: {}, which \
+                 expands at most {expansion}:1)",
+                h.compression
+            );
+        }
+        // A chunk's stored size is read into memory before it is checked against the file;
+        // the decoder bounds it by the uncompressed size of a whole row block or tile, which
+        // a tile far larger than the image makes huge (a 4x4 image in 13959232x64 tiles:
+        // 1.7 GB).
+        let block = (h.max_block_byte_size() as u64).max(1);
+        if block > most.max(MAX_EXR_BLOCK_FLOOR) {
+            bail!(
+                "the header's row blocks or tiles of {block} bytes each are more than the \
+                 file's {file_len} bytes can hold (and more than {} MB)",
+                MAX_EXR_BLOCK_FLOOR >> 20
             );
         }
     }
+    Ok(())
+}
+
+/// Row blocks or tiles up to this size are taken without comparing them to the file (a tile
+/// may be larger than a small image).
+const MAX_EXR_BLOCK_FLOOR: u64 = 256 << 20;
+
+/// First RGB(A) layer of an EXR; falls back to a luminance-only ("Y") layer as grey.
+fn read_exr(path: &Path) -> anyhow::Result<Image> {
+    use exr::prelude::{RgbaChannels, Vec2, read_first_rgba_layer_from_file};
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| anyhow::anyhow!("{e}"))?;
+    check_exr_sizes(&meta, std::fs::metadata(path)?.len())?;
+    // The image grows as decoded pixels arrive (rows in file order) rather than being
+    // allocated whole from the header: a file whose chunks are missing or broken fails before
+    // it costs the memory its header claims.
     let rgba = read_first_rgba_layer_from_file(
         path,
-        |res: Vec2<usize>, _: &RgbaChannels| {
-            (res.width(), vec![Rgb::ZERO; res.width() * res.height()])
-        },
-        |(w, px): &mut (usize, Vec<Rgb>), pos: Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
-            px[pos.y() * *w + pos.x()] = Rgb::new(r, g, b);
+        |res: Vec2<usize>, _: &RgbaChannels| (res.width(), res.height(), Vec::<Rgb>::new()),
+        |(w, _, px): &mut (usize, usize, Vec<Rgb>),
+         pos: Vec2<usize>,
+         (r, g, b, _a): (f32, f32, f32, f32)| {
+            let i = pos.y() * *w + pos.x();
+            if i >= px.len() {
+                px.resize(i + 1, Rgb::ZERO);
+            }
+            px[i] = Rgb::new(r, g, b);
         },
     );
+    // Only a first layer with a luminance channel is worth the second, grey, decode.
+    let has_y = meta
+        .headers
+        .first()
+        .is_some_and(|h| h.channels.list.iter().any(|c| c.name.to_string() == "Y"));
     match rgba {
         Ok(img) => {
             let size = img.layer_data.size;
-            let (_, pixels) = img.layer_data.channel_data.pixels;
+            let (w, h, mut pixels) = img.layer_data.channel_data.pixels;
+            pixels.resize(w * h, Rgb::ZERO);
             Ok(Image {
                 width: u32::try_from(size.width())?,
                 height: u32::try_from(size.height())?,
@@ -525,7 +606,8 @@ fn read_exr(path: &Path) -> anyhow::Result<Image> {
             })
         }
         // exr's errors print their io cause in their own message: keep that one only.
-        Err(rgba_err) => read_exr_grey(path).map_err(|_| anyhow::anyhow!("{rgba_err}")),
+        Err(rgba_err) if has_y => read_exr_grey(path).map_err(|_| anyhow::anyhow!("{rgba_err}")),
+        Err(rgba_err) => Err(anyhow::anyhow!("{rgba_err}")),
     }
 }
 

@@ -14,12 +14,12 @@
 //! OpenGL-style viewer shows for the same eye, target and up; a file's camera keeps its own
 //! handedness when flags move it.
 
-use crate::camera::Camera;
+use crate::camera::{Camera, Projection};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::{PrimKind, Primitive, RayQuery, Transform};
 use crate::lights::{Emitter, LightSampleContext, LightSource, SamplingMode};
 use crate::scene::{FilmSpec, Filter, Scene};
-use anyhow::ensure;
+use anyhow::{bail, ensure};
 use glam::{Mat4, UVec2, Vec2, Vec3};
 
 /// Field of view (degrees, shorter image axis) of automatic and flag-built cameras.
@@ -251,13 +251,18 @@ fn fmt_vec(v: Vec3) -> String {
 pub fn camera_flags(cam: &Camera, target: Vec3) -> String {
     let eye = cam.camera_to_world.point(Vec3::ZERO);
     let up = cam.camera_to_world.vector(Vec3::Y).normalize_or_zero();
-    format!(
-        "--look-from {} --look-at {} --up {} --fov {}",
+    let pose = format!(
+        "--look-from {} --look-at {} --up {}",
         fmt_vec(eye),
         fmt_vec(target),
-        fmt_vec(up),
-        (cam.fov_deg * 1e3).round() / 1e3
-    )
+        fmt_vec(up)
+    );
+    // Only a perspective camera has a field of view to paste back.
+    if cam.projection == Projection::Perspective {
+        format!("{pose} --fov {}", (cam.fov_deg * 1e3).round() / 1e3)
+    } else {
+        pose
+    }
 }
 
 /// The box of the scene's triangle vertices (exact, unlike the BVH's padded bounds, so
@@ -341,6 +346,17 @@ pub fn apply_view_flags(scene: &mut Scene, view: &ViewOptions) -> anyhow::Result
     } else {
         1.0
     };
+    // Only a perspective camera has a field of view: an orthographic one's view is its
+    // screen window, a spherical one sees every direction.
+    if view.fov.is_some() && cam.projection != Projection::Perspective {
+        bail!(
+            "--fov applies to a perspective camera only; the scene's camera is {}",
+            match cam.projection {
+                Projection::Orthographic => "orthographic (its screenwindow sets the view)",
+                _ => "spherical (it sees every direction)",
+            }
+        );
+    }
     let fov = view.fov.unwrap_or(cam.fov_deg);
     let mirror = c2w.swaps_handedness();
     let (camera, target) = if view.places_camera() || view.up.is_some() {
@@ -352,7 +368,10 @@ pub fn apply_view_flags(scene: &mut Scene, view: &ViewOptions) -> anyhow::Result
         };
         let up = view.up.unwrap_or(up0);
         let mut c = look_at_with(eye, target, up, fov, mirror)?;
+        // A new pose, the same camera: its kind of projection, window and lens stay.
         c.screen_window = cam.screen_window;
+        c.projection = cam.projection;
+        c.lens = cam.lens;
         (c, target)
     } else {
         ensure!(
