@@ -47,7 +47,8 @@ const PARALLEL_MIN: usize = 4096;
 /// Importances are clamped here so a receiver on top of a point light cannot make a pmf NaN.
 const MAX_IMPORTANCE: f32 = 1e30;
 
-/// One wide node: the bounds of its (up to) eight children, structure of arrays. 416 bytes.
+/// One wide node: the bounds of its (up to) eight children, structure of arrays: 384 bytes,
+/// six cache lines, so a level of the walk touches six lines.
 #[derive(Clone, Debug)]
 #[repr(C, align(64))]
 pub struct WideNode {
@@ -59,12 +60,12 @@ pub struct WideNode {
     wx: [f32; WIDTH],
     wy: [f32; WIDTH],
     wz: [f32; WIDTH],
+    /// The child's power Φ ≥ 0, its sign bit set where some light below emits on both sides
+    /// (a seventh cache line for that one flag would cost more than the `abs` it takes).
     phi: [f32; WIDTH],
     cos_o: [f32; WIDTH],
     sin_o: [f32; WIDTH],
     cos_e: [f32; WIDTH],
-    /// 1.0 where some light below emits on both sides, else 0.0.
-    two_sided: [f32; WIDTH],
     /// `LEAF | light`, a child node's index, or [`EMPTY`].
     child: [u32; WIDTH],
 }
@@ -83,10 +84,15 @@ impl Default for WideNode {
             cos_o: [1.0; WIDTH],
             sin_o: [0.0; WIDTH],
             cos_e: [0.0; WIDTH],
-            two_sided: [0.0; WIDTH],
             child: [EMPTY; WIDTH],
         }
     }
+}
+
+/// `x.max(0.0)` for every x, NaN included (a NaN becomes 0), in one compare and one mask.
+#[inline(always)]
+fn pos(x: f32) -> f32 {
+    if x > 0.0 { x } else { 0.0 }
 }
 
 impl WideNode {
@@ -100,11 +106,11 @@ impl WideNode {
         self.wx[k] = b.w.x;
         self.wy[k] = b.w.y;
         self.wz[k] = b.w.z;
-        self.phi[k] = if b.phi.is_nan() { 0.0 } else { b.phi.max(0.0) };
+        let phi = if b.phi.is_nan() { 0.0 } else { b.phi.max(0.0) };
+        self.phi[k] = if b.two_sided { -phi } else { phi };
         self.cos_o[k] = cos_o;
         self.sin_o[k] = (1.0 - cos_o * cos_o).max(0.0).sqrt();
         self.cos_e[k] = b.cos_theta_e;
-        self.two_sided[k] = if b.two_sided { 1.0 } else { 0.0 };
         self.child[k] = child;
     }
 
@@ -112,10 +118,20 @@ impl WideNode {
     /// when unknown): the formula of [`super::importance::importance`] (Φ·cos θ′/d², times
     /// cos θ′ᵢ), lane by lane, branch-free: all eight children in one pass.
     #[inline(always)]
-    // One index walks thirteen lane arrays (clearer than a thirteen-way zip).
-    #[allow(clippy::needless_range_loop)]
     fn importance(&self, p: Vec3, n: Vec3, out: &mut [f32; WIDTH]) {
-        let has_n = n != Vec3::ZERO;
+        // A receiver without a normal (a medium, a two-sided probe) skips the receiver-side
+        // cosine: one loop for each case keeps that test out of the lanes.
+        if n != Vec3::ZERO {
+            self.importance_lanes::<true>(p, n, out)
+        } else {
+            self.importance_lanes::<false>(p, n, out)
+        }
+    }
+
+    #[inline(always)]
+    // One index walks twelve lane arrays (clearer than a twelve-way zip).
+    #[allow(clippy::needless_range_loop)]
+    fn importance_lanes<const HAS_N: bool>(&self, p: Vec3, n: Vec3, out: &mut [f32; WIDTH]) {
         for k in 0..WIDTH {
             let tx = p.x - self.cx[k];
             let ty = p.y - self.cy[k];
@@ -124,15 +140,17 @@ impl WideNode {
             let d = dd.sqrt();
             let rl = self.r[k];
             // pbrt-v4's floor: the half diagonal compared with a squared length (see importance.rs).
-            let d2 = dd.max(rl).max(1e-12);
-            let inside = d <= rl || d == 0.0;
+            // (`max` spelled as compares: a NaN distance takes the floor, as `f32::max` does.)
+            let d2 = if dd > rl { dd } else { rl };
+            let d2 = if d2 > 1e-12 { d2 } else { 1e-12 };
+            let inside = (d <= rl) | (d == 0.0);
             let inv_d = 1.0 / d;
             let s = rl * inv_d;
             let sin_b = if inside { 0.0 } else { s };
             let cos_b = if inside {
                 -1.0
             } else {
-                (1.0 - s * s).max(0.0).sqrt()
+                pos(1.0 - s * s).sqrt()
             };
             let (wix, wiy, wiz) = if d > 0.0 {
                 (tx * inv_d, ty * inv_d, tz * inv_d)
@@ -140,12 +158,15 @@ impl WideNode {
                 (0.0, 0.0, 1.0)
             };
             let cw = self.wx[k] * wix + self.wy[k] * wiy + self.wz[k] * wiz;
-            let cos_w = if self.two_sided[k] > 0.5 {
+            let phi_signed = self.phi[k];
+            let phi = phi_signed.abs();
+            // Two-sided emitters face the receiver with either side of their cone.
+            let cos_w = if phi_signed.is_sign_negative() {
                 cw.abs()
             } else {
                 cw
             };
-            let sin_w = (1.0 - cos_w * cos_w).max(0.0).sqrt();
+            let sin_w = pos(1.0 - cos_w * cos_w).sqrt();
             let (cos_o, sin_o) = (self.cos_o[k], self.sin_o[k]);
             // θx = max(0, θw − θo), θ′ = max(0, θx − θb), as (sin, cos) pairs.
             let within_o = cos_w > cos_o;
@@ -164,21 +185,29 @@ impl WideNode {
             } else {
                 cos_x * cos_b + sin_x * sin_b
             };
-            let mut imp = self.phi[k] * cos_p / d2;
-            // The receiver's side: the angle between n and the direction to the bounds,
-            // narrowed by θb; zero only if the whole sphere is below the tangent plane.
-            let cos_i = (-(n.x * wix + n.y * wiy + n.z * wiz)).clamp(-1.0, 1.0);
-            let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
-            let cos_pi = if cos_i > cos_b {
-                1.0
+            let mut imp = phi * cos_p / d2;
+            let mut below = false;
+            if HAS_N {
+                // The receiver's side: the angle between n and the direction to the bounds,
+                // narrowed by θb; zero only if the whole sphere is below the tangent plane.
+                // A receiver inside the bounds (cos θb = −1) sees them on both sides.
+                let cos_i = (-(n.x * wix + n.y * wiy + n.z * wiz)).clamp(-1.0, 1.0);
+                let sin_i = pos(1.0 - cos_i * cos_i).sqrt();
+                let cos_pi = if cos_i > cos_b {
+                    1.0
+                } else {
+                    cos_i * cos_b + sin_i * sin_b
+                };
+                let use_n = !inside;
+                below = use_n & (cos_pi <= 0.0);
+                imp = if use_n { imp * cos_pi } else { imp };
+            }
+            let dead = (cos_p <= self.cos_e[k]) | (phi <= 0.0) | below | imp.is_nan();
+            out[k] = if dead || !(imp < MAX_IMPORTANCE) {
+                if dead { 0.0 } else { MAX_IMPORTANCE }
             } else {
-                cos_i * cos_b + sin_i * sin_b
+                imp
             };
-            let use_n = has_n && cos_b > -1.0;
-            let below = use_n && cos_pi <= 0.0;
-            imp = if use_n { imp * cos_pi } else { imp };
-            let dead = cos_p <= self.cos_e[k] || self.phi[k] <= 0.0 || below || imp.is_nan();
-            out[k] = if dead { 0.0 } else { imp.min(MAX_IMPORTANCE) };
         }
     }
 }
@@ -398,25 +427,32 @@ impl BvhSelector {
         loop {
             let node = &self.nodes[i];
             node.importance(ctx.p, ctx.n, &mut imp);
-            let total = total_of(&imp);
+            // Running sums in slot order (the order `total_of` adds in, so the total and hence
+            // every probability is the same f64 as `pmf_impl`'s): cum[k] = Σ imp[..k].
+            let mut cum = [0.0f64; WIDTH + 1];
+            let mut t = 0.0f64;
+            for k in 0..WIDTH {
+                t += imp[k] as f64;
+                cum[k + 1] = t;
+            }
+            let total = t;
             if !(total > 0.0) {
                 return None;
             }
             let target = u * total;
-            let mut cum = 0.0f64;
-            let mut pick = WIDTH;
-            for (k, &x) in imp.iter().enumerate() {
-                if x > 0.0 {
-                    pick = k;
-                    if target < cum + x as f64 {
-                        break;
-                    }
-                }
-                cum += x as f64;
+            // The chosen slot holds `target`: cum[pick] ≤ target < cum[pick + 1], i.e. the number
+            // of running sums past slot 0 that do not exceed it; such a slot has a positive
+            // importance (its running sum grows). Counting is branch-free, unlike a search.
+            let mut pick = 0;
+            for &c in &cum[1..] {
+                pick += (c <= target) as usize;
             }
-            // `pick` is the chosen slot (the last positive one if rounding ran past the end).
+            if pick == WIDTH {
+                // Rounding ran past the end: the last child that can contribute.
+                pick = imp.iter().rposition(|&x| x > 0.0).unwrap_or(0);
+            }
             let x = imp[pick] as f64;
-            let before: f64 = imp[..pick].iter().map(|&v| v as f64).sum();
+            let before = cum[pick];
             u = ((target - before) / x).clamp(0.0, 1.0 - f64::EPSILON);
             probs[levels] = x / total;
             levels += 1;
