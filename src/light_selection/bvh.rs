@@ -222,6 +222,23 @@ fn total_of(imp: &[f32; WIDTH]) -> f64 {
     t
 }
 
+/// The child whose share of the running sums `cum` (cum[k] = Σ imp[..k]) holds `target`:
+/// cum[pick] ≤ target < cum[pick + 1], i.e. the number of running sums past slot 0 that do not
+/// exceed it. Such a slot has a positive importance (its running sum grows), so this is the
+/// first positive child whose sum passes `target`, found by counting (branch-free) instead of
+/// searching. If rounding put `target` at or past the total: the last positive child.
+#[inline(always)]
+fn pick_slot(imp: &[f32; WIDTH], cum: &[f64; WIDTH + 1], target: f64) -> usize {
+    let mut pick = 0;
+    for &c in &cum[1..] {
+        pick += (c <= target) as usize;
+    }
+    if pick == WIDTH {
+        pick = imp.iter().rposition(|&x| x > 0.0).unwrap_or(0);
+    }
+    pick
+}
+
 /// Light BVH selector.
 #[derive(Clone, Debug)]
 pub struct BvhSelector {
@@ -440,17 +457,7 @@ impl BvhSelector {
                 return None;
             }
             let target = u * total;
-            // The chosen slot holds `target`: cum[pick] ≤ target < cum[pick + 1], i.e. the number
-            // of running sums past slot 0 that do not exceed it; such a slot has a positive
-            // importance (its running sum grows). Counting is branch-free, unlike a search.
-            let mut pick = 0;
-            for &c in &cum[1..] {
-                pick += (c <= target) as usize;
-            }
-            if pick == WIDTH {
-                // Rounding ran past the end: the last child that can contribute.
-                pick = imp.iter().rposition(|&x| x > 0.0).unwrap_or(0);
-            }
+            let pick = pick_slot(&imp, &cum, target);
             let x = imp[pick] as f64;
             let before = cum[pick];
             u = ((target - before) / x).clamp(0.0, 1.0 - f64::EPSILON);
@@ -672,6 +679,95 @@ mod tests {
             );
             assert!(imp[1..].iter().all(|&x| x == 0.0));
         }
+    }
+
+    #[test]
+    fn counted_pick_matches_the_linear_search() {
+        // The search `sample` used before: the first positive child whose running sum passes
+        // `target`, else the last positive one.
+        let search = |imp: &[f32; WIDTH], target: f64| {
+            let (mut cum, mut pick) = (0.0f64, WIDTH);
+            for (k, &x) in imp.iter().enumerate() {
+                if x > 0.0 {
+                    pick = k;
+                    if target < cum + x as f64 {
+                        break;
+                    }
+                }
+                cum += x as f64;
+            }
+            pick
+        };
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..20_000 {
+            let mut imp = [0.0f32; WIDTH];
+            for x in imp.iter_mut() {
+                let r = next();
+                // Zeros, tiny and huge values next to each other (sums that stop growing).
+                *x = match r % 4 {
+                    0 => 0.0,
+                    1 => (r >> 40) as f32 * 1e-30,
+                    2 => (r >> 40) as f32,
+                    _ => (r >> 40) as f32 * 1e20,
+                };
+            }
+            let mut cum = [0.0f64; WIDTH + 1];
+            for k in 0..WIDTH {
+                cum[k + 1] = cum[k] + imp[k] as f64;
+            }
+            if !(cum[WIDTH] > 0.0) {
+                continue;
+            }
+            let u = (next() >> 11) as f64 / (1u64 << 53) as f64;
+            // Random targets, every running sum exactly, and the total (rounding past the end).
+            let k = (next() % (WIDTH as u64 + 1)) as usize;
+            for target in [u * cum[WIDTH], cum[k], cum[WIDTH]] {
+                let p = pick_slot(&imp, &cum, target);
+                assert_eq!(p, search(&imp, target), "{imp:?} {target}");
+                assert!(imp[p] > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn two_sided_flag_in_the_sign_of_power() {
+        // A two-sided emitter facing away scores as if facing the receiver; zero power stays
+        // dead on either side.
+        let mut b = LightBounds {
+            min: Vec3::new(-0.1, -0.1, 2.0),
+            max: Vec3::new(0.1, 0.1, 2.0),
+            w: Vec3::Z,
+            phi: 2.0,
+            cos_theta_o: 1.0,
+            cos_theta_e: 0.0,
+            two_sided: true,
+        };
+        let mut node = WideNode::default();
+        node.set(0, &b, LEAF);
+        b.w = -Vec3::Z;
+        node.set(1, &b, LEAF | 1);
+        b.phi = 0.0;
+        node.set(2, &b, LEAF | 2);
+        let mut imp = [0.0; WIDTH];
+        node.importance(Vec3::ZERO, Vec3::Z, &mut imp);
+        assert!(imp[0] > 0.0 && imp[0] == imp[1], "{imp:?}");
+        assert_eq!(imp[2], 0.0);
+        assert!(
+            (imp[0]
+                - importance(Vec3::ZERO, Vec3::Z, &{
+                    let mut c = b;
+                    c.phi = 2.0;
+                    c
+                }))
+            .abs()
+                <= 1e-4 * imp[0]
+        );
     }
 
     #[test]
