@@ -361,6 +361,9 @@ fn encode_exr(img: &Image, attributes: &[(&str, String)]) -> anyhow::Result<Vec<
         (p.x, p.y, p.z)
     });
     let mut image = exr::image::Image::from_channels((w, img.height as usize), channels);
+    // Chunks in increasing row order, however the compressing threads finish: the same image
+    // is the same file, byte for byte.
+    image.layer_data.encoding.line_order = exr::meta::attribute::LineOrder::Increasing;
     for (name, value) in attributes {
         let text = |s: &str| {
             Text::new_or_none(s).ok_or_else(|| anyhow::anyhow!("EXR attribute {s:?} is not text"))
