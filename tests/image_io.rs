@@ -464,3 +464,17 @@ fn exr_files_are_byte_identical_for_the_same_image() {
         );
     }
 }
+
+#[test]
+fn an_image_too_large_to_read_names_its_size() {
+    // A Radiance header declaring 60000×50000 pixels (36 GB as linear RGB) over a few bytes of
+    // data: the error must say how large the file claims to be, not only that a limit was hit.
+    let dir = scratch("huge-hdr");
+    let p = dir.join("huge.hdr");
+    let mut bytes = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 50000 +X 60000\n".to_vec();
+    bytes.extend_from_slice(&[0x80; 64]);
+    std::fs::write(&p, bytes).unwrap();
+    let err = format!("{:#}", read_image(&p).unwrap_err());
+    assert!(err.contains("60000x50000"), "{err}");
+    assert!(err.contains("huge.hdr"), "{err}");
+}

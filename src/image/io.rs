@@ -473,9 +473,18 @@ pub fn not_a_file(path: &Path) -> Option<&'static str> {
 
 /// Decode via the `image` crate; `srgb` selects whether code values are sRGB-linearised.
 fn read_with_image_crate(path: &Path, srgb: bool) -> anyhow::Result<Image> {
-    let dynamic = image::ImageReader::open(path)?
+    let reader = image::ImageReader::open(path)?.with_guessed_format()?;
+    // The header alone says how large the image claims to be: a limit hit while decoding is
+    // reported with that size, so a truncated or hostile header is told from a real big image.
+    let (w, h) = image::ImageReader::open(path)?
         .with_guessed_format()?
-        .decode()?;
+        .into_dimensions()?;
+    let dynamic = match reader.decode() {
+        Err(image::ImageError::Limits(e)) => bail!(
+            "the file declares {w}x{h} pixels, more than the image reader's memory limit allows ({e})"
+        ),
+        other => other?,
+    };
     let rgb = dynamic.to_rgb32f();
     let (w, h) = rgb.dimensions();
     let lin = |v: f32| if srgb { srgb_to_linear(v) } else { v };
