@@ -8,13 +8,14 @@
 
 use super::many_open::film;
 use super::many_util::{
-    add_box, diffuse, log_uniform, radiance_for_power, random_colour, scene_rng, uniform,
+    add_box, add_mesh_light, diffuse, log_uniform, radiance_for_power, random_colour, scene_rng,
+    uniform,
 };
 use super::{BuiltinOptions, Scene};
 use crate::Rgb;
 use crate::camera::Camera;
 use crate::material::{Material, Texture};
-use crate::scene::{AreaEmission, SceneBuilder, TriangleMesh};
+use crate::scene::SceneBuilder;
 use anyhow::ensure;
 use glam::{Vec2, Vec3};
 use rand_pcg::Pcg32;
@@ -164,21 +165,7 @@ fn emissive_rect(
         let a = 2 * c;
         indices.extend([a, a + 2, a + 3, a, a + 3, a + 1]);
     }
-    let mesh = TriangleMesh {
-        positions,
-        normals: None,
-        uvs: None,
-        indices,
-        flip_normals: false,
-    };
-    b.add_mesh(
-        mesh,
-        material,
-        Some(AreaEmission {
-            l,
-            two_sided: false,
-        }),
-    )
+    add_mesh_light(b, positions, indices, l, material)
 }
 
 /// A one-sided emissive disk (a fan of `segments` triangles) facing `n`, of total power `phi`.
@@ -207,20 +194,12 @@ fn emissive_disk(
         indices.extend([0, 1 + k, 1 + (k + 1) % segments]);
     }
     let area = 0.5 * radius * radius * (TAU / segments as f32).sin() * segments as f32;
-    let mesh = TriangleMesh {
+    add_mesh_light(
+        b,
         positions,
-        normals: None,
-        uvs: None,
         indices,
-        flip_normals: false,
-    };
-    b.add_mesh(
-        mesh,
+        radiance_for_power(phi, area, colour),
         material,
-        Some(AreaEmission {
-            l: radiance_for_power(phi, area, colour),
-            two_sided: false,
-        }),
     )
 }
 

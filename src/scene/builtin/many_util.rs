@@ -72,21 +72,25 @@ pub fn add_triangle_light(
     l: Rgb,
     material: u32,
 ) -> anyhow::Result<()> {
+    add_mesh_light(b, p.to_vec(), vec![0, 1, 2], l, material)
+}
+
+/// A one-sided emissive triangle mesh (one light per triangle) of radiance `l`.
+pub fn add_mesh_light(
+    b: &mut SceneBuilder,
+    positions: Vec<Vec3>,
+    indices: Vec<u32>,
+    l: Rgb,
+    material: u32,
+) -> anyhow::Result<()> {
     let mesh = TriangleMesh {
-        positions: p.to_vec(),
+        positions,
         normals: None,
         uvs: None,
-        indices: vec![0, 1, 2],
+        indices,
         flip_normals: false,
     };
-    b.add_mesh(
-        mesh,
-        material,
-        Some(AreaEmission {
-            l,
-            two_sided: false,
-        }),
-    )
+    b.add_mesh(mesh, material, emission(l))
 }
 
 /// Emission of a one-sided light.
