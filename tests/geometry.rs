@@ -321,6 +321,7 @@ fn quadric_error_bounds_cover_the_intersections_own_rounding() {
                     kind,
                     to_world: Transform::new(m).unwrap(),
                     flip: false,
+                    alpha: None,
                 };
                 let prim = Primitive {
                     p: [Vec3::ZERO; 3],

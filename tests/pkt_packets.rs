@@ -303,6 +303,7 @@ fn rays_leaving_a_lone_surface_hit_nothing_on_any_path() {
             },
             to_world: Transform::new(m).unwrap(),
             flip: false,
+            alpha: None,
         };
         let p = Primitive {
             p: [Vec3::ZERO; 3],

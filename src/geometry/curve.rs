@@ -105,9 +105,26 @@ impl CurveSegment {
         (lo - Vec3::splat(w), hi + Vec3::splat(w))
     }
 
+    /// ∂p/∂u of the segment at `u` (object space).
+    pub fn tangent(&self, u: f64) -> DVec3 {
+        bezier(&self.cp.map(|p| p.as_dvec3()), u).1
+    }
+
     /// The nearest hit of ray (o, d) (object space, `d` need not be unit) with t in
     /// (0, t_max).
     pub fn intersect(&self, o: DVec3, d: DVec3, t_max: f64) -> Option<CurveHit> {
+        self.intersect_where(o, d, t_max, &|_| true)
+    }
+
+    /// [`Self::intersect`] among the hits `keep` accepts (a cut-out's test): the refinement
+    /// visits every flat piece the ray's box reaches, so the nearest accepted one is found.
+    pub fn intersect_where<K: Fn(&CurveHit) -> bool>(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t_max: f64,
+        keep: &K,
+    ) -> Option<CurveHit> {
         let len = d.length();
         if !(len > 0.0) {
             return None;
@@ -135,12 +152,14 @@ impl CurveSegment {
         let depth = r0.clamp(0, 10);
         let mut best: Option<CurveHit> = None;
         let mut zmax = len * t_max;
-        self.recurse(&cp, 0.0, 1.0, depth, &mut zmax, &mut best, &frame, dn, len);
+        self.recurse(
+            &cp, 0.0, 1.0, depth, &mut zmax, &mut best, &frame, dn, len, keep,
+        );
         best
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn recurse(
+    fn recurse<K: Fn(&CurveHit) -> bool>(
         &self,
         cp: &[DVec3; 4],
         u0: f64,
@@ -151,6 +170,7 @@ impl CurveSegment {
         frame: &[DVec3; 3],
         dn: DVec3,
         len: f64,
+        keep: &K,
     ) {
         let w = |u: f64| self.width[0] as f64 + (self.width[1] as f64 - self.width[0] as f64) * u;
         // The segment's box against the ray's (x = y = 0, 0 ≤ z ≤ zmax).
@@ -169,8 +189,8 @@ impl CurveSegment {
         if depth > 0 {
             let [a, b] = split(cp);
             let um = 0.5 * (u0 + u1);
-            self.recurse(&a, u0, um, depth - 1, zmax, best, frame, dn, len);
-            self.recurse(&b, um, u1, depth - 1, zmax, best, frame, dn, len);
+            self.recurse(&a, u0, um, depth - 1, zmax, best, frame, dn, len, keep);
+            self.recurse(&b, um, u1, depth - 1, zmax, best, frame, dn, len, keep);
             return;
         }
         // The ray's point (the origin of the xy plane) beyond the start's perpendicular and
@@ -245,13 +265,17 @@ impl CurveSegment {
                 }
             }
         };
-        *zmax = pc.z;
-        *best = Some(CurveHit {
+        let hit = CurveHit {
             t: pc.z / len,
             u,
             v,
             n,
-        });
+        };
+        if !keep(&hit) {
+            return;
+        }
+        *zmax = pc.z;
+        *best = Some(hit);
     }
 }
 

@@ -5,7 +5,7 @@ use super::{AreaEmission, FilmSpec, Scene, TriangleMesh};
 use crate::camera::Camera;
 use crate::geometry::{
     Alpha, Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Transform,
-    interaction::NO_LIGHT,
+    interaction::NO_LIGHT, quadric::CutOut,
 };
 use crate::lights::{DiskLight, Light, QuadLight, SphereLight, TriangleLight};
 use crate::material::Material;
@@ -245,13 +245,20 @@ impl SceneBuilder {
         Ok(())
     }
 
+    /// Add quadric `q` with the cut-out `alpha`, keyed by its index (every quadric's hash
+    /// differs, in this geometry and in the emitters' copy alike).
     fn add_quadric(
         &mut self,
-        q: Quadric,
+        mut q: Quadric,
         material: u32,
         emission: Option<AreaEmission>,
+        alpha: Option<Alpha>,
     ) -> anyhow::Result<()> {
         self.check_material(material)?;
+        q.alpha = alpha.map(|alpha| CutOut {
+            alpha,
+            key: 1 << 63 | self.quadrics.len() as u64,
+        });
         let light = match emission {
             Some(e) => {
                 check_emission(&e)?;
@@ -281,6 +288,28 @@ impl SceneBuilder {
         emission: Option<AreaEmission>,
         reverse_orientation: bool,
     ) -> anyhow::Result<()> {
+        self.add_sphere_cut_out(
+            to_world,
+            radius,
+            material,
+            emission,
+            reverse_orientation,
+            None,
+        )
+    }
+
+    /// [`SceneBuilder::add_sphere`] with an alpha cut-out over its uv (pbrt-v4's shape
+    /// `alpha`). An emissive one's light is the whole sphere (the light samples ignore the
+    /// mask, as a cut-out mesh's triangle lights do).
+    pub fn add_sphere_cut_out(
+        &mut self,
+        to_world: Transform,
+        radius: f32,
+        material: u32,
+        emission: Option<AreaEmission>,
+        reverse_orientation: bool,
+        alpha: Option<Alpha>,
+    ) -> anyhow::Result<()> {
         ensure!(
             radius.is_finite() && radius > 0.0,
             "sphere radius must be positive and finite, got {radius}"
@@ -289,8 +318,9 @@ impl SceneBuilder {
             kind: QuadricKind::Sphere { radius },
             to_world,
             flip: reverse_orientation ^ to_world.swaps_handedness(),
+            alpha: None,
         };
-        self.add_quadric(q, material, emission)
+        self.add_quadric(q, material, emission, alpha)
     }
 
     /// Add a disk of `radius` in the z = `height` plane of `to_world`'s object space, normal +z.
@@ -303,6 +333,30 @@ impl SceneBuilder {
         emission: Option<AreaEmission>,
         reverse_orientation: bool,
     ) -> anyhow::Result<()> {
+        self.add_disk_cut_out(
+            to_world,
+            height,
+            radius,
+            material,
+            emission,
+            reverse_orientation,
+            None,
+        )
+    }
+
+    /// [`SceneBuilder::add_disk`] with an alpha cut-out over its uv (see
+    /// [`SceneBuilder::add_sphere_cut_out`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_disk_cut_out(
+        &mut self,
+        to_world: Transform,
+        height: f32,
+        radius: f32,
+        material: u32,
+        emission: Option<AreaEmission>,
+        reverse_orientation: bool,
+        alpha: Option<Alpha>,
+    ) -> anyhow::Result<()> {
         ensure!(
             radius.is_finite() && radius > 0.0 && height.is_finite(),
             "disk radius must be positive and finite (radius {radius}, height {height})"
@@ -311,13 +365,16 @@ impl SceneBuilder {
             kind: QuadricKind::Disk { height, radius },
             to_world,
             flip: reverse_orientation ^ to_world.swaps_handedness(),
+            alpha: None,
         };
-        self.add_quadric(q, material, emission)
+        self.add_quadric(q, material, emission, alpha)
     }
 
     /// Add pbrt-v4's partial sphere `[zmin, zmax, phimax (radians)]` of `radius` in
-    /// `to_world`'s object space. An emissive one becomes a [`PARTIAL_LIGHT_GRID`] mesh of
-    /// triangle lights with the sphere's normals (the loader warns).
+    /// `to_world`'s object space, with an optional alpha cut-out over its uv. An emissive one
+    /// becomes a [`PARTIAL_LIGHT_GRID`] mesh of triangle lights with the sphere's normals and
+    /// uvs (the loader warns).
+    #[allow(clippy::too_many_arguments)]
     pub fn add_partial_sphere(
         &mut self,
         to_world: Transform,
@@ -326,6 +383,7 @@ impl SceneBuilder {
         material: u32,
         emission: Option<AreaEmission>,
         reverse_orientation: bool,
+        alpha: Option<Alpha>,
     ) -> anyhow::Result<()> {
         ensure!(
             radius.is_finite() && radius > 0.0,
@@ -351,7 +409,9 @@ impl SceneBuilder {
                 );
                 (n * radius, n)
             });
-            return self.add_mesh_repaired(mesh, material, Some(e)).map(|_| ());
+            return self
+                .add_mesh_cut_out(mesh, material, Some(e), alpha)
+                .map(|_| ());
         }
         let q = Quadric {
             kind: QuadricKind::SphereCut {
@@ -362,13 +422,15 @@ impl SceneBuilder {
             },
             to_world,
             flip,
+            alpha: None,
         };
-        self.add_quadric(q, material, None)
+        self.add_quadric(q, material, None, alpha)
     }
 
     /// Add pbrt-v4's annulus / partial disk (`inner` ≤ r ≤ `radius`, φ in [0, `phimax`]) in the
-    /// z = `height` plane of `to_world`'s object space. An emissive one becomes a
-    /// [`PARTIAL_LIGHT_GRID`] mesh of triangle lights (the loader warns).
+    /// z = `height` plane of `to_world`'s object space, with an optional alpha cut-out. An
+    /// emissive one becomes a [`PARTIAL_LIGHT_GRID`] mesh of triangle lights (the loader warns).
+    #[allow(clippy::too_many_arguments)]
     pub fn add_partial_disk(
         &mut self,
         to_world: Transform,
@@ -377,6 +439,7 @@ impl SceneBuilder {
         material: u32,
         emission: Option<AreaEmission>,
         reverse_orientation: bool,
+        alpha: Option<Alpha>,
     ) -> anyhow::Result<()> {
         ensure!(
             radius.is_finite() && radius > 0.0 && height.is_finite(),
@@ -392,7 +455,9 @@ impl SceneBuilder {
                 let (r, phi) = (radius - (radius - inner) * v, u * phimax);
                 (Vec3::new(r * phi.cos(), r * phi.sin(), height), Vec3::Z)
             });
-            return self.add_mesh_repaired(mesh, material, Some(e)).map(|_| ());
+            return self
+                .add_mesh_cut_out(mesh, material, Some(e), alpha)
+                .map(|_| ());
         }
         let q = Quadric {
             kind: QuadricKind::DiskCut {
@@ -403,14 +468,15 @@ impl SceneBuilder {
             },
             to_world,
             flip,
+            alpha: None,
         };
-        self.add_quadric(q, material, None)
+        self.add_quadric(q, material, None, alpha)
     }
 
     /// Add pbrt-v4's cylinder `[radius, zmin, zmax, phimax (radians)]` of `to_world`'s object
     /// space (axis z). An emissive one becomes a mesh of
     /// [`CYLINDER_LIGHT_SEGMENTS`] × 2 triangle lights with the cylinder's normals (the
-    /// lights sample triangles; the loader warns).
+    /// lights sample triangles; the loader warns). `alpha`: an optional cut-out over its uv.
     pub fn add_cylinder(
         &mut self,
         to_world: Transform,
@@ -418,6 +484,7 @@ impl SceneBuilder {
         material: u32,
         emission: Option<AreaEmission>,
         reverse_orientation: bool,
+        alpha: Option<Alpha>,
     ) -> anyhow::Result<()> {
         ensure!(
             radius.is_finite() && radius > 0.0 && zmin.is_finite() && zmax.is_finite(),
@@ -461,7 +528,9 @@ impl SceneBuilder {
                 indices,
                 flip_normals: flip,
             };
-            return self.add_mesh_repaired(mesh, material, Some(e)).map(|_| ());
+            return self
+                .add_mesh_cut_out(mesh, material, Some(e), alpha)
+                .map(|_| ());
         }
         let q = Quadric {
             kind: QuadricKind::Cylinder {
@@ -472,18 +541,21 @@ impl SceneBuilder {
             },
             to_world,
             flip,
+            alpha: None,
         };
-        self.add_quadric(q, material, None)
+        self.add_quadric(q, material, None, alpha)
     }
 
     /// Add a world-space bilinear patch (corners p00, p10, p01, p11, their uvs), normal
-    /// ∂p/∂u × ∂p/∂v (negated with `flip`); not emissive.
+    /// ∂p/∂u × ∂p/∂v (negated with `flip`), with an optional alpha cut-out over its uv; not
+    /// emissive.
     pub fn add_bilinear_patch(
         &mut self,
         p: [Vec3; 4],
         uv: [glam::Vec2; 4],
         material: u32,
         flip: bool,
+        alpha: Option<Alpha>,
     ) -> anyhow::Result<()> {
         ensure!(
             p.iter().all(|v| v.is_finite()) && uv.iter().all(|v| v.is_finite()),
@@ -493,18 +565,20 @@ impl SceneBuilder {
             kind: QuadricKind::Bilinear { p, uv },
             to_world: Transform::IDENTITY,
             flip,
+            alpha: None,
         };
-        self.add_quadric(q, material, None)
+        self.add_quadric(q, material, None, alpha)
     }
 
-    /// Add one cubic Bézier segment of a pbrt-v4 `curve` in `to_world`'s object space (not
-    /// emissive).
+    /// Add one cubic Bézier segment of a pbrt-v4 `curve` in `to_world`'s object space, with an
+    /// optional alpha cut-out over its (u along, v across) (not emissive).
     pub fn add_curve(
         &mut self,
         to_world: Transform,
         segment: crate::geometry::curve::CurveSegment,
         material: u32,
         reverse_orientation: bool,
+        alpha: Option<Alpha>,
     ) -> anyhow::Result<()> {
         ensure!(
             segment.cp.iter().all(|p| p.is_finite())
@@ -516,8 +590,9 @@ impl SceneBuilder {
             to_world,
             // pbrt-v4's curves flip as its quadrics do.
             flip: reverse_orientation ^ to_world.swaps_handedness(),
+            alpha: None,
         };
-        self.add_quadric(q, material, None)
+        self.add_quadric(q, material, None, alpha)
     }
 
     /// Add a light that is not attached to geometry (point, spot, distant, infinite).
@@ -610,7 +685,7 @@ fn emitter_geometry(prims: &[Primitive], meshes: &[MeshShading], quadrics: &[Qua
                     let m = &mut quadric_map[q as usize];
                     if *m == u32::MAX {
                         *m = own_quadrics.len() as u32;
-                        own_quadrics.push(quadrics[q as usize]);
+                        own_quadrics.push(quadrics[q as usize].clone());
                     }
                     PrimKind::Quadric(*m)
                 }

@@ -1,6 +1,7 @@
 //! Normal and bump maps at closest hits (every path vertex): the shading normal of a hit whose
 //! material has one is replaced before the shading frame is built (pbrt-v4's `NormalMap` / `BumpMap`), from the
-//! hit triangle's ∂p/∂u, ∂p/∂v. Hits on spheres and disks keep their normal (the parser warns).
+//! hit triangle's ∂p/∂u, ∂p/∂v, or a quadric's, curve's or bilinear patch's own (pbrt-v4's
+//! parametric derivatives, [`crate::geometry::Quadric::derivatives`]).
 
 use super::Scene;
 use crate::geometry::{HitColumns, PrimKind, SurfaceHit};
@@ -72,32 +73,47 @@ pub fn perturb_hits(
         let Some(prim) = scene.geometry.primitive(hit.prim) else {
             continue;
         };
-        let PrimKind::Triangle { mesh, v } = prim.kind else {
-            continue;
-        };
-        let m = &scene.geometry.meshes[mesh as usize];
-        let uv = match &m.uvs {
-            Some(uv) => v.map(|i| uv[i as usize]),
-            // pbrt-v4's default parameterisation.
-            None => [Vec2::ZERO, Vec2::new(1.0, 0.0), Vec2::ONE],
-        };
-        let Some((dpdu, dpdv)) = triangle_derivatives(prim.p, uv, hit.ns, m.normals.is_some())
-        else {
-            continue;
-        };
-        let (dndu, dndv) = match &m.normals {
-            Some(n) => triangle_dndu(v.map(|i| n[i as usize]), uv),
-            None => (Vec3::ZERO, Vec3::ZERO),
+        let d = match prim.kind {
+            PrimKind::Triangle { mesh, v } => {
+                let m = &scene.geometry.meshes[mesh as usize];
+                let uv = match &m.uvs {
+                    Some(uv) => v.map(|i| uv[i as usize]),
+                    // pbrt-v4's default parameterisation.
+                    None => [Vec2::ZERO, Vec2::new(1.0, 0.0), Vec2::ONE],
+                };
+                let Some((dpdu, dpdv)) =
+                    triangle_derivatives(prim.p, uv, hit.ns, m.normals.is_some())
+                else {
+                    continue;
+                };
+                let (dndu, dndv) = match &m.normals {
+                    Some(n) => triangle_dndu(v.map(|i| n[i as usize]), uv),
+                    None => (Vec3::ZERO, Vec3::ZERO),
+                };
+                ShadingDerivatives {
+                    dpdu,
+                    dpdv,
+                    dndu,
+                    dndv,
+                }
+            }
+            PrimKind::Quadric(q) => {
+                let Some([dpdu, dpdv, dndu, dndv]) =
+                    scene.geometry.quadrics[q as usize].derivatives(hit.p, hit.uv, hit.ng)
+                else {
+                    continue;
+                };
+                ShadingDerivatives {
+                    dpdu,
+                    dpdv,
+                    dndu,
+                    dndv,
+                }
+            }
         };
         let tc = material
             .footprint()
             .map_or(TexCoord::point(hit.uv), |f| f.tex_coord(hit));
-        let d = ShadingDerivatives {
-            dpdu,
-            dpdv,
-            dndu,
-            dndv,
-        };
         let ns = pert.shading_normal(&tc, hit.ns, hit.ng, &d);
         hit.ns = ns;
         for a in 0..3 {

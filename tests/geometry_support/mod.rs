@@ -99,6 +99,7 @@ pub fn soup_with_quadrics(tris: u32, sphere_radius: f32, disk_radius: f32) -> Ge
             kind,
             to_world: Transform::translate(Vec3::new(c.x, c.y, h.x) * 10.0),
             flip: false,
+            alpha: None,
         });
         prims.push(Primitive {
             p: [Vec3::ZERO; 3],

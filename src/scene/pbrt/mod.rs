@@ -35,7 +35,7 @@ use tokenizer::{Loc, err_at};
 pub struct ShapeCall {
     /// World-space geometry.
     pub geom: ShapeGeom,
-    /// The shape's alpha cut-out (meshes only).
+    /// The shape's alpha cut-out.
     pub alpha: Option<crate::geometry::Alpha>,
     /// Builder material index (into [`PbrtScene::materials`]).
     pub material: u32,
@@ -126,24 +126,26 @@ impl PbrtScene {
                             }
                         })
                 }
-                ShapeGeom::Sphere { to_world, radius } => b.add_sphere(
+                ShapeGeom::Sphere { to_world, radius } => b.add_sphere_cut_out(
                     to_world,
                     radius,
                     s.material,
                     s.emission,
                     s.reverse_orientation,
+                    s.alpha,
                 ),
                 ShapeGeom::Disk {
                     to_world,
                     height,
                     radius,
-                } => b.add_disk(
+                } => b.add_disk_cut_out(
                     to_world,
                     height,
                     radius,
                     s.material,
                     s.emission,
                     s.reverse_orientation,
+                    s.alpha,
                 ),
                 ShapeGeom::PartialSphere {
                     to_world,
@@ -156,6 +158,7 @@ impl PbrtScene {
                     s.material,
                     s.emission,
                     s.reverse_orientation,
+                    s.alpha,
                 ),
                 ShapeGeom::PartialDisk {
                     to_world,
@@ -168,20 +171,29 @@ impl PbrtScene {
                     s.material,
                     s.emission,
                     s.reverse_orientation,
+                    s.alpha,
                 ),
-                ShapeGeom::Curves { to_world, segments } => segments
-                    .into_iter()
-                    .try_for_each(|c| b.add_curve(to_world, c, s.material, s.reverse_orientation)),
+                ShapeGeom::Curves { to_world, segments } => {
+                    segments.into_iter().try_for_each(|c| {
+                        b.add_curve(
+                            to_world,
+                            c,
+                            s.material,
+                            s.reverse_orientation,
+                            s.alpha.clone(),
+                        )
+                    })
+                }
                 ShapeGeom::Bilinear { patches, mesh } => {
-                    if s.emission.is_some() || s.alpha.is_some() {
-                        // Lights and cut-outs are triangles: exact for parallelograms.
+                    if s.emission.is_some() {
+                        // Lights are triangles: exact for parallelograms.
                         let bent = patches.iter().any(|(c, _, _)| {
                             let size = (c[3] - c[0]).length().max((c[1] - c[2]).length());
                             (c[3] - c[2] - c[1] + c[0]).length() > 1e-5 * size
                         });
                         if bent && warned_at.insert(format!("bilinear@{}", s.loc.file_line())) {
                             warnings.push(format!(
-                                "{}: warning: emissive or cut-out bilinearmesh with non-parallelogram patches approximated by two triangles each",
+                                "{}: warning: emissive bilinearmesh with non-parallelogram patches approximated by two triangles each",
                                 s.loc.file_line()
                             ));
                         }
@@ -193,7 +205,7 @@ impl PbrtScene {
                         }
                     } else {
                         patches.into_iter().try_for_each(|(p, uv, flip)| {
-                            b.add_bilinear_patch(p, uv, s.material, flip)
+                            b.add_bilinear_patch(p, uv, s.material, flip, s.alpha.clone())
                         })
                     }
                 }
@@ -209,6 +221,7 @@ impl PbrtScene {
                     s.material,
                     s.emission,
                     s.reverse_orientation,
+                    s.alpha,
                 ),
             };
             r.map_err(|e| err_at(&s.loc, e))?;

@@ -1102,7 +1102,7 @@ impl Parser {
         let mut pending = Vec::new();
         let mut warn = |k: &str, l: &Loc, m: String| pending.push((k.to_string(), l.clone(), m));
         let geom = make_shape(ty, ps, &ctx, &mut warn)?;
-        let alpha = shape_alpha(ty, ps, &self.textures, loc, &mut warn)?;
+        let alpha = shape_alpha(ps, &self.textures, loc, &mut warn)?;
         for (k, l, m) in pending {
             self.warn(&k, &l, m);
         }
@@ -1116,21 +1116,6 @@ impl Parser {
             );
             return Ok(());
         };
-        if !matches!(geom, super::shapes::ShapeGeom::Mesh(_))
-            && matches!(
-                self.out.materials.get(material as usize),
-                Some(MaterialDesc::Varying {
-                    normal: Some(_),
-                    ..
-                })
-            )
-        {
-            self.warn(
-                "normalmap-quadric",
-                loc,
-                format!("normal and bump maps on a \"{ty}\" are ignored (triangle meshes only)"),
-            );
-        }
         let emission = self.gs.area.as_ref().map(|a| AreaEmission {
             l: a.radiance_for_area(geom.area()),
             two_sided: a.two_sided,

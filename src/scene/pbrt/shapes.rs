@@ -820,10 +820,9 @@ fn curve_shape(
 
 /// The shape's `"float alpha"` / `"texture alpha"` cut-out (pbrt-v4: none when the coverage is
 /// 1). Coverage is clamped to [0, 1] by the alpha test; a varying float texture (image,
-/// checkerboard, scale, mapped) is evaluated at each candidate hit's uv. Spheres and disks keep
-/// no cut-out (warned).
+/// checkerboard, scale, mapped) is evaluated at each candidate hit's uv (a quadric's, a
+/// curve's or a patch's own uv as for meshes).
 pub fn shape_alpha(
-    kind: &str,
     params: &ParamSet,
     textures: &TextureTable,
     loc: &Loc,
@@ -843,14 +842,6 @@ pub fn shape_alpha(
         if a >= 1.0 {
             return Ok(None);
         }
-    }
-    if matches!(kind, "sphere" | "disk" | "cylinder" | "curve") {
-        warn(
-            "shape-alpha-quadric",
-            loc,
-            format!("'alpha' on a {kind} is not supported; rendered opaque"),
-        );
-        return Ok(None);
     }
     Ok(Some(match t.constant() {
         Some(a) => Alpha::Constant(a.max(0.0)),
