@@ -329,7 +329,7 @@ fn quadric_error_bounds_cover_the_intersections_own_rounding() {
                     material: 0,
                     light: u32::MAX,
                 };
-                let g = Geometry::new(vec![prim], vec![MeshShading::default()], vec![q]);
+                let g = Geometry::new(vec![prim], vec![MeshShading::default()], vec![q.clone()]);
                 let exact_inv = m.as_dmat4().inverse();
                 for _ in 0..20 {
                     let u = u2();

