@@ -324,7 +324,11 @@ fn chi2_dispersive_rough_dielectric_per_channel_and_mixed() {
     let d = dispersive(Vec2::splat(0.3), false);
     for c in 0..3 {
         let b = Bsdf::Dielectric(d.channel(c));
-        sphere(&format!("dispersive channel {c} entering=false 30°"), &b, wo_at(30.0));
+        sphere(
+            &format!("dispersive channel {c} entering=false 30°"),
+            &b,
+            wo_at(30.0),
+        );
     }
     for (alpha, entering, deg) in [
         (Vec2::splat(0.3), true, 30.0),

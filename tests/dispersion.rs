@@ -86,7 +86,10 @@ fn each_channel_refracts_by_snells_law_with_its_own_index() {
                 let w = weight(&s);
                 for k in 0..3 {
                     let want = if k == c { 3.0 / (eta * eta) } else { 0.0 };
-                    assert!((w[k] - want).abs() < 1e-5 * want.max(1.0), "{w} channel {c}");
+                    assert!(
+                        (w[k] - want).abs() < 1e-5 * want.max(1.0),
+                        "{w} channel {c}"
+                    );
                 }
             }
             // The channels refract apart (blue bends most) unless one is totally reflected.
@@ -130,13 +133,19 @@ fn smooth_dispersive_interface_conserves_energy_per_channel() {
                 let m = e[k] / n as f64;
                 let sd = ((e2[k] / n as f64 - m * m).max(0.0) / n as f64).sqrt();
                 eprintln!("entering={entering} {deg}° channel {k}: {m:.5} ± {sd:.1e}");
-                assert!((m - 1.0).abs() <= 5.0 * sd + 1e-6, "channel {k}: {m} ± {sd}");
+                assert!(
+                    (m - 1.0).abs() <= 5.0 * sd + 1e-6,
+                    "channel {k}: {m} ± {sd}"
+                );
             }
             let r = b.reflectance(wo);
             let mean = ((r.x + r.y + r.z) / 3.0) as f64;
             let fr = nr as f64 / n as f64;
             let sd = (mean * (1.0 - mean) / n as f64).sqrt();
-            assert!((fr - mean).abs() <= 5.0 * sd + 1e-9, "reflected {fr} vs R̄ {mean}");
+            assert!(
+                (fr - mean).abs() <= 5.0 * sd + 1e-9,
+                "reflected {fr} vs R̄ {mean}"
+            );
         }
     }
 }
@@ -165,7 +174,10 @@ fn a_tilted_slab_shifts_each_channel_by_its_own_amount() {
             let s = top.sample(-dir, uc_for(c, 0.9999), Vec2::ZERO).unwrap();
             let w1 = weight(&s);
             let inside = s.wi;
-            assert_eq!(inside, refract(dir, Vec3::Z, 1.0 / ETA[c]).map_or(inside, |_| inside));
+            assert_eq!(
+                inside,
+                refract(dir, Vec3::Z, 1.0 / ETA[c]).map_or(inside, |_| inside)
+            );
             assert!((inside - refract(dir, Vec3::Z, 1.0 / ETA[c]).unwrap()).length() < 1e-5);
             let p = inside * (d / -inside.z);
             // The bottom face seen from inside (the frame flips toward wo: normal +z again).
@@ -231,7 +243,11 @@ fn rough_f_is_per_channel_and_pdf_is_the_channel_mean() {
                 }
                 let mean = (ch[0].pdf(wo, s.wi) + ch[1].pdf(wo, s.wi) + ch[2].pdf(wo, s.wi)) / 3.0;
                 assert!((pdf - mean).abs() <= 1e-6 * mean, "{pdf} vs {mean}");
-                assert_eq!((s.f, s.pdf), (f, pdf), "the sample reports f and pdf at its wi");
+                assert_eq!(
+                    (s.f, s.pdf),
+                    (f, pdf),
+                    "the sample reports f and pdf at its wi"
+                );
                 assert_eq!(b.f_pdf(wo, s.wi), (f, pdf));
             }
             assert!(n_samples > 1500, "{n_samples}");
@@ -280,9 +296,15 @@ fn rough_pdf_integrates_to_the_kept_fraction_and_energy_is_at_most_one() {
         }
         let kept = kept as f64 / n as f64;
         let sd = (kept * (1.0 - kept) / n as f64).sqrt();
-        eprintln!("rough α={alpha} entering={entering} {deg}°: ∫pdf {q:.5}, kept {kept:.5}, energy {:?}", e.map(|v| v / n as f64));
+        eprintln!(
+            "rough α={alpha} entering={entering} {deg}°: ∫pdf {q:.5}, kept {kept:.5}, energy {:?}",
+            e.map(|v| v / n as f64)
+        );
         assert!(q <= 1.0 + 2e-3, "∫pdf = {q}");
-        assert!((q - kept).abs() <= 5.0 * sd + 3e-3, "∫pdf {q} vs kept {kept}");
+        assert!(
+            (q - kept).abs() <= 5.0 * sd + 3e-3,
+            "∫pdf {q} vs kept {kept}"
+        );
         for (k, v) in e.iter().enumerate() {
             let m = v / n as f64;
             assert!(m <= 1.0 + 0.01 && m > 0.5, "channel {k}: energy {m}");
@@ -332,7 +354,10 @@ Shape "sphere" "float radius" [ 1.2 ]
         let se = (px.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
         eprintln!("furnace channel {c}: {mean:.5} ± {se:.1e}");
         assert!(se > 0.0 && se < 0.02, "σ {se}");
-        assert!((mean - 1.0).abs() <= 5.0 * se + 1e-4, "channel {c}: {mean} ± {se}");
+        assert!(
+            (mean - 1.0).abs() <= 5.0 * se + 1e-4,
+            "channel {c}: {mean} ± {se}"
+        );
     }
 }
 

