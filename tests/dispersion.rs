@@ -503,3 +503,41 @@ AttributeEnd
         "{plain:?} vs {want_plain}"
     );
 }
+
+#[test]
+fn only_what_is_still_approximated_warns() {
+    // A dielectric disperses (no warning); a coat keeps the index at 550 nm and says so, once.
+    let scene = |material: &str| {
+        let src = format!(
+            r#"LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" [ 30 ]
+Film "rgb" "integer xresolution" [ 4 ] "integer yresolution" [ 4 ]
+WorldBegin
+{material}
+Shape "sphere" "float radius" [ 1 ]
+{material}
+Shape "sphere" "float radius" [ 0.5 ]
+"#
+        );
+        pbrt_scene_in(&src, Path::new("."))
+    };
+    let (s, w) = scene(r#"Material "dielectric" "spectrum eta" [ 400 1.6 500 1.55 700 1.5 ]"#);
+    assert!(!w.iter().any(|w| w.contains("dispersion")), "{w:?}");
+    let Material::DispersiveDielectric { eta, .. } = s.materials[0] else {
+        panic!("{:?}", s.materials[0]);
+    };
+    assert!(eta.z > eta.y && eta.y > eta.x && eta.x > 1.5, "{eta}");
+    // A constant spectrum is no dispersion: the plain dielectric, as before.
+    let (s, _) = scene(r#"Material "dielectric" "spectrum eta" [ 300 1.5 900 1.5 ]"#);
+    assert!(matches!(s.materials[0], Material::Dielectric { eta, .. } if eta == 1.5));
+    let (_, w) = scene(r#"Material "coateddiffuse" "spectrum eta" "glass-BK7""#);
+    let n = w
+        .iter()
+        .filter(|w| w.contains("dispersion approximated"))
+        .count();
+    assert_eq!(n, 1, "{w:?}");
+    assert!(
+        w.iter().all(|w| w.matches("warning:").count() <= 1),
+        "{w:?}"
+    );
+}
