@@ -400,7 +400,7 @@ impl SceneBuilder {
         let flip = reverse_orientation ^ to_world.swaps_handedness();
         if let Some(e) = emission {
             let (t0, t1) = ((zmin / radius).acos(), (zmax / radius).acos());
-            let mesh = tessellate(&to_world, flip, |u, v| {
+            let mesh = tessellate(&to_world, flip, PARTIAL_LIGHT_GRID, |u, v| {
                 let (theta, phi) = (t0 + (t1 - t0) * v, u * phimax);
                 let n = Vec3::new(
                     theta.sin() * phi.cos(),
@@ -451,7 +451,7 @@ impl SceneBuilder {
         );
         let flip = reverse_orientation ^ to_world.swaps_handedness();
         if let Some(e) = emission {
-            let mesh = tessellate(&to_world, flip, |u, v| {
+            let mesh = tessellate(&to_world, flip, PARTIAL_LIGHT_GRID, |u, v| {
                 let (r, phi) = (radius - (radius - inner) * v, u * phimax);
                 (Vec3::new(r * phi.cos(), r * phi.sin(), height), Vec3::Z)
             });
@@ -499,35 +499,13 @@ impl SceneBuilder {
         // space as a normal, so a mirrored cylinder faces inward.
         let flip = reverse_orientation ^ to_world.swaps_handedness();
         if let Some(e) = emission {
-            let n = CYLINDER_LIGHT_SEGMENTS;
-            let (mut positions, mut normals, mut uvs, mut indices) =
-                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-            let nt = to_world.m_inv.transpose();
-            for i in 0..=n {
-                let u = i as f32 / n as f32;
-                let phi = u * phimax;
-                let (s, c) = phi.sin_cos();
-                for (z, v) in [(zmin, 0.0), (zmax, 1.0)] {
-                    positions.push(to_world.point(Vec3::new(radius * c, radius * s, z)));
-                    let nn = nt
-                        .transform_vector3(Vec3::new(c, s, 0.0))
-                        .normalize_or_zero();
-                    normals.push(if flip { -nn } else { nn });
-                    uvs.push(glam::Vec2::new(u, v));
-                }
-            }
-            for i in 0..n {
-                let (a, b) = (2 * i, 2 * i + 2);
-                // Wound so that (p1 − p0) × (p2 − p0) points outward: along +φ, then +z.
-                indices.extend_from_slice(&[a, b, b + 1, a, b + 1, a + 1]);
-            }
-            let mesh = TriangleMesh {
-                positions,
-                normals: Some(normals),
-                uvs: Some(uvs),
-                indices,
-                flip_normals: flip,
-            };
+            // One band of quads around the sweep, wound (p1 − p0) × (p2 − p0) outward: along
+            // +φ, then +z.
+            let mesh = tessellate(&to_world, flip, (CYLINDER_LIGHT_SEGMENTS, 1), |u, v| {
+                let (s, c) = (u * phimax).sin_cos();
+                let z = if v == 0.0 { zmin } else { zmax };
+                (Vec3::new(radius * c, radius * s, z), Vec3::new(c, s, 0.0))
+            });
             return self
                 .add_mesh_cut_out(mesh, material, Some(e), alpha)
                 .map(|_| ());
@@ -696,15 +674,15 @@ fn emitter_geometry(prims: &[Primitive], meshes: &[MeshShading], quadrics: &[Qua
     Geometry::new(own_prims, own_meshes, own_quadrics)
 }
 
-/// A [`PARTIAL_LIGHT_GRID`] triangle mesh of the object-space surface `f(u, v) → (point,
-/// normal)` over [0, 1]², in world space, with the surface's normals (negated with `flip`) and
-/// uv = (u, v); wound so the triangles' normals agree with the vertex normals.
+/// A `(nu, nv)` grid triangle mesh of the object-space surface `f(u, v) → (point, normal)` over
+/// [0, 1]², in world space, with the surface's normals (negated with `flip`) and uv = (u, v);
+/// wound so the triangles' normals agree with the vertex normals.
 fn tessellate(
     to_world: &Transform,
     flip: bool,
+    (nu, nv): (u32, u32),
     f: impl Fn(f32, f32) -> (Vec3, Vec3),
 ) -> TriangleMesh {
-    let (nu, nv) = PARTIAL_LIGHT_GRID;
     let nt = to_world.m_inv.transpose();
     let (mut positions, mut normals, mut uvs, mut indices) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
