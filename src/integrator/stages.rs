@@ -899,7 +899,17 @@ impl<'a> Integrator<'a> {
                 let light = &scene.lights[i as usize];
                 let (p, n) = (Vec3::ZERO, Vec3::ZERO);
                 let from = paths.depth >= 2;
-                let nee = nee_pdf(self.selector, from, light, i, &prev.at, wi, p, n, self.mode());
+                let nee = nee_pdf(
+                    self.selector,
+                    from,
+                    light,
+                    i,
+                    &prev.at,
+                    wi,
+                    p,
+                    n,
+                    self.mode(),
+                );
                 (prev.pdf, nee)
             })
         })
@@ -959,7 +969,17 @@ impl<'a> Integrator<'a> {
                     let at = sh.shading_point();
                     (
                         b.pdf,
-                        nee_pdf(self.selector, secondary, light, h.light, &at, wi, h.p, h.ng, mode),
+                        nee_pdf(
+                            self.selector,
+                            secondary,
+                            light,
+                            h.light,
+                            &at,
+                            wi,
+                            h.p,
+                            h.ng,
+                            mode,
+                        ),
                     )
                 })
             })?;
@@ -974,7 +994,10 @@ impl<'a> Integrator<'a> {
                 let light = &scene.lights[i as usize];
                 let at = sh.shading_point();
                 let (p, n) = (Vec3::ZERO, Vec3::ZERO);
-                (b.pdf, nee_pdf(self.selector, secondary, light, i, &at, wi, p, n, mode))
+                (
+                    b.pdf,
+                    nee_pdf(self.selector, secondary, light, i, &at, wi, p, n, mode),
+                )
             })
         });
         Some((b.ray, b.weight * sum))

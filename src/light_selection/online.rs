@@ -19,7 +19,7 @@
 //! round's frozen distribution (which depends only on earlier rounds), so each round's image is
 //! unbiased and so is their sample-weighted sum.
 
-use super::defensive::{self, DEFENSIVE_FLOOR, Defensive, ProbeConfig};
+use super::defensive::{self, Defensive, ProbeConfig};
 use super::power::PowerSelector;
 use super::spatial::{CellTable, SpatialSelector};
 use super::{
@@ -150,7 +150,10 @@ impl OnlineLearner {
         let cells = self.spatial.grid().len();
         let mut learned: Vec<Option<(CellTable, f32)>> = vec![None; cells];
         let mut trained = 0;
-        for (cell, sums) in self.sums[class * cells..(class + 1) * cells].iter().enumerate() {
+        for (cell, sums) in self.sums[class * cells..(class + 1) * cells]
+            .iter()
+            .enumerate()
+        {
             let n: u64 = sums.values().map(|s| s.1).sum();
             if n < self.cfg.min_records {
                 continue;
@@ -298,22 +301,16 @@ impl FiniteSelector for OnlineSnapshot {
     }
 }
 
-/// Smallest probability the snapshot gives a light of power share `p_power`: the defensive
-/// floor (for tests).
-pub fn floor(p_power: f32) -> f32 {
-    DEFENSIVE_FLOOR * p_power
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn digests_sum_per_key_in_record_order() {
-        let scene = crate::scene::builtin::find("many-open").expect("built-in")(
-            &crate::scene::builtin::BuiltinOptions::default(),
-        );
-        let Ok(scene) = scene else { return };
+        let opts = crate::scene::load::LoadOptions::default();
+        let scene = crate::scene::load::load("many-open", &opts)
+            .expect("built-in")
+            .scene;
         let learner = OnlineLearner::new(&scene, OnlineConfig::new(1));
         let r = |light, value, secondary| LearnRecord {
             p: Vec3::ZERO,
