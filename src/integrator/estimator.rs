@@ -183,11 +183,13 @@ pub(super) struct PrevVertex {
 
 /// The density with which next-event estimation at `at` (light selection, then `light`'s own
 /// sampling in `mode`) draws direction `wi` toward light `index` at `p` with normal `n` (zero
-/// for infinite lights): pmf · p_L.
+/// for infinite lights): pmf · p_L, the pmf of the vertex class of `at` (`secondary`: a vertex
+/// after the first).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub(super) fn nee_pdf(
     selector: &dyn LightSelector,
+    secondary: bool,
     light: &Light,
     index: u32,
     at: &ShadingPoint,
@@ -197,7 +199,7 @@ pub(super) fn nee_pdf(
     mode: SamplingMode,
 ) -> f32 {
     let ctx = LightSampleContext { p: at.p, n: at.n };
-    selector.pmf(at, index) * light.pdf_li(&ctx, wi, p, n, mode)
+    selector.pmf_at(at, index, secondary) * light.pdf_li(&ctx, wi, p, n, mode)
 }
 
 /// How a vertex combines its two techniques (the `--strategy`).

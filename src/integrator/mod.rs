@@ -13,6 +13,7 @@ pub mod film;
 mod lanes;
 pub mod queues;
 pub mod render;
+mod rounds;
 pub mod stages;
 
 pub use render::{RenderStats, render};

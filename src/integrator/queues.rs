@@ -469,6 +469,12 @@ impl ShadowRays {
         self.clear = self.active & !blocked;
     }
 
+    /// Lane k's value if it had a ray and the ray is clear (after [`Self::resolve`]).
+    #[inline]
+    pub(super) fn clear_value(&self, k: usize) -> Option<Rgb> {
+        (self.clear >> k & 1 != 0).then(|| self.value.get(k))
+    }
+
     /// Add to `sums` each lane's value where its ray is clear, zero elsewhere, for the lanes
     /// `on` (valid after [`Self::resolve`]).
     #[inline]

@@ -12,7 +12,8 @@ use crate::camera::CameraRays;
 use crate::geometry::{PACKET, Ray, RayPacket};
 use crate::image::Image;
 use crate::isa::{Cpu, Kernel, Token};
-use crate::light_selection::make_selector;
+use crate::light_selection::online::{Digest, OnlineLearner};
+use crate::light_selection::{LightSelector, SelectorKind, make_selector};
 use crate::sampling::{PixelSamples, make_pattern};
 use crate::scene::Filter;
 use crate::scene::Scene;
@@ -90,6 +91,24 @@ pub fn render(
     res: UVec2,
     opts: &RenderOptions,
 ) -> anyhow::Result<(Image, RenderStats)> {
+    if opts.light_selection == SelectorKind::Online {
+        return super::rounds::render_online(scene, res, opts);
+    }
+    let selector = make_selector(opts.light_selection, scene, opts.seed);
+    let (img, stats, _) = render_with(scene, res, opts, selector.as_ref(), None)?;
+    Ok((img, stats))
+}
+
+/// [`render`] with light selection `selector`; with a `learner`, every tile also records
+/// what its light samples delivered and returns it summed ([`OnlineLearner::digest`]), in
+/// tile order.
+pub(super) fn render_with(
+    scene: &Scene,
+    res: UVec2,
+    opts: &RenderOptions,
+    selector: &dyn LightSelector,
+    learner: Option<&OnlineLearner>,
+) -> anyhow::Result<(Image, RenderStats, Vec<Digest>)> {
     anyhow::ensure!(
         res.x > 0 && res.y > 0,
         "resolution must be positive, got {}x{}",
@@ -98,11 +117,10 @@ pub fn render(
     );
     anyhow::ensure!(opts.spp > 0, "--spp must be at least 1");
     let samples = opts.samples()?;
-    let selector = make_selector(opts.light_selection, scene, opts.seed);
     let pattern = make_pattern(opts.pattern, opts.seed);
     let est = Integrator {
         scene,
-        selector: selector.as_ref(),
+        selector,
         pattern: pattern.as_ref(),
         strategy: opts.strategy,
         mis: opts.mis,
@@ -162,7 +180,7 @@ pub fn render(
         .map(|_| std::sync::Mutex::new(None))
         .collect();
     let start = Instant::now();
-    let tiles: Vec<TileOut> = (0..tiles_x * tiles_y)
+    let (tiles, digests): (Vec<TileOut>, Vec<Option<Digest>>) = (0..tiles_x * tiles_y)
         .into_par_iter()
         // Per worker thread: one PixelSamples per pixel of a tile (filled in place) and the
         // wave's queues, made once and reused from tile to tile (rayon's `map_init` would make
@@ -202,6 +220,8 @@ pub fn render(
             cams.clear();
             weights.clear();
             us.clear();
+            queues.learning = learner.is_some();
+            queues.records.clear();
             let mut cam = CameraPacket::new();
             let (mut tile_rays, mut tile_bad) = (RayCounts::default(), 0u64);
             let mut flush = |cams: &mut Vec<CameraPacket>,
@@ -339,9 +359,10 @@ pub fn render(
             }
             bad.fetch_add(tile_bad, Ordering::Relaxed);
             bar.inc(1);
-            out
+            let digest = learner.map(|l| l.digest(&queues.records));
+            (out, digest)
         })
-        .collect();
+        .unzip();
     bar.finish_and_clear();
     if opts.is_cancelled() {
         return Err(super::Cancelled.into());
@@ -398,7 +419,7 @@ pub fn render(
             stats.non_finite
         );
     }
-    Ok((img, stats))
+    Ok((img, stats, digests.into_iter().flatten().collect()))
 }
 
 /// The camera samples of a packet's lanes before their rays are made.

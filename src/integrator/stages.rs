@@ -41,6 +41,7 @@ use crate::bsdf::{Bsdf, Bxdf, LaneBsdf, LobeSampling};
 use crate::geometry::interaction::NO_LIGHT;
 use crate::geometry::packet::bits;
 use crate::geometry::{PACKET, Ray, RayPacket, RayQuery, SurfaceHit};
+use crate::light_selection::online::LearnRecord;
 use crate::light_selection::{
     LightSelector, SelectedLight, SelectorKind, ShadingPoint, UniformSelector,
 };
@@ -113,6 +114,14 @@ pub struct Queues {
     gathered: ShadowRays,
     /// Per lane: the sum over this vertex's rounds.
     sums: [Rgb; PACKET],
+    /// Record what every light sample delivered (`online` selection's rounds).
+    pub learning: bool,
+    /// Lanes that selected a light this round (when `learning`).
+    chosen: u32,
+    /// Per `chosen` lane: the light and its pmf.
+    chosen_light: [SelectedLight; PACKET],
+    /// The records of the light samples taken since the caller last drained them.
+    pub records: Vec<LearnRecord>,
 }
 
 impl Default for Queues {
@@ -141,6 +150,10 @@ impl Queues {
             nee: ShadowRays::new(),
             gathered: ShadowRays::new(),
             sums: [Rgb::ZERO; PACKET],
+            learning: false,
+            chosen: 0,
+            chosen_light: [SelectedLight { index: 0, pmf: 0.0 }; PACKET],
+            records: Vec::new(),
         }
     }
 
@@ -460,6 +473,9 @@ impl<'a> Integrator<'a> {
             self.gather_emitters(q, t, on);
             let clock = timing.then(Instant::now);
             self.trace_shadows(q);
+            if q.learning {
+                self.record(q);
+            }
             if let Some(c) = clock {
                 let traced = q.nee.active.count_ones() + q.gathered.active.count_ones();
                 rays.timed.shadow.add(&QueryTime {
@@ -590,6 +606,7 @@ impl<'a> Integrator<'a> {
     #[inline(always)]
     fn sample_lights(&self, q: &mut Queues, t: Techniques) -> u64 {
         q.nee.active = 0;
+        q.chosen = 0;
         if !t.light() {
             return 0;
         }
@@ -600,16 +617,21 @@ impl<'a> Integrator<'a> {
         // selector per sample.
         let uniform =
             (self.selector.kind() == SelectorKind::Uniform).then_some(scene.lights.len() as u32);
+        let secondary = q.paths.depth > 0;
         for k in bits(q.shaded) {
             let u = q.drawn.light_select[k];
             let sel = match uniform {
                 Some(count) => UniformSelector::pick(count, u),
                 None => match q.view(k) {
-                    Some(sh) => self.selector.sample(&sh.shading_point(), u),
+                    Some(sh) => self.selector.sample_at(&sh.shading_point(), u, secondary),
                     None => continue,
                 },
             };
             let Some(sel) = sel else { continue };
+            if q.learning {
+                q.chosen |= 1 << k;
+                q.chosen_light[k] = sel;
+            }
             let diffuse = q.rx.diffuse >> k & 1 != 0;
             match scene.lights[sel.index as usize].lane_kind() {
                 Some(LaneLight::Triangle(tri)) if diffuse => q.tri_lanes.load(k, tri, sel.pmf),
@@ -693,6 +715,7 @@ impl<'a> Integrator<'a> {
         let scene = self.scene;
         q.gathered.active = 0;
         let ending = q.bsdf_rays.active & !continuing;
+        let secondary = q.paths.depth > 0;
         if ending == 0 || !t.bsdf() {
             return;
         }
@@ -707,9 +730,31 @@ impl<'a> Integrator<'a> {
             }
             let Some(sh) = q.view(k) else { continue };
             let b = q.bsdf_rays.get(k);
-            if let Some((r, v)) = self.bsdf_gather(&sh, &b, hit, t) {
+            if let Some((r, v)) = self.bsdf_gather(&sh, &b, hit, t, secondary) {
                 q.gathered.set(k, &r, v);
             }
+        }
+    }
+
+    /// After *trace_shadows*, when learning: what each light sample of the round delivered,
+    /// f·Le·G·w/pdf_ω (its value times the selection pmf), zero when its shadow ray was
+    /// blocked or the sample was void, so the learned tables see occlusion.
+    fn record(&self, q: &mut Queues) {
+        let secondary = q.paths.depth > 0;
+        for k in bits(q.chosen) {
+            let sel = q.chosen_light[k];
+            let value = q
+                .nee
+                .clear_value(k)
+                .map_or(0.0, |v| crate::luminance(v) * sel.pmf);
+            let Some(sh) = q.view(k) else { continue };
+            let p = sh.ctx.p;
+            q.records.push(LearnRecord {
+                p,
+                light: sel.index,
+                value,
+                secondary,
+            });
         }
     }
 
@@ -804,6 +849,7 @@ impl<'a> Integrator<'a> {
                 let at = &prev.at;
                 let nee = nee_pdf(
                     self.selector,
+                    paths.depth >= 2,
                     light,
                     hit.light,
                     at,
@@ -855,7 +901,18 @@ impl<'a> Integrator<'a> {
                 let prev = paths.prev(k);
                 let light = &scene.lights[i as usize];
                 let (p, n) = (Vec3::ZERO, Vec3::ZERO);
-                let nee = nee_pdf(self.selector, light, i, &prev.at, wi, p, n, self.mode());
+                let from = paths.depth >= 2;
+                let nee = nee_pdf(
+                    self.selector,
+                    from,
+                    light,
+                    i,
+                    &prev.at,
+                    wi,
+                    p,
+                    n,
+                    self.mode(),
+                );
                 (prev.pdf, nee)
             })
         })
@@ -904,6 +961,7 @@ impl<'a> Integrator<'a> {
         b: &BsdfRay,
         hit: Option<&SurfaceHit>,
         t: Techniques,
+        secondary: bool,
     ) -> Option<(Ray, Rgb)> {
         let wi = b.ray.d;
         let mode = self.mode();
@@ -914,7 +972,17 @@ impl<'a> Integrator<'a> {
                     let at = sh.shading_point();
                     (
                         b.pdf,
-                        nee_pdf(self.selector, light, h.light, &at, wi, h.p, h.ng, mode),
+                        nee_pdf(
+                            self.selector,
+                            secondary,
+                            light,
+                            h.light,
+                            &at,
+                            wi,
+                            h.p,
+                            h.ng,
+                            mode,
+                        ),
                     )
                 })
             })?;
@@ -929,7 +997,10 @@ impl<'a> Integrator<'a> {
                 let light = &scene.lights[i as usize];
                 let at = sh.shading_point();
                 let (p, n) = (Vec3::ZERO, Vec3::ZERO);
-                (b.pdf, nee_pdf(self.selector, light, i, &at, wi, p, n, mode))
+                (
+                    b.pdf,
+                    nee_pdf(self.selector, secondary, light, i, &at, wi, p, n, mode),
+                )
             })
         });
         Some((b.ray, b.weight * sum))

@@ -49,6 +49,8 @@ pub struct ProbeConfig {
     pub resolution: u32,
     /// Light samples per probed vertex.
     pub lights_per_vertex: u32,
+    /// Probe the eye hits (primary vertices).
+    pub primary: bool,
     /// Also probe one BSDF bounce after each eye hit.
     pub bounce: bool,
     /// Relative reduction of the second moment a δ < 1 must achieve over power alone.
@@ -66,6 +68,7 @@ impl ProbeConfig {
         Self {
             resolution: 64,
             lights_per_vertex: 4,
+            primary: true,
             bounce: true,
             margin,
             min_hits: 64,
@@ -143,12 +146,12 @@ pub fn probe(
                 power.pick((2.0 * u).min(ONE_MINUS_EPS)).map(|(i, _)| i)
             } else {
                 learned
-                    .sample(&eh.sp, (2.0 * u - 1.0).min(ONE_MINUS_EPS))
+                    .sample_at(&eh.sp, (2.0 * u - 1.0).min(ONE_MINUS_EPS), eh.secondary)
                     .map(|(i, _)| i)
             };
             let lu = Vec2::new(next_f32(rng), next_f32(rng));
             let Some(i) = picked else { continue };
-            let (pp, pl) = (power.prob(i), learned.pmf(&eh.sp, i));
+            let (pp, pl) = (power.prob(i), learned.pmf_at(&eh.sp, i, eh.secondary));
             let q = 0.5 * pp as f64 + 0.5 * pl as f64;
             let (c, r) = contribution_mis(scene, eh, set.finite[i as usize], lu);
             let c = c as f64;
@@ -168,7 +171,9 @@ pub fn probe(
             let mut rng = pixel_rng(cfg.seed, 0xdefe, 0, px);
             let mut out = Vec::new();
             if let Some(eh) = eye_hit(scene, res, px, &mut rng) {
-                at(&eh, &mut rng, &mut out);
+                if cfg.primary {
+                    at(&eh, &mut rng, &mut out);
+                }
                 if cfg.bounce
                     && let Some(bh) = bounce_hit(scene, &eh, &mut rng)
                 {

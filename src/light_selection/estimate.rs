@@ -24,6 +24,8 @@ pub struct EyeHit {
     pub hit: SurfaceHit,
     /// What a selector sees.
     pub sp: ShadingPoint,
+    /// A vertex after a bounce (not a camera-ray hit).
+    pub secondary: bool,
     bsdf: Bsdf,
     frame: Frame,
     wo_local: Vec3,
@@ -66,7 +68,9 @@ pub fn bounce_hit(scene: &Scene, eh: &EyeHit, rng: &mut Pcg32) -> Option<EyeHit>
         return None;
     }
     let wi = eh.frame.to_world(s.wi).try_normalize()?;
-    hit_along(scene, &Ray::new(eh.hit.spawn_origin(wi), wi))
+    let mut bh = hit_along(scene, &Ray::new(eh.hit.spawn_origin(wi), wi))?;
+    bh.secondary = true;
+    Some(bh)
 }
 
 /// The shading set-up at the first hit of `ray`, if its surface has a material.
@@ -87,6 +91,7 @@ fn hit_along(scene: &Scene, ray: &Ray) -> Option<EyeHit> {
             wo: g.wo,
         },
         n: g.n,
+        secondary: false,
         hit,
     })
 }

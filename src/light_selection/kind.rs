@@ -15,6 +15,9 @@ pub enum SelectorKind {
     Spatial,
     /// The spatial grid, trained per cell by eye rays.
     Adaptive,
+    /// The spatial grid, trained per cell while the image renders, separately for camera-ray
+    /// hits and later path vertices (`online.rs`).
+    Online,
     /// One global distribution estimated from low-resolution eye rays (Wald et al. 2003).
     Wald,
     /// Light BVH with bounds and emission cones (Conty Estevez & Kulla 2018, pbrt-v4).
@@ -30,11 +33,12 @@ pub enum SelectorKind {
 
 impl SelectorKind {
     /// Every strategy, in CLI order.
-    pub const ALL: [SelectorKind; 8] = [
+    pub const ALL: [SelectorKind; 9] = [
         SelectorKind::Uniform,
         SelectorKind::Power,
         SelectorKind::Spatial,
         SelectorKind::Adaptive,
+        SelectorKind::Online,
         SelectorKind::Wald,
         SelectorKind::Bvh,
         SelectorKind::Exhaustive,
@@ -66,6 +70,7 @@ impl SelectorKind {
             SelectorKind::Power => "power",
             SelectorKind::Spatial => "spatial",
             SelectorKind::Adaptive => "adaptive",
+            SelectorKind::Online => "online",
             SelectorKind::Wald => "wald",
             SelectorKind::Bvh => "bvh",
             SelectorKind::Exhaustive => "exhaustive",

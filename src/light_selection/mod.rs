@@ -6,7 +6,8 @@
 //! (importance of every light per shading point, O(N): the yardstick), [`bvh`] (light BVH à la
 //! Conty Estevez & Kulla 2018 / pbrt-v4), [`wald`] (Wald et al. 2003: one global distribution
 //! estimated from low-resolution eye rays), [`spatial`] (a grid of per-cell tables built from
-//! conservative bounds), [`adaptive`] (the spatial grid, trained per cell by eye rays) and
+//! conservative bounds), [`adaptive`] (the spatial grid, trained per cell by eye rays),
+//! [`online`] (the grid's tables learned while the image renders, per vertex class), and
 //! [`ris`] (resampled importance sampling of K power-sampled candidates; its `pmf` is RIS's
 //! contribution weight, not an exact probability: [`SelectorKind::exact_pmf`]).
 //!
@@ -21,6 +22,7 @@ pub mod estimate;
 pub mod exhaustive;
 pub mod importance;
 pub mod kind;
+pub mod online;
 pub mod power;
 pub mod ris;
 pub mod spatial;
@@ -68,6 +70,17 @@ pub trait LightSelector: Send + Sync {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<SelectedLight>;
     /// Probability that `sample` picks `light` at `ctx`.
     fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32;
+    /// [`Self::sample`] at a vertex of the given class: a camera-ray hit (`secondary` false) or
+    /// a later path vertex. Only `online` tells them apart.
+    fn sample_at(&self, ctx: &ShadingPoint, u: f32, secondary: bool) -> Option<SelectedLight> {
+        let _ = secondary;
+        self.sample(ctx, u)
+    }
+    /// [`Self::pmf`] of [`Self::sample_at`] with the same class.
+    fn pmf_at(&self, ctx: &ShadingPoint, light: u32, secondary: bool) -> f32 {
+        let _ = secondary;
+        self.pmf(ctx, light)
+    }
     /// Which strategy this is.
     fn kind(&self) -> SelectorKind;
     /// Name as accepted by `--light-selection`.
@@ -82,6 +95,16 @@ pub trait FiniteSelector: Send + Sync {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)>;
     /// Probability of local index `i`.
     fn pmf(&self, ctx: &ShadingPoint, i: u32) -> f32;
+    /// [`Self::sample`] at a primary (`secondary` false) or later path vertex.
+    fn sample_at(&self, ctx: &ShadingPoint, u: f32, secondary: bool) -> Option<(u32, f32)> {
+        let _ = secondary;
+        self.sample(ctx, u)
+    }
+    /// [`Self::pmf`] of [`Self::sample_at`] with the same class.
+    fn pmf_at(&self, ctx: &ShadingPoint, i: u32, secondary: bool) -> f32 {
+        let _ = secondary;
+        self.pmf(ctx, i)
+    }
 }
 
 /// Probability given to the lights without bounds (infinite and distant) when the scene also
@@ -168,11 +191,19 @@ impl Selector {
 
 impl LightSelector for Selector {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<SelectedLight> {
+        self.sample_at(ctx, u, false)
+    }
+
+    fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32 {
+        self.pmf_at(ctx, light, false)
+    }
+
+    fn sample_at(&self, ctx: &ShadingPoint, u: f32, secondary: bool) -> Option<SelectedLight> {
         let share = self.set.finite_share();
         if u < share {
             // Reuse u: rescaled to [0, 1) it still is uniform for the finite strategy.
             let v = (u / share).min(ONE_MINUS_EPS);
-            let (i, p) = self.finite.sample(ctx, v)?;
+            let (i, p) = self.finite.sample_at(ctx, v, secondary)?;
             let pmf = p * share;
             (pmf > 0.0).then(|| SelectedLight {
                 index: self.set.finite[i as usize],
@@ -192,7 +223,7 @@ impl LightSelector for Selector {
         }
     }
 
-    fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32 {
+    fn pmf_at(&self, ctx: &ShadingPoint, light: u32, secondary: bool) -> f32 {
         let Some(&local) = self.set.local.get(light as usize) else {
             return 0.0;
         };
@@ -200,7 +231,7 @@ impl LightSelector for Selector {
         if local == u32::MAX {
             (1.0 - share) / self.set.other.len().max(1) as f32
         } else {
-            share * self.finite.pmf(ctx, local)
+            share * self.finite.pmf_at(ctx, local, secondary)
         }
     }
 
@@ -254,6 +285,11 @@ pub fn make_selector(
             let cfg = defensive::ProbeConfig::new(seed, GRID_MARGIN);
             Box::new(defensive::Defensive::new(scene, set, inner, &cfg))
         }),
+        // Before any round has rendered: the untrained grid (what the first round samples).
+        SelectorKind::Online => {
+            let learner = online::OnlineLearner::new(scene, online::OnlineConfig::new(seed));
+            learner.selector(scene, true)
+        }
         SelectorKind::Adaptive => wrap(&|set| {
             let inner = AdaptiveSelector::new(scene, set, &adaptive::AdaptiveConfig::new(seed));
             let cfg = defensive::ProbeConfig::new(seed, GRID_MARGIN);
