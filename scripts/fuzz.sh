@@ -2,6 +2,7 @@
 # A fuzz campaign on one target (pbrt, obj, gltf, ply, image) with cargo-fuzz on nightly:
 #   scripts/fuzz.sh TARGET [SECONDS]        (default 3600 s; one job, one core)
 #   scripts/fuzz.sh all [SECONDS]           (each of the five in turn, SECONDS each)
+#   RUNS=10000000 scripts/fuzz.sh TARGET S  (stops at RUNS executions or S seconds, the first)
 # On a shared machine run it as `nice -n 19 scripts/fuzz.sh ...`.
 # The corpus grows in fuzz/corpus/TARGET/ (local, not committed: it derives from the
 # third-party scenes), seeded from fuzz/seeds/TARGET/, fuzz/regressions/TARGET/ and
@@ -40,5 +41,5 @@ command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz
 cd "$root/fuzz"
 exec cargo +nightly fuzz run --sanitizer none -O "$target" "$corpus" \
   "seeds/$target" "regressions/$target" -- \
-  -max_total_time="$secs" -jobs=1 -workers=1 -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+  -max_total_time="$secs" -runs="${RUNS:--1}" -jobs=1 -workers=1 -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
   -print_final_stats=1

@@ -93,3 +93,47 @@ fn every_saved_fuzz_input_loads_or_fails_cleanly_and_renders_finite_pixels() {
     }
     eprintln!("replayed {} in {:?}", counts.join(", "), start.elapsed());
 }
+
+#[test]
+fn every_committed_seed_and_regression_is_in_a_folder_the_replay_reads() {
+    // The replay reads `fuzz/seeds/TARGET/` and `fuzz/regressions/TARGET/` one level deep: a
+    // crash saved anywhere else (a misspelt target, a subfolder, the top level) would never
+    // be replayed, and CI would not notice the bug coming back.
+    let fuzz = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz");
+    let mut stray = Vec::new();
+    let mut replayed = 0;
+    for kind in ["seeds", "regressions"] {
+        let mut stack = vec![fuzz.join(kind)];
+        while let Some(dir) = stack.pop() {
+            for entry in std::fs::read_dir(&dir).unwrap().flatten() {
+                let p = entry.path();
+                if p.is_dir() {
+                    stack.push(p);
+                    continue;
+                }
+                if p.file_name().is_some_and(|n| n == ".keep") {
+                    continue;
+                }
+                let rel = p.strip_prefix(fuzz.join(kind)).unwrap();
+                let in_target = rel.components().count() == 2
+                    && TARGETS.iter().any(|(t, _)| rel.starts_with(t));
+                if in_target {
+                    replayed += 1;
+                } else {
+                    stray.push(p.display().to_string());
+                }
+            }
+        }
+    }
+    assert!(stray.is_empty(), "not replayed: {stray:?}");
+    let listed: usize = TARGETS
+        .iter()
+        .flat_map(|(t, _)| ["seeds", "regressions"].map(|k| files_in(&fuzz.join(k).join(t))))
+        .map(|v| v.len())
+        .sum();
+    assert_eq!(
+        listed, replayed,
+        "the replay's file listing misses some inputs"
+    );
+    assert!(replayed > 0);
+}

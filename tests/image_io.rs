@@ -240,6 +240,18 @@ fn hdr_and_tga_reads() {
 /// one-entry offset table and `tail` zero bytes. `compression` is the header's code (0 none,
 /// 3 ZIP, 8 DWAA, ...); `tile` makes it a one-level tiled file with that tile size.
 fn exr_header_only(w: i32, h: i32, compression: u8, tile: Option<u32>, tail: usize) -> Vec<u8> {
+    exr_header_only_with(&["B", "G", "R"], w, h, compression, tile, tail)
+}
+
+/// [`exr_header_only`] with the half-float channels `names` (sorted, as EXR stores them).
+fn exr_header_only_with(
+    names: &[&str],
+    w: i32,
+    h: i32,
+    compression: u8,
+    tile: Option<u32>,
+    tail: usize,
+) -> Vec<u8> {
     fn attr(out: &mut Vec<u8>, name: &str, kind: &str, value: &[u8]) {
         for s in [name, kind] {
             out.extend_from_slice(s.as_bytes());
@@ -253,7 +265,7 @@ fn exr_header_only(w: i32, h: i32, compression: u8, tile: Option<u32>, tail: usi
     let flags: u32 = if tile.is_some() { 0x200 } else { 0 };
     out.extend_from_slice(&(2 | flags).to_le_bytes());
     let mut channels = Vec::new();
-    for name in ["B", "G", "R"] {
+    for name in names {
         channels.extend_from_slice(name.as_bytes());
         channels.push(0);
         channels.extend_from_slice(&ints(&[1, 0, 1, 1])); // half, pLinear+reserved, sampling 1×1
@@ -320,6 +332,25 @@ fn an_exr_header_cannot_make_the_reader_allocate_what_the_file_does_not_hold() {
     std::fs::write(&p, exr_header_only(14000, 14000, 8, None, 20_000)).unwrap();
     let err = format!("{:#}", read_image(&p).unwrap_err());
     assert!(err.contains("dwaa-big.exr"), "{err}");
+    if let Some(peak) = peak_rss() {
+        assert!(peak < PEAK_RSS_LIMIT, "peak memory {} MB", peak >> 20);
+    }
+}
+
+#[test]
+fn a_grey_dwa_exr_header_cannot_make_the_reader_allocate_what_the_file_does_not_hold() {
+    // A luminance-only layer is read by a second decode when the RGB one finds no R, G, B:
+    // that decode must also grow the image as chunks arrive. 10 kB of DWA claiming 16384²
+    // half Y pixels (512 MB) pass the size check (DWA's worst case is 66048:1), and the
+    // reader once allocated all 512 MB before finding the chunks missing.
+    let dir = scratch("exrgrey");
+    for (name, compression) in [("y-dwaa.exr", 8), ("y-dwab.exr", 9)] {
+        let p = dir.join(name);
+        let bytes = exr_header_only_with(&["Y"], 16384, 16384, compression, None, 10_000);
+        std::fs::write(&p, bytes).unwrap();
+        let err = format!("{:#}", read_image(&p).unwrap_err());
+        assert!(err.contains(name), "{err}");
+    }
     if let Some(peak) = peak_rss() {
         assert!(peak < PEAK_RSS_LIMIT, "peak memory {} MB", peak >> 20);
     }

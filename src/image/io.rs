@@ -585,20 +585,11 @@ fn read_exr(path: &Path) -> anyhow::Result<Image> {
     let meta =
         exr::meta::MetaData::read_from_file(path, false).map_err(|e| anyhow::anyhow!("{e}"))?;
     check_exr_sizes(&meta, std::fs::metadata(path)?.len())?;
-    // The image grows as decoded pixels arrive (rows in file order) rather than being
-    // allocated whole from the header: a file whose chunks are missing or broken fails before
-    // it costs the memory its header claims.
     let rgba = read_first_rgba_layer_from_file(
         path,
-        |res: Vec2<usize>, _: &RgbaChannels| (res.width(), res.height(), Vec::<Rgb>::new()),
-        |(w, _, px): &mut (usize, usize, Vec<Rgb>),
-         pos: Vec2<usize>,
-         (r, g, b, _a): (f32, f32, f32, f32)| {
-            let i = pos.y() * *w + pos.x();
-            if i >= px.len() {
-                px.resize(i + 1, Rgb::ZERO);
-            }
-            px[i] = Rgb::new(r, g, b);
+        |res: Vec2<usize>, _: &RgbaChannels| GrowingImage::new(res),
+        |img: &mut GrowingImage, pos: Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
+            img.set(pos, Rgb::new(r, g, b))
         },
     );
     // Only a first layer with a luminance channel is worth the second, grey, decode.
@@ -607,19 +598,47 @@ fn read_exr(path: &Path) -> anyhow::Result<Image> {
         .first()
         .is_some_and(|h| h.channels.list.iter().any(|c| c.name.to_string() == "Y"));
     match rgba {
-        Ok(img) => {
-            let size = img.layer_data.size;
-            let (w, h, mut pixels) = img.layer_data.channel_data.pixels;
-            pixels.resize(w * h, Rgb::ZERO);
-            Ok(Image {
-                width: u32::try_from(size.width())?,
-                height: u32::try_from(size.height())?,
-                pixels,
-            })
-        }
+        Ok(img) => img.layer_data.channel_data.pixels.finish(),
         // exr's errors print their io cause in their own message: keep that one only.
         Err(rgba_err) if has_y => read_exr_grey(path).map_err(|_| anyhow::anyhow!("{rgba_err}")),
         Err(rgba_err) => Err(anyhow::anyhow!("{rgba_err}")),
+    }
+}
+
+/// An EXR image being decoded: it grows as decoded pixels arrive (rows in file order) rather
+/// than being allocated whole from the header, so that a file whose chunks are missing or
+/// broken fails before it costs the memory its header claims (a 10 kB DWA file may claim
+/// 512 MB and pass [`check_exr_sizes`]).
+struct GrowingImage {
+    width: usize,
+    height: usize,
+    pixels: Vec<Rgb>,
+}
+
+impl GrowingImage {
+    fn new(size: exr::math::Vec2<usize>) -> Self {
+        GrowingImage {
+            width: size.width(),
+            height: size.height(),
+            pixels: Vec::new(),
+        }
+    }
+
+    fn set(&mut self, pos: exr::math::Vec2<usize>, value: Rgb) {
+        let i = pos.y() * self.width + pos.x();
+        if i >= self.pixels.len() {
+            self.pixels.resize(i + 1, Rgb::ZERO);
+        }
+        self.pixels[i] = value;
+    }
+
+    fn finish(mut self) -> anyhow::Result<Image> {
+        self.pixels.resize(self.width * self.height, Rgb::ZERO);
+        Ok(Image {
+            width: u32::try_from(self.width)?,
+            height: u32::try_from(self.height)?,
+            pixels: self.pixels,
+        })
     }
 }
 
@@ -646,23 +665,24 @@ pub fn read_exr_attributes(path: &Path) -> anyhow::Result<Vec<(String, String)>>
 
 /// An EXR whose first layer has a "Y" channel, replicated to RGB.
 fn read_exr_grey(path: &Path) -> anyhow::Result<Image> {
-    let img = exr::prelude::read_first_flat_layer_from_file(path)?;
-    let layer = &img.layer_data;
-    let y = layer
-        .channel_data
-        .list
-        .iter()
-        .find(|c| c.name.to_string() == "Y")
-        .ok_or_else(|| anyhow::anyhow!("no R/G/B or Y channels"))?;
-    let (w, h) = (layer.size.width(), layer.size.height());
-    let pixels = (0..w * h)
-        .map(|i| Rgb::splat(y.sample_data.value_by_flat_index(i).to_f32()))
-        .collect();
-    Ok(Image {
-        width: u32::try_from(w)?,
-        height: u32::try_from(h)?,
-        pixels,
-    })
+    use exr::prelude::{ReadChannels, ReadLayers, ReadSpecificChannel, Vec2, read};
+    // Decoded like the RGB layer, growing as pixels arrive: the crate's flat-layer reader
+    // allocated the whole layer from the header first.
+    let img = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .specific_channels()
+        .required("Y")
+        .collect_pixels(
+            |res: Vec2<usize>, _: &(exr::meta::attribute::ChannelDescription,)| {
+                GrowingImage::new(res)
+            },
+            |img: &mut GrowingImage, pos: Vec2<usize>, (y,): (f32,)| img.set(pos, Rgb::splat(y)),
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)?;
+    img.layer_data.channel_data.pixels.finish()
 }
 
 /// A file's first token for an error message: quoted when it is short printable text, else
