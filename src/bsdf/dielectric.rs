@@ -3,6 +3,7 @@
 //! rough interface (Walter et al. 2007, "Microfacet Models for Refraction through Rough
 //! Surfaces") sampled with visible normals. The rough lobe is always importance sampled
 //! ([`LobeSampling`](super::LobeSampling) modes only cover the reflection hemisphere).
+//! One index for every channel; a dispersive glass is [`DispersiveDielectric`](super::DispersiveDielectric).
 
 use super::fresnel::fr_dielectric;
 use super::ggx::{TrowbridgeReitz, is_smooth};
@@ -85,7 +86,7 @@ impl Dielectric {
     }
 
     /// Rough f and pdf together (they share the half vector and Fresnel term).
-    fn rough_eval(&self, wo: Vec3, wi: Vec3) -> (f32, f32) {
+    pub(super) fn rough_eval(&self, wo: Vec3, wi: Vec3) -> (f32, f32) {
         if wo.z <= 0.0 || wi.z == 0.0 {
             return (0.0, 0.0);
         }

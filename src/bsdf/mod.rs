@@ -20,6 +20,7 @@ pub mod coated_conductor;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse_transmission;
+pub mod dispersive;
 pub mod fresnel;
 pub mod ggx;
 pub mod lambert;
@@ -31,6 +32,7 @@ pub use coated::CoatedDiffuse;
 pub use conductor::{Conductor, named_metal};
 pub use dielectric::Dielectric;
 pub use diffuse_transmission::DiffuseTransmission;
+pub use dispersive::DispersiveDielectric;
 pub use ggx::{TrowbridgeReitz, roughness_to_alpha};
 pub use lambert::Lambert;
 pub use layered::{LayerParams, Layered};
@@ -216,8 +218,10 @@ pub enum Bsdf {
     Phong(Phong),
     /// GGX rough (or smooth) conductor.
     Conductor(Conductor),
-    /// Smooth glass.
+    /// Smooth or GGX rough glass.
     Dielectric(Dielectric),
+    /// Glass with one index per RGB channel (dispersion).
+    DispersiveDielectric(DispersiveDielectric),
     /// GGX dielectric coat over a diffuse base.
     CoatedDiffuse(CoatedDiffuse),
     /// Ideal mirror.
@@ -236,6 +240,7 @@ macro_rules! dispatch {
             Bsdf::Phong($b) => $e,
             Bsdf::Conductor($b) => $e,
             Bsdf::Dielectric($b) => $e,
+            Bsdf::DispersiveDielectric($b) => $e,
             Bsdf::CoatedDiffuse($b) => $e,
             Bsdf::Mirror($b) => $e,
             Bsdf::Layered($b) => $e,
@@ -269,6 +274,22 @@ impl Bsdf {
         dispatch!(self, b => (b.f(wo, wi), b.pdf(wo, wi)))
     }
 
+    /// The BSDF for a path whose throughput is `beta`: a dispersive dielectric reached by a
+    /// path that carries one channel only (it refracted through dispersive glass before)
+    /// becomes that channel's plain dielectric, so the channel is not picked again (a pick of
+    /// another would end the path: 2/3 of the samples lost per further refraction). The other
+    /// channels' zero throughput keeps them zero, as pbrt-v4's terminated wavelengths stay.
+    #[inline]
+    pub fn for_throughput(&mut self, beta: Rgb) {
+        if let Bsdf::DispersiveDielectric(d) = self {
+            let nonzero = beta.to_array().map(|v| v != 0.0);
+            if let [true, false, false] | [false, true, false] | [false, false, true] = nonzero {
+                let c = nonzero.iter().position(|&b| b).unwrap_or(0);
+                *self = Bsdf::Dielectric(d.channel(c));
+            }
+        }
+    }
+
     /// Choose how every non-delta lobe is sampled (the lab's I₁/I₂ comparison); delta BSDFs
     /// ignore it because a delta lobe can only be sampled one way.
     pub fn set_sampling(&mut self, s: LobeSampling) {
@@ -279,7 +300,7 @@ impl Bsdf {
             Bsdf::CoatedDiffuse(b) => b.sampling = s,
             Bsdf::Layered(b) => b.sampling = s,
             Bsdf::DiffuseTransmission(b) => b.sampling = s,
-            Bsdf::Dielectric(_) | Bsdf::Mirror(_) => {}
+            Bsdf::Dielectric(_) | Bsdf::DispersiveDielectric(_) | Bsdf::Mirror(_) => {}
         }
     }
 }

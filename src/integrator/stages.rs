@@ -836,6 +836,9 @@ impl<'a> Integrator<'a> {
         if self.bsdf_sampling != LobeSampling::Importance {
             lane.bsdf.set_sampling(self.bsdf_sampling);
         }
+        if matches!(lane.bsdf, Bsdf::DispersiveDielectric(_)) {
+            lane.bsdf.for_throughput(paths.beta.get(k));
+        }
         if let Some(LaneBsdf::Lambert(albedo)) = lane.bsdf.lane_kind() {
             rx.set_diffuse(k, albedo);
         }

@@ -10,7 +10,9 @@
 //! ⌈log₈ N⌉ levels (5 for 10k lights, 7 for 1M) instead of the binary tree's log₂ N levels of
 //! two evaluations each. The importance has no acos/atan: angles are combined through
 //! (sin, cos) pairs, with `sin θo` stored per child, so it costs four square roots and two
-//! divisions per lane. The pmf for MIS is the product along the light's path, found by walking
+//! divisions per lane — all of them taken from d² directly (the pairs are carried scaled by
+//! d), so they run side by side instead of waiting on each other; the running sums of a
+//! node's importances are added as a tree, four additions deep. The pmf for MIS is the product along the light's path, found by walking
 //! *up* from the light's slot through parent links (no search from the root); `sample`
 //! multiplies its per-level probabilities in the same bottom-up order, so both return the same
 //! f32 bit for bit.
@@ -132,6 +134,10 @@ impl WideNode {
     // One index walks twelve lane arrays (clearer than a twelve-way zip).
     #[allow(clippy::needless_range_loop)]
     fn importance_lanes<const HAS_N: bool>(&self, p: Vec3, n: Vec3, out: &mut [f32; WIDTH]) {
+        // Every angle is carried as its (sin, cos) pair scaled by the distance d (or d² for
+        // products of two), so the four square roots and the two divisions all start from
+        // d² at once instead of waiting on each other: a level's latency is one square root
+        // and a few multiplies, not sqrt → div → sqrt → div.
         for k in 0..WIDTH {
             let tx = p.x - self.cx[k];
             let ty = p.y - self.cy[k];
@@ -143,64 +149,51 @@ impl WideNode {
             // (`max` spelled as compares: a NaN distance takes the floor, as `f32::max` does.)
             let d2 = if dd > rl { dd } else { rl };
             let d2 = if d2 > 1e-12 { d2 } else { 1e-12 };
-            let inside = (d <= rl) | (d == 0.0);
-            let inv_d = 1.0 / d;
-            let s = rl * inv_d;
-            let sin_b = if inside { 0.0 } else { s };
-            let cos_b = if inside {
-                -1.0
-            } else {
-                pos(1.0 - s * s).sqrt()
-            };
-            let (wix, wiy, wiz) = if d > 0.0 {
-                (tx * inv_d, ty * inv_d, tz * inv_d)
-            } else {
-                (0.0, 0.0, 1.0)
-            };
-            let cw = self.wx[k] * wix + self.wy[k] * wiy + self.wz[k] * wiz;
             let phi_signed = self.phi[k];
             let phi = phi_signed.abs();
-            // Two-sided emitters face the receiver with either side of their cone.
-            let cos_w = if phi_signed.is_sign_negative() {
-                cw.abs()
+            let phi_d2 = phi / d2;
+            let inv_dd = 1.0 / dd;
+            // A receiver inside the bounding sphere sees it in every direction: θb = π.
+            let inside = (d <= rl) | (d == 0.0);
+            // cos θb·d and sin θb·d = r.
+            let cb = pos(dd - rl * rl).sqrt();
+            // cos θw·d, with two-sided emitters facing the receiver with either side.
+            let wt = self.wx[k] * tx + self.wy[k] * ty + self.wz[k] * tz;
+            let wt = if phi_signed.is_sign_negative() {
+                wt.abs()
             } else {
-                cw
+                wt
             };
-            let sin_w = pos(1.0 - cos_w * cos_w).sqrt();
+            let sw = pos(dd - wt * wt).sqrt();
             let (cos_o, sin_o) = (self.cos_o[k], self.sin_o[k]);
-            // θx = max(0, θw − θo), θ′ = max(0, θx − θb), as (sin, cos) pairs.
-            let within_o = cos_w > cos_o;
-            let cos_x = if within_o {
-                1.0
-            } else {
-                cos_w * cos_o + sin_w * sin_o
-            };
-            let sin_x = if within_o {
+            // θx = max(0, θw − θo), θ′ = max(0, θx − θb), as (sin, cos)·d pairs.
+            let within_o = wt > cos_o * d;
+            let cx = if within_o { d } else { wt * cos_o + sw * sin_o };
+            let sx = if within_o {
                 0.0
             } else {
-                sin_w * cos_o - cos_w * sin_o
+                sw * cos_o - wt * sin_o
             };
-            let cos_p = if cos_x > cos_b {
+            let cos_p = if inside | (cx > cb) {
                 1.0
             } else {
-                cos_x * cos_b + sin_x * sin_b
+                (cx * cb + sx * rl) * inv_dd
             };
-            let mut imp = phi * cos_p / d2;
+            let mut imp = phi_d2 * cos_p;
             let mut below = false;
             if HAS_N {
                 // The receiver's side: the angle between n and the direction to the bounds,
                 // narrowed by θb; zero only if the whole sphere is below the tangent plane.
-                // A receiver inside the bounds (cos θb = −1) sees them on both sides.
-                let cos_i = (-(n.x * wix + n.y * wiy + n.z * wiz)).clamp(-1.0, 1.0);
-                let sin_i = pos(1.0 - cos_i * cos_i).sqrt();
-                let cos_pi = if cos_i > cos_b {
+                // A receiver inside the bounds (θb = π) sees them on both sides.
+                let ci = -(n.x * tx + n.y * ty + n.z * tz);
+                let si = pos(dd - ci * ci).sqrt();
+                let cos_pi = if ci > cb {
                     1.0
                 } else {
-                    cos_i * cos_b + sin_i * sin_b
+                    (ci * cb + si * rl) * inv_dd
                 };
-                let use_n = !inside;
-                below = use_n & (cos_pi <= 0.0);
-                imp = if use_n { imp * cos_pi } else { imp };
+                below = !inside & (cos_pi <= 0.0);
+                imp = if inside { imp } else { imp * cos_pi };
             }
             let dead = (cos_p <= self.cos_e[k]) | (phi <= 0.0) | below | imp.is_nan();
             out[k] = if dead || !(imp < MAX_IMPORTANCE) {
@@ -212,17 +205,36 @@ impl WideNode {
     }
 }
 
-/// The probability of slot `k` among importances `imp` summing to `total`.
+/// Running sums of a node's eight importances in f64, `cum[k]` = Σ imp[..k], added as a tree
+/// (four additions deep instead of eight in a row: a level of the walk waits on them):
+/// pairs, then the first quad, then quad + pair, each sum extending one already made. Every
+/// `cum[k + 1]` is `cum[k]` or a sum made from it plus non-negative terms, so rounding keeps
+/// them non-decreasing and a zero importance adds exactly nothing (its slot's interval is
+/// empty). The total is `cum[WIDTH]`: the one place both `sample` and `pmf` add importances,
+/// so every probability is the same f64 in both.
 #[inline(always)]
-fn total_of(imp: &[f32; WIDTH]) -> f64 {
-    let mut t = 0.0f64;
-    for &x in imp {
-        t += x as f64;
-    }
-    t
+fn running_sums(imp: &[f32; WIDTH]) -> [f64; WIDTH + 1] {
+    let a = imp.map(|x| x as f64);
+    let p01 = a[0] + a[1];
+    let p23 = a[2] + a[3];
+    let p45 = a[4] + a[5];
+    let p67 = a[6] + a[7];
+    let q0 = p01 + p23;
+    let h6 = q0 + p45;
+    [
+        0.0,
+        a[0],
+        p01,
+        p01 + a[2],
+        q0,
+        q0 + a[4],
+        h6,
+        h6 + a[6],
+        h6 + p67,
+    ]
 }
 
-/// The child whose share of the running sums `cum` (cum[k] = Σ imp[..k]) holds `target`:
+/// The child whose share of the running sums `cum` (from [`running_sums`]) holds `target`:
 /// cum[pick] ≤ target < cum[pick + 1], i.e. the number of running sums past slot 0 that do not
 /// exceed it. Such a slot has a positive importance (its running sum grows), so this is the
 /// first positive child whose sum passes `target`, found by counting (branch-free) instead of
@@ -444,23 +456,17 @@ impl BvhSelector {
         loop {
             let node = &self.nodes[i];
             node.importance(ctx.p, ctx.n, &mut imp);
-            // Running sums in slot order (the order `total_of` adds in, so the total and hence
-            // every probability is the same f64 as `pmf_impl`'s): cum[k] = Σ imp[..k].
-            let mut cum = [0.0f64; WIDTH + 1];
-            let mut t = 0.0f64;
-            for k in 0..WIDTH {
-                t += imp[k] as f64;
-                cum[k + 1] = t;
-            }
-            let total = t;
+            let cum = running_sums(&imp);
+            let total = cum[WIDTH];
             if !(total > 0.0) {
                 return None;
             }
             let target = u * total;
             let pick = pick_slot(&imp, &cum, target);
             let x = imp[pick] as f64;
-            let before = cum[pick];
-            u = ((target - before) / x).clamp(0.0, 1.0 - f64::EPSILON);
+            // `target − cum[pick]` ≥ 0 is exact in sign (cum[pick] ≤ target, or the fallback
+            // slot's sum, below the total).
+            u = ((target - cum[pick]) / x).clamp(0.0, 1.0 - f64::EPSILON);
             probs[levels] = x / total;
             levels += 1;
             let c = node.child[pick];
@@ -487,7 +493,7 @@ impl BvhSelector {
             let i = (code >> 3) as usize;
             let node = &self.nodes[i];
             node.importance(ctx.p, ctx.n, &mut imp);
-            let total = total_of(&imp);
+            let total = running_sums(&imp)[WIDTH];
             let x = imp[(code & 7) as usize];
             if !(total > 0.0) || x <= 0.0 {
                 return 0.0;
@@ -684,7 +690,8 @@ mod tests {
     #[test]
     fn counted_pick_matches_the_linear_search() {
         // The search `sample` used before: the first positive child whose running sum passes
-        // `target`, else the last positive one.
+        // `target`, else the last positive one. The tree of running sums rounds differently,
+        // so the two may differ only for targets within rounding of a boundary.
         let search = |imp: &[f32; WIDTH], target: f64| {
             let (mut cum, mut pick) = (0.0f64, WIDTH);
             for (k, &x) in imp.iter().enumerate() {
@@ -705,6 +712,7 @@ mod tests {
             state ^= state << 17;
             state
         };
+        let mut agreed = 0;
         for _ in 0..20_000 {
             let mut imp = [0.0f32; WIDTH];
             for x in imp.iter_mut() {
@@ -717,22 +725,93 @@ mod tests {
                     _ => (r >> 40) as f32 * 1e20,
                 };
             }
+            let sums = running_sums(&imp);
+            let total = sums[WIDTH];
+            if !(total > 0.0) {
+                continue;
+            }
             let mut cum = [0.0f64; WIDTH + 1];
             for k in 0..WIDTH {
                 cum[k + 1] = cum[k] + imp[k] as f64;
             }
-            if !(cum[WIDTH] > 0.0) {
-                continue;
+            for k in 0..WIDTH {
+                assert!(sums[k] <= sums[k + 1], "{imp:?}: {sums:?}");
+                // A zero importance adds nothing (a tiny one next to a huge one may not either).
+                assert!(imp[k] > 0.0 || sums[k] == sums[k + 1], "{imp:?}: {sums:?}");
             }
+            let tol = 1e-12 * total;
             let u = (next() >> 11) as f64 / (1u64 << 53) as f64;
-            // Random targets, every running sum exactly, and the total (rounding past the end).
-            let k = (next() % (WIDTH as u64 + 1)) as usize;
-            for target in [u * cum[WIDTH], cum[k], cum[WIDTH]] {
-                let p = pick_slot(&imp, &cum, target);
-                assert_eq!(p, search(&imp, target), "{imp:?} {target}");
-                assert!(imp[p] > 0.0);
+            // Random targets, every running sum exactly, the total and past it (rounding of
+            // u · total).
+            let mut targets = vec![u * total, total * (1.0 + 1e-15)];
+            targets.extend(sums);
+            for target in targets {
+                let p = pick_slot(&imp, &sums, target);
+                assert!(imp[p] > 0.0, "{imp:?} {target}: slot {p}");
+                assert!(
+                    target >= sums[p] || target >= total,
+                    "{imp:?} {target}: slot {p}"
+                );
+                let near_boundary = cum.iter().any(|&c| (c - target).abs() <= tol);
+                if !near_boundary && target < cum[WIDTH] {
+                    assert_eq!(p, search(&imp, target), "{imp:?} {target}");
+                    agreed += 1;
+                }
             }
         }
+        assert!(agreed > 10_000, "{agreed}");
+    }
+
+    #[test]
+    fn sample_and_pmf_return_the_same_bits() {
+        // The pmf MIS uses is the probability `sample` reported, bit for bit: both add a
+        // node's importances through `sums` and multiply the levels bottom-up.
+        let bounds: Vec<LightBounds> = (0..5000)
+            .map(|i| {
+                let f = i as f32;
+                let c = Vec3::new((f * 0.37).sin() * 9.0, (f * 0.11).cos() * 9.0, f * 0.002);
+                LightBounds {
+                    min: c - Vec3::splat(0.05 + (i % 3) as f32 * 0.1),
+                    max: c + Vec3::splat(0.05),
+                    w: Vec3::new((f * 0.7).sin(), (f * 0.3).cos(), 0.5).normalize(),
+                    phi: 1.0 + (i % 11) as f32 * 10.0,
+                    cos_theta_o: if i % 4 == 0 { -1.0 } else { 0.7 },
+                    cos_theta_e: 0.0,
+                    two_sided: i % 5 == 0,
+                }
+            })
+            .collect();
+        let bvh = BvhSelector::new(&bounds);
+        let mut checked = 0;
+        for j in 0..200 {
+            let f = j as f32;
+            let ctx = ShadingPoint {
+                p: Vec3::new(
+                    (f * 0.9).sin() * 8.0,
+                    (f * 0.4).cos() * 8.0,
+                    (f * 0.1).sin() * 5.0,
+                ),
+                n: if j % 7 == 0 {
+                    Vec3::ZERO
+                } else {
+                    Vec3::new((f * 1.3).sin(), (f * 0.6).cos(), 0.3).normalize()
+                },
+                wo: Vec3::Z,
+            };
+            for k in 0..50 {
+                let u = ((k as f32 + 0.5) / 50.0 + f * 0.618).fract();
+                if let Some((l, p)) = bvh.sample(&ctx, u) {
+                    assert!(p > 0.0);
+                    assert_eq!(
+                        p.to_bits(),
+                        bvh.pmf(&ctx, l).to_bits(),
+                        "light {l} at {ctx:?}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 5000, "{checked}");
     }
 
     #[test]

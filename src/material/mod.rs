@@ -19,8 +19,8 @@ use crate::bsdf::coated_conductor::{coated_conductor, layered_diffuse};
 use crate::bsdf::fresnel::k_from_reflectance;
 use crate::bsdf::ggx::is_smooth;
 use crate::bsdf::{
-    Bsdf, CoatedDiffuse, Conductor, Dielectric, DiffuseTransmission, Lambert, LayerParams, Mirror,
-    Phong,
+    Bsdf, CoatedDiffuse, Conductor, Dielectric, DiffuseTransmission, DispersiveDielectric, Lambert,
+    LayerParams, Mirror, Phong,
 };
 use crate::geometry::SurfaceHit;
 use glam::Vec2;
@@ -87,6 +87,14 @@ pub enum Material {
     Dielectric {
         /// Index of refraction (inside / outside).
         eta: f32,
+        /// GGX widths (already remapped from roughness by the loader).
+        alpha: Vec2,
+    },
+    /// Glass whose index varies with wavelength: one index per RGB channel (see
+    /// [`DispersiveDielectric`]); a constant index is [`Material::Dielectric`].
+    DispersiveDielectric {
+        /// Index of refraction (inside / outside) per channel.
+        eta: Rgb,
         /// GGX widths (already remapped from roughness by the loader).
         alpha: Vec2,
     },
@@ -275,6 +283,13 @@ impl Material {
                 alpha: ov.alpha.unwrap_or(*alpha),
                 entering: front,
             }),
+            Material::DispersiveDielectric { eta, alpha } => {
+                Bsdf::DispersiveDielectric(DispersiveDielectric {
+                    eta: *eta,
+                    alpha: ov.alpha.unwrap_or(*alpha),
+                    entering: front,
+                })
+            }
             Material::Mirror => Bsdf::Mirror(Mirror { r: Rgb::ONE }),
             Material::DiffuseTransmission {
                 reflectance,
@@ -309,9 +324,9 @@ impl Material {
             }
             Material::Filtered { base, .. } => base.is_delta_only(),
             Material::Mirror => true,
-            Material::Conductor { alpha, .. } | Material::Dielectric { alpha, .. } => {
-                is_smooth(*alpha)
-            }
+            Material::Conductor { alpha, .. }
+            | Material::Dielectric { alpha, .. }
+            | Material::DispersiveDielectric { alpha, .. } => is_smooth(*alpha),
             Material::CoatedConductor {
                 coat_alpha,
                 alpha,
@@ -347,7 +362,9 @@ impl Material {
                 transmittance,
                 ..
             } => reflectance.filters() || transmittance.filters(),
-            Material::Dielectric { .. } | Material::Mirror => false,
+            Material::Dielectric { .. }
+            | Material::DispersiveDielectric { .. }
+            | Material::Mirror => false,
             Material::Varying(v) => {
                 v.base.filters_textures()
                     || r(&v.roughness)

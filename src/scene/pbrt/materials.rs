@@ -4,7 +4,8 @@
 use super::named_spectra;
 use super::params::{ParamSet, SpecVal};
 use super::spectra::{
-    SpectrumUse, conductor_rgb, named_glass_ior, sampled_at, spectrum_to_rgb, to_rgb,
+    SpectrumUse, conductor_rgb, dielectric_rgb, named_glass_ior, named_glass_rgb, sampled_at,
+    spectrum_to_rgb, to_rgb,
 };
 use super::textures::{FloatTexDesc, ImageCache, TextureDesc, TextureTable, Warn};
 use super::tokenizer::{Loc, err_at};
@@ -89,8 +90,11 @@ pub enum MaterialDesc {
     },
     /// `dielectric` / `thindielectric`.
     Dielectric {
-        /// IOR.
+        /// IOR (at 550 nm when it varies with wavelength).
         eta: f32,
+        /// One IOR per RGB channel when it varies with wavelength
+        /// (`spectra::dielectric_rgb`); `None` for a constant IOR.
+        dispersion: Option<Rgb>,
         /// (u, v) roughness as given.
         roughness: Vec2,
         /// pbrt's `remaproughness`.
@@ -346,19 +350,13 @@ fn metal(params: &ParamSet, name: &str, default: &str) -> anyhow::Result<MetalSp
     })
 }
 
-fn ior(params: &ParamSet, name: &str, loc: &Loc, warn: &mut Warn) -> anyhow::Result<f32> {
+/// An index of refraction as the file gives it: the index at 550 nm and, when it varies with
+/// wavelength (a `glass-*` name, sampled pairs or a `.spd` file, or a non-grey RGB, which
+/// pbrt-v4 upsamples to a varying spectrum), one index per RGB channel.
+fn ior_spectrum(params: &ParamSet, name: &str, loc: &Loc) -> anyhow::Result<(f32, Option<Rgb>)> {
     use super::params::ParamType;
-    let mut dispersive = || {
-        warn(
-            "dispersion",
-            loc,
-            format!(
-                "spectral '{name}': dispersion approximated by the index at 550 nm (penumbra renders RGB)"
-            ),
-        )
-    };
-    let eta = match params.type_of(name) {
-        None | Some(ParamType::Float | ParamType::Integer) => params.float(name, 1.5)?,
+    let (eta, rgb) = match params.type_of(name) {
+        None | Some(ParamType::Float | ParamType::Integer) => (params.float(name, 1.5)?, None),
         Some(_) => match params.spectrum(name)? {
             Some(SpecVal::Named(n)) => {
                 let v = named_glass_ior(&n).ok_or_else(|| {
@@ -367,22 +365,47 @@ fn ior(params: &ParamSet, name: &str, loc: &Loc, warn: &mut Warn) -> anyhow::Res
                         format!("'{name}': \"{n}\" is not an index of refraction"),
                     )
                 })?;
-                dispersive();
-                v
+                (v, named_glass_rgb(&n))
             }
-            Some(SpecVal::Sampled(p)) => {
-                dispersive();
-                sampled_at(&p, 550.0) as f32
-            }
-            Some(SpecVal::Rgb(c)) => c.y,
-            Some(SpecVal::Blackbody(_)) | None => 1.5,
+            Some(SpecVal::Sampled(p)) => (
+                sampled_at(&p, 550.0) as f32,
+                Some(dielectric_rgb(|l| sampled_at(&p, l))),
+            ),
+            Some(SpecVal::Rgb(c)) => (c.y, Some(c)),
+            Some(SpecVal::Blackbody(_)) | None => (1.5, None),
         },
     };
-    if !(eta.is_finite() && eta > 0.0) {
+    let positive = |v: f32| v.is_finite() && v > 0.0;
+    if !positive(eta) {
         return Err(err_at(
             loc,
             format!("'{name}' must be positive, found {eta}"),
         ));
+    }
+    if let Some(c) = rgb
+        && !c.to_array().into_iter().all(positive)
+    {
+        return Err(err_at(
+            loc,
+            format!("'{name}' must be positive in every channel, found {c}"),
+        ));
+    }
+    // An index that does not vary is no dispersion (and renders as before).
+    Ok((eta, rgb.filter(|c| c.x != c.y || c.y != c.z)))
+}
+
+/// The index of a coat (`coateddiffuse`, `coatedconductor`): layered BSDFs take one index, so
+/// a spectral one is its value at 550 nm, with a warning.
+fn ior(params: &ParamSet, name: &str, loc: &Loc, warn: &mut Warn) -> anyhow::Result<f32> {
+    let (eta, dispersion) = ior_spectrum(params, name, loc)?;
+    if dispersion.is_some() {
+        warn(
+            "dispersion",
+            loc,
+            format!(
+                "spectral '{name}' of a coat: dispersion approximated by the index at 550 nm (only \"dielectric\" disperses)"
+            ),
+        );
     }
     Ok(eta)
 }
@@ -494,8 +517,10 @@ fn material_body(
                 );
             }
             let (r, rt) = roughness(params, tex, 0.0, warn)?;
+            let (eta, dispersion) = ior_spectrum(params, "eta", loc)?;
             let base = MaterialDesc::Dielectric {
-                eta: ior(params, "eta", loc, warn)?,
+                eta,
+                dispersion,
                 roughness: r,
                 remap: params.bool("remaproughness", true)?,
                 thin,
@@ -735,6 +760,7 @@ pub fn to_material(
         }
         MaterialDesc::Dielectric {
             eta,
+            dispersion,
             roughness,
             remap,
             thin,
@@ -745,9 +771,15 @@ pub fn to_material(
                     "warning: thindielectric approximated by a dielectric".to_string(),
                 );
             }
-            Material::Dielectric {
-                eta: *eta,
-                alpha: alpha(*roughness, *remap),
+            match dispersion {
+                Some(eta) => Material::DispersiveDielectric {
+                    eta: *eta,
+                    alpha: alpha(*roughness, *remap),
+                },
+                None => Material::Dielectric {
+                    eta: *eta,
+                    alpha: alpha(*roughness, *remap),
+                },
             }
         }
         MaterialDesc::Varying {
