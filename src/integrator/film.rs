@@ -258,8 +258,16 @@ pub fn filter_sample(filter: &Filter, pixel: UVec2, u: Vec2) -> Vec2 {
     match *filter {
         Filter::Box { radius } => center + (u * 2.0 - Vec2::ONE) * radius,
         Filter::Triangle { radius } => center + Vec2::new(tent(u.x, radius.x), tent(u.y, radius.y)),
-        _ => FilterSampler::new(filter)
-            .map(|s| s.sample(pixel, u).0)
-            .unwrap_or(center),
+        _ => tabulated_sample(filter, pixel, u, center),
     }
+}
+
+/// [`filter_sample`] for a tabulated filter, out of line so that the box and tent arms, run
+/// for every camera ray, stay small (cornell direct mis 64 spp, AVX2: 5.64 → 5.23 user s).
+#[cold]
+#[inline(never)]
+fn tabulated_sample(filter: &Filter, pixel: UVec2, u: Vec2, center: Vec2) -> Vec2 {
+    FilterSampler::new(filter)
+        .map(|s| s.sample(pixel, u).0)
+        .unwrap_or(center)
 }

@@ -489,6 +489,20 @@ impl CameraLanes {
     /// [`CameraLanes::rays`] as plain loops over the lanes, compiled for each instruction set.
     #[inline(always)]
     fn rays_portable(&self, camera: &CameraRays, filter: &Filter, ray: &mut RayPacket) {
+        // One loop per filter kind, each with its filter a constant: no test of the kind per
+        // lane.
+        match *filter {
+            Filter::Box { radius } => self.rays_under(&Filter::Box { radius }, camera, ray),
+            Filter::Triangle { radius } => {
+                self.rays_under(&Filter::Triangle { radius }, camera, ray)
+            }
+            _ => self.rays_under(filter, camera, ray),
+        }
+    }
+
+    /// [`CameraLanes::rays_portable`] under one filter.
+    #[inline(always)]
+    fn rays_under(&self, filter: &Filter, camera: &CameraRays, ray: &mut RayPacket) {
         let o = Ray::new(camera.origin(), Vec3::Z);
         for k in 0..PACKET {
             let d = camera.direction(filter_sample(filter, self.pixel[k], self.u[k]));
