@@ -254,12 +254,23 @@ impl FilterSampler {
 /// here and their weight is left out: renders use [`FilterSampler::sample`], which keeps both.
 #[inline]
 pub fn filter_sample(filter: &Filter, pixel: UVec2, u: Vec2) -> Vec2 {
-    let center = pixel.as_vec2() + Vec2::splat(0.5);
     match *filter {
-        Filter::Box { radius } => center + (u * 2.0 - Vec2::ONE) * radius,
-        Filter::Triangle { radius } => center + Vec2::new(tent(u.x, radius.x), tent(u.y, radius.y)),
-        _ => tabulated_sample(filter, pixel, u, center),
+        Filter::Box { radius } => box_sample(pixel, u, radius),
+        Filter::Triangle { radius } => tent_sample(pixel, u, radius),
+        _ => tabulated_sample(filter, pixel, u, pixel.as_vec2() + Vec2::splat(0.5)),
     }
+}
+
+/// [`filter_sample`] under a box filter of `radius`.
+#[inline(always)]
+pub fn box_sample(pixel: UVec2, u: Vec2, radius: Vec2) -> Vec2 {
+    pixel.as_vec2() + Vec2::splat(0.5) + (u * 2.0 - Vec2::ONE) * radius
+}
+
+/// [`filter_sample`] under a tent filter of `radius`.
+#[inline(always)]
+pub fn tent_sample(pixel: UVec2, u: Vec2, radius: Vec2) -> Vec2 {
+    pixel.as_vec2() + Vec2::splat(0.5) + Vec2::new(tent(u.x, radius.x), tent(u.y, radius.y))
 }
 
 /// [`filter_sample`] for a tabulated filter, out of line so that the box and tent arms, run

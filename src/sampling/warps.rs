@@ -525,7 +525,7 @@ pub fn balance_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
 /// pdf(x) = (r − |x|)/r². The left half's w = 2u is clamped to ≥ 2⁻²⁴ ([`open_unit`]), so
 /// u = 0 lands at −r(1 − 2⁻¹²) instead of on the rim −r, where the pdf is 0 (the right half
 /// never reaches r).
-#[inline]
+#[inline(always)]
 pub fn tent(u: f32, r: f32) -> f32 {
     // Both halves as one computation with selects instead of a branch: the pixel filter draws
     // u uniformly, so a branch on u < 0.5 mispredicts half the time. Same values bit for bit:
