@@ -52,7 +52,7 @@ def test_thread_count_does_not_change_the_image(cornell):
     [
         ("strategy", "bsdf, light-area, light-solid-angle, mis"),
         ("pattern", "fixed, random, grid, stratified, lhs, sobol"),
-        ("light_selection", "uniform, power, spatial, adaptive, wald, bvh, exhaustive"),
+        ("light_selection", "uniform, power, spatial, adaptive, online, wald, bvh, exhaustive"),
         ("mis", "power or balance"),
         ("integrator", "direct"),
         ("mis_light", "solid-angle, area"),
