@@ -120,39 +120,56 @@ impl Dielectric {
         (f, d.pdf(wo, wm) * dwm_dwi * t)
     }
 
+    /// Smooth interface: the event `uc` picks, reflection with probability R (Fresnel) and
+    /// refraction otherwise (`None` where refraction has no direction).
+    #[inline]
+    pub(super) fn smooth_event(&self, wo: Vec3, uc: f32) -> Option<SmoothEvent> {
+        let eta = self.eta_rel();
+        if uc < fr_dielectric(wo.z, eta) {
+            return Some(SmoothEvent::Reflect(reflect_z(wo)));
+        }
+        Some(SmoothEvent::Refract {
+            wi: refract_z(wo, eta)?,
+            eta,
+        })
+    }
+
     /// Smooth interface: the delta reflection or refraction chosen by Fresnel.
     fn sample_smooth(&self, wo: Vec3, uc: f32) -> Option<BsdfSample> {
-        let eta = self.eta_rel();
-        let r = fr_dielectric(wo.z, eta);
         // Choosing the event with probability R (resp. T) makes the weight f·|cos|/pdf equal to 1
         // for reflection and to the radiance scaling 1/η² for refraction.
-        if uc < r {
-            let wi = reflect_z(wo);
-            return Some(BsdfSample {
-                wi,
-                f: Rgb::splat(1.0 / wi.z),
-                pdf: 1.0,
-                delta: true,
-            });
-        }
-        let wi = refract_z(wo, eta)?;
-        Some(BsdfSample {
-            wi,
+        let (wi, f) = match self.smooth_event(wo, uc)? {
+            SmoothEvent::Reflect(wi) => (wi, 1.0 / wi.z),
             // Radiance is compressed into the smaller solid angle on the dense side (pbrt's
             // TransportMode::Radiance factor 1/η²).
-            f: Rgb::splat(1.0 / (eta * eta * wi.z.abs())),
+            SmoothEvent::Refract { wi, eta } => (wi, 1.0 / (eta * eta * wi.z.abs())),
+        };
+        Some(BsdfSample {
+            wi,
+            f: Rgb::splat(f),
             pdf: 1.0,
             delta: true,
         })
     }
 }
 
+/// What a smooth dielectric interface does with a ray: its delta reflection or refraction.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum SmoothEvent {
+    /// Mirror reflection into `wi`.
+    Reflect(Vec3),
+    /// Refraction into `wi` with relative index `eta` (η_t / η_i).
+    Refract {
+        /// The refracted direction.
+        wi: Vec3,
+        /// Relative index of the interface as the ray sees it.
+        eta: f32,
+    },
+}
+
 impl Bxdf for Dielectric {
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if is_smooth(self.alpha) {
-            return Rgb::ZERO;
-        }
-        Rgb::splat(self.rough_eval(wo, wi).0)
+        self.f_pdf(wo, wi).0
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
@@ -191,10 +208,15 @@ impl Bxdf for Dielectric {
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.f_pdf(wo, wi).1
+    }
+
+    fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         if is_smooth(self.alpha) {
-            return 0.0;
+            return (Rgb::ZERO, 0.0);
         }
-        self.rough_eval(wo, wi).1
+        let (f, pdf) = self.rough_eval(wo, wi);
+        (Rgb::splat(f), pdf)
     }
 
     fn is_delta(&self) -> bool {

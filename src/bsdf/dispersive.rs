@@ -18,10 +18,9 @@
 //!
 //! A material whose index does not vary is a plain [`Dielectric`], untouched by all this.
 
-use super::dielectric::{Dielectric, refract_z};
-use super::fresnel::fr_dielectric;
+use super::dielectric::{Dielectric, SmoothEvent};
 use super::ggx::is_smooth;
-use super::{BsdfSample, Bxdf, reflect_z};
+use super::{BsdfSample, Bxdf};
 use crate::Rgb;
 use glam::{Vec2, Vec3};
 
@@ -62,38 +61,26 @@ impl DispersiveDielectric {
     /// Fresnel reflectance for wo per channel (1 under total internal reflection).
     #[inline]
     pub fn reflectance(&self, wo: Vec3) -> Rgb {
-        Rgb::from_array([0, 1, 2].map(|c| fr_dielectric(wo.z, self.channel(c).eta_rel())))
-    }
-
-    /// Rough f per channel and the mixture pdf (mean of the channels' pdfs) at (wo, wi).
-    fn rough_eval(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        let e = [0, 1, 2].map(|c| self.channel(c).rough_eval(wo, wi));
-        (
-            Rgb::new(e[0].0, e[1].0, e[2].0),
-            (e[0].1 + e[1].1 + e[2].1) / 3.0,
-        )
+        Rgb::from_array([0, 1, 2].map(|c| self.channel(c).reflectance(wo)))
     }
 
     /// Smooth interface: a channel, then its reflection or refraction (module comment).
     fn sample_smooth(&self, wo: Vec3, uc: f32) -> Option<BsdfSample> {
         let (c, u) = pick_channel(uc);
-        let r = self.reflectance(wo);
-        if u < r[c] {
-            let wi = reflect_z(wo);
-            let mean = (r.x + r.y + r.z) / 3.0;
-            return Some(BsdfSample {
-                wi,
-                f: r / (mean * wi.z),
-                pdf: 1.0,
-                delta: true,
-            });
-        }
-        let eta = self.channel(c).eta_rel();
-        let wi = refract_z(wo, eta)?;
-        let mut f = Rgb::ZERO;
-        // Channel c's refraction weight 1/η² (pbrt's radiance scaling) over the probability 1/3
-        // of having picked it; the others' light does not go this way.
-        f[c] = 3.0 / (eta * eta * wi.z.abs());
+        let (wi, f) = match self.channel(c).smooth_event(wo, u)? {
+            SmoothEvent::Reflect(wi) => {
+                let r = self.reflectance(wo);
+                let mean = (r.x + r.y + r.z) / 3.0;
+                (wi, r / (mean * wi.z))
+            }
+            SmoothEvent::Refract { wi, eta } => {
+                let mut f = Rgb::ZERO;
+                // Channel c's refraction weight 1/η² (pbrt's radiance scaling) over the
+                // probability 1/3 of having picked it; the others' light does not go this way.
+                f[c] = 3.0 / (eta * eta * wi.z.abs());
+                (wi, f)
+            }
+        };
         Some(BsdfSample {
             wi,
             f,
@@ -105,10 +92,7 @@ impl DispersiveDielectric {
 
 impl Bxdf for DispersiveDielectric {
     fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if is_smooth(self.alpha) {
-            return Rgb::ZERO;
-        }
-        self.rough_eval(wo, wi).0
+        self.f_pdf(wo, wi).0
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
@@ -120,7 +104,7 @@ impl Bxdf for DispersiveDielectric {
         }
         let (c, uc) = pick_channel(uc);
         let wi = self.channel(c).sample(wo, uc, u)?.wi;
-        let (f, pdf) = self.rough_eval(wo, wi);
+        let (f, pdf) = self.f_pdf(wo, wi);
         if pdf <= 0.0 || !pdf.is_finite() {
             return None;
         }
@@ -133,17 +117,20 @@ impl Bxdf for DispersiveDielectric {
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if is_smooth(self.alpha) {
-            return 0.0;
-        }
-        self.rough_eval(wo, wi).1
+        self.f_pdf(wo, wi).1
     }
 
+    /// Each channel's rough f (its own [`Dielectric`]) and the mixture pdf, the mean of the
+    /// channels' pdfs.
     fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         if is_smooth(self.alpha) {
             return (Rgb::ZERO, 0.0);
         }
-        self.rough_eval(wo, wi)
+        let e = [0, 1, 2].map(|c| self.channel(c).rough_eval(wo, wi));
+        (
+            Rgb::new(e[0].0, e[1].0, e[2].0),
+            (e[0].1 + e[1].1 + e[2].1) / 3.0,
+        )
     }
 
     fn is_delta(&self) -> bool {

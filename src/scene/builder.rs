@@ -279,29 +279,11 @@ impl SceneBuilder {
     }
 
     /// Add a sphere of `radius` centred at the origin of `to_world`'s object space.
-    /// `reverse_orientation` flips its normals (inward-facing emission).
+    /// `reverse_orientation` flips its normals (inward-facing emission); `alpha` is an
+    /// optional cut-out over its uv (pbrt-v4's shape `alpha`). An emissive cut-out's light is
+    /// the whole sphere (the light samples ignore the mask, as a cut-out mesh's triangle
+    /// lights do).
     pub fn add_sphere(
-        &mut self,
-        to_world: Transform,
-        radius: f32,
-        material: u32,
-        emission: Option<AreaEmission>,
-        reverse_orientation: bool,
-    ) -> anyhow::Result<()> {
-        self.add_sphere_cut_out(
-            to_world,
-            radius,
-            material,
-            emission,
-            reverse_orientation,
-            None,
-        )
-    }
-
-    /// [`SceneBuilder::add_sphere`] with an alpha cut-out over its uv (pbrt-v4's shape
-    /// `alpha`). An emissive one's light is the whole sphere (the light samples ignore the
-    /// mask, as a cut-out mesh's triangle lights do).
-    pub fn add_sphere_cut_out(
         &mut self,
         to_world: Transform,
         radius: f32,
@@ -323,31 +305,10 @@ impl SceneBuilder {
         self.add_quadric(q, material, emission, alpha)
     }
 
-    /// Add a disk of `radius` in the z = `height` plane of `to_world`'s object space, normal +z.
-    pub fn add_disk(
-        &mut self,
-        to_world: Transform,
-        height: f32,
-        radius: f32,
-        material: u32,
-        emission: Option<AreaEmission>,
-        reverse_orientation: bool,
-    ) -> anyhow::Result<()> {
-        self.add_disk_cut_out(
-            to_world,
-            height,
-            radius,
-            material,
-            emission,
-            reverse_orientation,
-            None,
-        )
-    }
-
-    /// [`SceneBuilder::add_disk`] with an alpha cut-out over its uv (see
-    /// [`SceneBuilder::add_sphere_cut_out`]).
+    /// Add a disk of `radius` in the z = `height` plane of `to_world`'s object space, normal
+    /// +z, with an optional alpha cut-out over its uv (see [`SceneBuilder::add_sphere`]).
     #[allow(clippy::too_many_arguments)]
-    pub fn add_disk_cut_out(
+    pub fn add_disk(
         &mut self,
         to_world: Transform,
         height: f32,

@@ -119,7 +119,7 @@ pub fn cornell_phong(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
             n,
         });
         let c = Vec3::new(-0.62 + 0.62 * i as f32, r, 0.3);
-        b.add_sphere(Transform::translate(c), r, m, None, false)?;
+        b.add_sphere(Transform::translate(c), r, m, None, false, None)?;
     }
     for (i, (metal, alpha)) in [("Au", 0.05f32), ("Cu", 0.2), ("Al", 0.5)]
         .into_iter()
@@ -135,7 +135,7 @@ pub fn cornell_phong(_opts: &BuiltinOptions) -> anyhow::Result<Scene> {
         });
         // Floating above the front row so the camera sees both rows.
         let c = Vec3::new(-0.62 + 0.62 * i as f32, 1.0, -0.35);
-        b.add_sphere(Transform::translate(c), r, m, None, false)?;
+        b.add_sphere(Transform::translate(c), r, m, None, false, None)?;
     }
     b.build(cornell_camera(), cornell_film())
 }

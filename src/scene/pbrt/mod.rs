@@ -126,7 +126,7 @@ impl PbrtScene {
                             }
                         })
                 }
-                ShapeGeom::Sphere { to_world, radius } => b.add_sphere_cut_out(
+                ShapeGeom::Sphere { to_world, radius } => b.add_sphere(
                     to_world,
                     radius,
                     s.material,
@@ -138,7 +138,7 @@ impl PbrtScene {
                     to_world,
                     height,
                     radius,
-                } => b.add_disk_cut_out(
+                } => b.add_disk(
                     to_world,
                     height,
                     radius,
