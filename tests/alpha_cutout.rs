@@ -5,16 +5,17 @@
 //! kept hits carry the hit record of the same quad without a mask; and through the pbrt
 //! loader a direct-lighting render under a cut-out roof is 1 − c of the unshadowed one.
 
+mod geometry_support;
 mod render_support;
 
+use geometry_support::agreed_hits;
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::interaction::NO_LIGHT;
 use penumbra::geometry::{
-    Alpha, AlphaTexture, Backend, Geometry, MeshShading, PACKET, PrimKind, Primitive, Ray, RayQuery,
+    Alpha, AlphaTexture, Backend, Geometry, MeshShading, PrimKind, Primitive, Ray, RayQuery,
 };
-use penumbra::integrator::{RenderOptions, render};
 use penumbra::sampling::{PatternKind, make_pattern};
-use render_support::{assert_fraction, mean_se, pbrt_scene_in};
+use render_support::{assert_fraction, check_fraction, roof_mean};
 use std::sync::Arc;
 
 /// The quad [-1, 1]² at height z as triangles of mesh `mesh` (uv = ((x+1)/2, (y+1)/2)).
@@ -74,69 +75,18 @@ fn light_rays(n: u32) -> Vec<Ray> {
         .collect()
 }
 
-/// Per ray: closest-hit prim and t (None for a miss), checked equal across every query and
-/// backend (any-hit ⇔ closest-hit, packets = one-ray).
+/// Per ray: closest-hit (mesh, first vertex) and t (None for a miss), checked equal across
+/// every query and backend ([`agreed_hits`]).
 fn answers(zs: &[f32], alphas: &[Option<Alpha>], rays: &[Ray]) -> Vec<Option<(u32, f32)>> {
-    let mut first: Option<Vec<Option<(u32, f32)>>> = None;
-    for backend in [Backend::Wide, Backend::Own, Backend::Obvhs] {
-        let g = quads(zs, alphas, backend);
-        // Prim ids depend on the backend's leaf order: compare (mesh, first vertex) instead.
-        let name = |id: u32| match g.primitive(id).expect("hit prim").kind {
-            PrimKind::Triangle { mesh, v } => mesh * 16 + v[1],
-            PrimKind::Quadric(_) => u32::MAX,
-        };
-        let mut got = Vec::with_capacity(rays.len());
-        for chunk in rays.chunks(PACKET) {
-            let mut pk = [chunk[0]; PACKET];
-            pk[..chunk.len()].copy_from_slice(chunk);
-            let active = (1u32 << chunk.len()) - 1;
-            let mut out = [None; PACKET];
-            g.intersect_packet(&pk, active, &mut out);
-            let blocked = g.occluded_packet(&pk, active);
-            for (i, r) in chunk.iter().enumerate() {
-                let h = g.intersect(r);
-                assert_eq!(
-                    h.is_some(),
-                    g.occluded(r),
-                    "{backend:?}: closest and any-hit disagree on {r:?}"
-                );
-                assert_eq!(
-                    blocked >> i & 1 == 1,
-                    h.is_some(),
-                    "{backend:?}: any-hit packet"
-                );
-                match (&h, &out[i]) {
-                    (Some(a), Some(b)) => assert!(
-                        a.t.to_bits() == b.t.to_bits()
-                            && a.prim == b.prim
-                            && a.uv == b.uv
-                            && a.p == b.p,
-                        "{backend:?}: packet hit {b:?} != one-ray hit {a:?}"
-                    ),
-                    (None, None) => {}
-                    _ => panic!("{backend:?}: packet {:?} vs one-ray {h:?}", out[i]),
-                }
-                got.push(h.map(|h| (name(h.prim), h.t)));
-            }
-        }
-        match &first {
-            None => first = Some(got),
-            Some(f) => assert!(f == &got, "{backend:?} differs from the wide BVH"),
-        }
-    }
-    first.expect("three backends")
-}
-
-/// Passed fraction must be `want` within 5σ of a binomial of n trials.
-fn check_fraction(what: &str, passed: usize, n: usize, want: f64) {
-    let f = passed as f64 / n as f64;
-    let sigma = (want * (1.0 - want) / n as f64).sqrt();
-    eprintln!("{what}: passed {f:.5}, expected {want:.5} ± {sigma:.5}");
-    assert!(
-        (f - want).abs() <= 5.0 * sigma,
-        "{what}: passed fraction {f} is not {want} within 5σ = {}",
-        5.0 * sigma
-    );
+    // Prim ids depend on the backend's leaf order: compare (mesh, first vertex) instead.
+    let name = |g: &Geometry, id: u32| match g.primitive(id).expect("hit prim").kind {
+        PrimKind::Triangle { mesh, v } => mesh * 16 + v[1],
+        PrimKind::Quadric(_) => u32::MAX,
+    };
+    agreed_hits(|backend| quads(zs, alphas, backend), name, rays)
+        .into_iter()
+        .map(|h| h.map(|(n, h)| (n, h.t)))
+        .collect()
 }
 
 #[test]
@@ -219,43 +169,19 @@ fn kept_hits_are_the_unmasked_quads_hits() {
     assert!(kept > 1_500 && kept < 2_500, "kept {kept} of 4000");
 }
 
-/// A diffuse ground at z = 0 seen from below a roof at z = 1 (a quad of the given alpha, or
-/// none), lit by a distant light from straight above.
-fn roof_scene(alpha: Option<f32>) -> String {
-    let roof = match alpha {
+/// A roof at z = 1 over the ground of `render_support::roof_scene`: a quad of the given alpha, or none.
+fn quad_roof(alpha: Option<f32>) -> String {
+    match alpha {
         Some(a) => format!(
             "Shape \"trianglemesh\" \"float alpha\" {a} \"integer indices\" [0 1 2 0 2 3] \
              \"point3 P\" [-20 -20 1  20 -20 1  20 20 1  -20 20 1]"
         ),
         None => String::new(),
-    };
-    format!(
-        "LookAt 0 0 0.5  0 0 0  0 1 0\n\
-         Camera \"perspective\" \"float fov\" 40\n\
-         Film \"rgb\" \"integer xresolution\" 24 \"integer yresolution\" 24 \"string filename\" \"x.exr\"\n\
-         WorldBegin\n\
-         LightSource \"distant\" \"point3 from\" [0 0 10] \"point3 to\" [0 0 0] \"rgb L\" [1 1 1]\n\
-         Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n\
-         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \
-         \"point3 P\" [-20 -20 0  20 -20 0  20 20 0  -20 20 0]\n\
-         {roof}\n"
-    )
+    }
 }
 
 fn render_mean(alpha: Option<f32>) -> (f64, f64) {
-    let (scene, warnings) = pbrt_scene_in(&roof_scene(alpha), std::path::Path::new("."));
-    assert!(
-        !warnings.iter().any(|w| w.contains("alpha")),
-        "alpha warned about: {warnings:?}"
-    );
-    let opts = RenderOptions {
-        spp: 16,
-        seed: 5,
-        progress: false,
-        ..RenderOptions::default()
-    };
-    let (img, _) = render(&scene, UVec2::new(24, 24), &opts).unwrap();
-    mean_se(&img)
+    roof_mean(&quad_roof(alpha))
 }
 
 #[test]

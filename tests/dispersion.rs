@@ -5,14 +5,16 @@
 //! (f and pdf per channel, pdf the mean, ∫pdf = the kept fraction) and a prism that spreads a
 //! white source into red and blue images at the pixels Snell's law puts them.
 
+mod furnace_support;
 mod render_support;
 
+use furnace_support::Rng;
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::Rgb;
 use penumbra::bsdf::{Bsdf, Bxdf, Dielectric, DispersiveDielectric};
 use penumbra::integrator::{IntegratorKind, RenderOptions, render};
 use penumbra::material::Material;
-use render_support::pbrt_scene_in;
+use render_support::{mean_se_channel, pbrt_scene_in};
 use std::path::Path;
 
 /// Roughly glass-F11's spread, exaggerated a little so that channels differ clearly.
@@ -28,18 +30,6 @@ fn smooth(entering: bool) -> DispersiveDielectric {
         eta: ETA,
         alpha: Vec2::ZERO,
         entering,
-    }
-}
-
-/// A tiny PCG for Monte Carlo loops.
-struct Rng(u64);
-impl Rng {
-    fn f(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 40) as f32 / (1u64 << 24) as f32).min(0.999_999_9)
     }
 }
 
@@ -348,10 +338,7 @@ Shape "sphere" "float radius" [ 1.2 ]
     let (img, stats) = render(&scene, UVec2::new(24, 24), &render_opts(64, 40)).unwrap();
     assert_eq!(stats.non_finite, 0);
     for c in 0..3 {
-        let px: Vec<f64> = img.pixels.iter().map(|p| p[c] as f64).collect();
-        let n = px.len() as f64;
-        let mean = px.iter().sum::<f64>() / n;
-        let se = (px.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        let (mean, se) = mean_se_channel(&img, c);
         eprintln!("furnace channel {c}: {mean:.5} ± {se:.1e}");
         assert!(se > 0.0 && se < 0.02, "σ {se}");
         assert!(

@@ -132,6 +132,7 @@ fn sphere_light_irradiance_is_pi_l_sin2_alpha_for_every_strategy_and_pattern() {
             m,
             Some(emission),
             false,
+            None,
         )
         .unwrap();
     });

@@ -5,13 +5,16 @@
 //! the Cornell box converges to Mitsuba's `path` reference with less error per pixel than
 //! filter importance sampling at the same samples.
 
+mod render_support;
+
 use glam::UVec2;
 use penumbra::image::Image;
 use penumbra::image::io::read_image;
 use penumbra::integrator::{IntegratorKind, RenderOptions, render};
 use penumbra::scene::Scene;
 use penumbra::scene::load::{LoadOptions, load};
-use std::path::{Path, PathBuf};
+use render_support::{pbrt_scene, rel_mse};
+use std::path::PathBuf;
 
 /// A closed black cube emitting radiance 1 everywhere, seen from inside: every camera ray
 /// finds exactly 1, whatever its pixel position.
@@ -25,10 +28,7 @@ Material "diffuse" "rgb reflectance" [0 0 0]
 Shape "trianglemesh" "point3 P" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1]
   "integer indices" [0 1 2 0 2 3  4 6 5 4 7 6  0 4 5 0 5 1  3 2 6 3 6 7  0 3 7 0 7 4  1 5 6 1 6 2]
 "#;
-    let parsed = penumbra::scene::pbrt::parse_pbrt_str("cube.pbrt", src, Path::new("."))
-        .expect("cube scene parses");
-    let (b, cam, film, _) = parsed.into_builder().expect("cube scene converts");
-    b.build(cam, film).expect("cube scene builds")
+    pbrt_scene(src)
 }
 
 fn splat_path(spp: u32, depth: u32) -> RenderOptions {
@@ -80,18 +80,6 @@ fn splatted_images_do_not_depend_on_the_thread_count() {
             "{threads} threads differ from 1"
         );
     }
-}
-
-fn rel_mse(a: &Image, b: &Image) -> f64 {
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    let mut s = 0.0f64;
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        for c in 0..3 {
-            let (x, y) = (p[c] as f64, q[c] as f64);
-            s += (x - y) * (x - y) / (y * y + 0.01);
-        }
-    }
-    s / (3.0 * a.pixels.len() as f64)
 }
 
 /// The Cornell box's path-traced image at 512², 64 spp against Mitsuba's 4096-spp `path`

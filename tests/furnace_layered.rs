@@ -21,6 +21,9 @@
 //! defaults t = 0.01, D = 10, where this gives a darker material than Tungsten's plastic; these
 //! tests show that `Layered` is pbrt-v4's definition (see docs/path-tracing.md).
 
+mod furnace_support;
+
+use furnace_support::Rng;
 use glam::{Vec2, Vec3};
 use penumbra::Rgb;
 use penumbra::bsdf::layered::{Base, Coat};
@@ -102,18 +105,6 @@ fn layered(r: f32, alpha: f32, thickness: f32, max_depth: u32) -> Layered {
             ..LayerParams::default()
         },
     )
-}
-
-/// A small PCG-style generator for the test's own draws.
-struct Rng(u64);
-impl Rng {
-    fn f(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 40) as f32 / (1u64 << 24) as f32).min(0.999_999_9)
-    }
 }
 
 fn wo_at(mu: f64) -> Vec3 {

@@ -76,7 +76,7 @@ fn triangle_hit_miss_edges_and_grazing() {
 fn one_sphere(t: Transform, r: f32) -> Scene {
     let mut b = SceneBuilder::new();
     let m = grey(&mut b);
-    b.add_sphere(t, r, m, None, false).unwrap();
+    b.add_sphere(t, r, m, None, false, None).unwrap();
     b.build(cam(), film()).unwrap()
 }
 
@@ -126,7 +126,7 @@ fn spheres_and_disks_under_transforms() {
     let mut b = SceneBuilder::new();
     let m = grey(&mut b);
     let rot = Transform::new(Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2)).unwrap();
-    b.add_disk(rot, 2.0, 1.0, m, None, false).unwrap();
+    b.add_disk(rot, 2.0, 1.0, m, None, false, None).unwrap();
     let s = b.build(cam(), film()).unwrap();
     // Rotating +z by 90° about x gives −y: the disk lies in y = −2 with normal −y.
     let h = s

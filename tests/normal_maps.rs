@@ -4,55 +4,29 @@
 //! tilt must render as a plane of that normal under a distant light: ρ/π · E · cos θ′; a
 //! flat map changes nothing bit for bit; bad maps are errors at their line.
 
+mod texture_support;
+
 use glam::{UVec2, Vec3};
 use penumbra::Rgb;
 use penumbra::image::Image;
 use penumbra::image::io::{srgb_to_linear, write_image};
-use penumbra::integrator::{RenderOptions, render};
 use penumbra::scene::pbrt::parse_pbrt_str;
-use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::Path;
+use texture_support::{MAT, analytic, constant_image, lit_header, render_lit, tmpdir};
 
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("penumbra-nmap-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+/// Height of the camera over the square.
+const EYE_Z: f32 = 2.0;
 
-/// Direction the distant light comes from (not along either axis, so tilts toward u and v
-/// and their signs all change the cosine differently).
-const FROM: [f32; 3] = [0.3, 0.5, 1.0];
-/// Irradiance of the distant light on a surface facing it.
-const E: f64 = 2.0;
-/// Diffuse reflectance.
-const RHO: f64 = 0.6;
-
-/// The unit square z = 0 seen straight down by a 32×16 orthographic camera (every pixel sees
-/// it), under the distant light, with material line `mat`. `uv` gives the vertices' texture
-/// coordinates; `normals` an optional `"normal N"` parameter.
+/// The unit square z = 0 seen straight down by the lit view (every pixel sees it), with
+/// material line `mat`. `uv` gives the vertices' texture coordinates; `normals` an optional
+/// `"normal N"` parameter.
 fn render_square(dir: &Path, textures: &str, mat: &str, uv: &str, normals: &str) -> Image {
-    let src = format!(
-        "LookAt 0.5 0.5 2  0.5 0.5 0  0 1 0\nCamera \"orthographic\" \"float screenwindow\" [-0.5 0.5 -0.25 0.25]\n\
-         PixelFilter \"box\"\nFilm \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 16\n\
-         WorldBegin\nLightSource \"distant\" \"point3 from\" [{} {} {}] \"point3 to\" [0 0 0] \"rgb L\" [1 1 1] \"float scale\" {E}\n\
-         {textures}\n{mat}\n\
+    let body = format!(
+        "{textures}\n{mat}\n\
          Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 1 1 0 0 1 0] \"point2 uv\" [{uv}] {normals} \
-         \"integer indices\" [0 1 2 0 2 3]\n",
-        FROM[0], FROM[1], FROM[2]
+         \"integer indices\" [0 1 2 0 2 3]"
     );
-    let s = parse_pbrt_str("t.pbrt", &src, dir).unwrap_or_else(|e| panic!("{e:#}"));
-    assert!(
-        s.warnings.iter().all(|w| !w.contains("ignored")),
-        "{:?}",
-        s.warnings
-    );
-    let (b, cam, film, _) = s.into_builder().unwrap();
-    let scene = b.build(cam, film).unwrap();
-    let opts = RenderOptions {
-        spp: 16,
-        ..Default::default()
-    };
-    render(&scene, UVec2::new(32, 16), &opts).unwrap().0
+    render_lit(dir, EYE_Z, &body, &["ignored"])
 }
 
 /// Texture coordinates u = x, v = y.
@@ -72,34 +46,18 @@ fn mean_sigma(img: &Image, x0: usize, x1: usize) -> (f64, f64) {
     (m, (var / n).sqrt())
 }
 
-/// ρ/π · E · max(0, n·l) for world normal `n`.
-fn analytic(n: Vec3) -> f64 {
-    let l = Vec3::from(FROM).normalize();
-    RHO / PI * E * (n.normalize().dot(l).max(0.0) as f64)
-}
-
 /// The render's mean is the analytic value within 5σ. A delta light on a Lambertian plane
 /// has no variance (σ is rounding, ~1e-8), so the bound has a floor of 2e-5 relative: the
 /// f32 arithmetic of the frame and of the finite differences.
 fn assert_analytic(what: &str, img: &Image, x0: usize, x1: usize, n: Vec3) {
     let (m, s) = mean_sigma(img, x0, x1);
-    let want = analytic(n);
+    let want = analytic(n.as_dvec3());
     let bound = (5.0 * s).max(2e-5 * want);
     assert!(
         (m - want).abs() <= bound,
         "{what}: {m} vs analytic {want} (σ {s}, bound {bound})"
     );
 }
-
-/// A 4×4 image of one colour (as linear values; for PNG the sRGB-encoded code values are
-/// what is stored).
-fn constant_image(path: &Path, c: Rgb) {
-    let mut img = Image::new(4, 4);
-    img.pixels.fill(c);
-    write_image(&img, path, 0.0).unwrap();
-}
-
-const MAT: &str = "\"rgb reflectance\" [0.6 0.6 0.6]";
 
 #[test]
 fn constant_tilt_normal_map_renders_as_the_tilted_normal() {
@@ -248,7 +206,7 @@ fn bump_map_of_a_linear_ramp_renders_as_the_tilted_normal() {
         assert_analytic(what, &img, 1, 31, n);
         let (m, _) = mean_sigma(&img, 1, 31);
         assert!(
-            (m - analytic(Vec3::Z)).abs() > 0.02 * m,
+            (m - analytic(Vec3::Z.as_dvec3())).abs() > 0.02 * m,
             "{what}: {m} looks flat"
         );
     }
@@ -308,13 +266,7 @@ fn bad_normal_maps_are_errors_at_their_line() {
 /// The (u, v) each pixel centre of `render_square`'s 32×16 view sees (UV layout), found by
 /// projecting a fine grid of points of the square.
 fn pixel_uvs(dir: &Path) -> Vec<glam::Vec2> {
-    let s = parse_pbrt_str(
-        "t.pbrt",
-        "LookAt 0.5 0.5 2  0.5 0.5 0  0 1 0\nCamera \"orthographic\" \"float screenwindow\" [-0.5 0.5 -0.25 0.25]\n\
-         Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 16\nWorldBegin\n",
-        dir,
-    )
-    .unwrap();
+    let s = parse_pbrt_str("t.pbrt", &lit_header(EYE_Z), dir).unwrap();
     let res = UVec2::new(32, 16);
     let mut best = vec![(f32::INFINITY, glam::Vec2::ZERO); 32 * 16];
     for i in 0..=400 {
@@ -374,7 +326,7 @@ fn normal_map_texels_land_where_their_uv_is() {
             continue;
         }
         let (u_hi, v_hi) = (uv.x > 0.5, uv.y > 0.5);
-        let want = analytic(quadrant(u_hi, v_hi));
+        let want = analytic(quadrant(u_hi, v_hi).as_dvec3());
         let got = r.pixels[k].x as f64;
         assert!(
             (got - want).abs() <= 2e-5 * want,

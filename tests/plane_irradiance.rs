@@ -370,7 +370,8 @@ fn build(c: &Case) -> Built {
                 c.center.extend(1.0),
             );
             let t = Transform::new(m).unwrap();
-            b.add_disk(t, 0.0, 0.5 * s, receiver, None, false).unwrap();
+            b.add_disk(t, 0.0, 0.5 * s, receiver, None, false, None)
+                .unwrap();
         }
         Receiver::Sphere => {
             b.add_sphere(
@@ -379,6 +380,7 @@ fn build(c: &Case) -> Built {
                 receiver,
                 None,
                 false,
+                None,
             )
             .unwrap();
         }
@@ -478,7 +480,7 @@ fn build(c: &Case) -> Built {
         LightKind::SphereArea => {
             let r = dist * (0.2f32).min(0.5 * sin_e);
             let le = 10.0 * (dist * dist) / (std::f32::consts::PI * r * r);
-            b.add_sphere(Transform::translate(p_light), r, black, emission(le), false)
+            b.add_sphere(Transform::translate(p_light), r, black, emission(le), false, None)
                 .unwrap();
             Exact::Sphere {
                 c: dv(p_light),

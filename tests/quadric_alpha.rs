@@ -7,19 +7,20 @@
 //! agrees ray by ray; kept hits are the unmasked shape's hit records bit for bit; and through
 //! the pbrt loader a cut-out disk or sphere over a ground passes 1 − c of the sun, unwarned.
 
+mod geometry_support;
 mod render_support;
 
+use geometry_support::agreed_hits;
 use glam::{Mat4, UVec2, Vec2, Vec3};
 use penumbra::geometry::curve::{CurveSegment, CurveType};
 use penumbra::geometry::interaction::NO_LIGHT;
 use penumbra::geometry::quadric::CutOut;
 use penumbra::geometry::{
-    Alpha, AlphaTexture, Backend, Geometry, PACKET, PrimKind, Primitive, Quadric, QuadricKind, Ray,
-    RayQuery, SurfaceHit, Transform,
+    Alpha, AlphaTexture, Backend, Geometry, PrimKind, Primitive, Quadric, QuadricKind, Ray,
+    SurfaceHit, Transform,
 };
-use penumbra::integrator::{RenderOptions, render};
 use penumbra::sampling::{PatternKind, make_pattern};
-use render_support::{assert_fraction, mean_se, pbrt_scene_in};
+use render_support::{assert_fraction, check_fraction, roof_mean};
 use std::f32::consts::PI;
 use std::sync::Arc;
 
@@ -47,71 +48,13 @@ fn quadric(kind: QuadricKind, to_world: Transform, alpha: Option<Alpha>, key: u6
 }
 
 /// Per ray: the closest hit (quadric index and record), checked equal across every query and
-/// backend (any-hit ⇔ closest-hit, packets = one-ray).
+/// backend ([`agreed_hits`]).
 fn answers(qs: &[Quadric], rays: &[Ray]) -> Vec<Option<(u32, SurfaceHit)>> {
-    let mut first: Option<Vec<Option<(u32, SurfaceHit)>>> = None;
-    for backend in [Backend::Wide, Backend::Own, Backend::Obvhs] {
-        let g = geometry(qs, backend);
-        let name = |id: u32| match g.primitive(id).expect("hit prim").kind {
-            PrimKind::Quadric(q) => q,
-            PrimKind::Triangle { .. } => u32::MAX,
-        };
-        let mut got = Vec::with_capacity(rays.len());
-        for chunk in rays.chunks(PACKET) {
-            let mut pk = [chunk[0]; PACKET];
-            pk[..chunk.len()].copy_from_slice(chunk);
-            let active = (1u32 << chunk.len()) - 1;
-            let mut out = [None; PACKET];
-            g.intersect_packet(&pk, active, &mut out);
-            let blocked = g.occluded_packet(&pk, active);
-            for (i, r) in chunk.iter().enumerate() {
-                let h = g.intersect(r);
-                assert_eq!(
-                    h.is_some(),
-                    g.occluded(r),
-                    "{backend:?}: closest and any-hit disagree on {r:?}"
-                );
-                assert_eq!(
-                    blocked >> i & 1 == 1,
-                    h.is_some(),
-                    "{backend:?}: any-hit packet"
-                );
-                match (&h, &out[i]) {
-                    (Some(a), Some(b)) => assert!(
-                        a.t.to_bits() == b.t.to_bits() && a.prim == b.prim && a.uv == b.uv,
-                        "{backend:?}: packet hit {b:?} != one-ray hit {a:?}"
-                    ),
-                    (None, None) => {}
-                    _ => panic!("{backend:?}: packet {:?} vs one-ray {h:?}", out[i]),
-                }
-                got.push(h.map(|h| (name(h.prim), h)));
-            }
-        }
-        match &first {
-            None => first = Some(got),
-            Some(f) => {
-                let same = f.iter().zip(&got).all(|(a, b)| match (a, b) {
-                    (Some((qa, a)), Some((qb, b))) => qa == qb && a.t.to_bits() == b.t.to_bits(),
-                    (None, None) => true,
-                    _ => false,
-                });
-                assert!(same, "{backend:?} differs from the wide BVH");
-            }
-        }
-    }
-    first.expect("three backends")
-}
-
-/// Passed fraction must be `want` within 5σ of a binomial of n trials.
-fn check_fraction(what: &str, passed: usize, n: usize, want: f64) {
-    let f = passed as f64 / n as f64;
-    let sigma = (want * (1.0 - want) / n as f64).sqrt();
-    eprintln!("{what}: passed {f:.5}, expected {want:.5} ± {sigma:.5}");
-    assert!(
-        (f - want).abs() <= 5.0 * sigma,
-        "{what}: passed fraction {f} is not {want} within 5σ = {}",
-        5.0 * sigma
-    );
+    let name = |g: &Geometry, id: u32| match g.primitive(id).expect("hit prim").kind {
+        PrimKind::Quadric(q) => q,
+        PrimKind::Triangle { .. } => u32::MAX,
+    };
+    agreed_hits(|backend| geometry(qs, backend), name, rays)
 }
 
 /// `n` parallel rays along `d` (slightly tilted from +z) from z = −5, uniform over the square
@@ -358,41 +301,9 @@ fn texture_alpha_cuts_exactly_where_it_is_zero() {
     }
 }
 
-/// A diffuse ground at z = 0 seen from above by a camera under a cut-out `roof` shape (or
-/// none), lit by a distant light from straight above.
-fn roof_scene(roof: &str) -> String {
-    format!(
-        "LookAt 0 0 0.5  0 0 0  0 1 0\n\
-         Camera \"perspective\" \"float fov\" 40\n\
-         Film \"rgb\" \"integer xresolution\" 24 \"integer yresolution\" 24 \"string filename\" \"x.exr\"\n\
-         WorldBegin\n\
-         LightSource \"distant\" \"point3 from\" [0 0 10] \"point3 to\" [0 0 0] \"rgb L\" [1 1 1]\n\
-         Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n\
-         Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \
-         \"point3 P\" [-20 -20 0  20 -20 0  20 20 0  -20 20 0]\n\
-         {roof}\n"
-    )
-}
-
-fn render_mean(roof: &str) -> (f64, f64) {
-    let (scene, warnings) = pbrt_scene_in(&roof_scene(roof), std::path::Path::new("."));
-    assert!(
-        !warnings.iter().any(|w| w.contains("alpha")),
-        "alpha warned about: {warnings:?}"
-    );
-    let opts = RenderOptions {
-        spp: 16,
-        seed: 5,
-        progress: false,
-        ..RenderOptions::default()
-    };
-    let (img, _) = render(&scene, UVec2::new(24, 24), &opts).unwrap();
-    mean_se(&img)
-}
-
 #[test]
 fn pbrt_cut_out_quadric_roofs_pass_one_minus_coverage_of_the_sun() {
-    let open = render_mean("");
+    let open = roof_mean("");
     let c = 0.35;
     // A disk over the ground, and a sphere around the whole view (the shadow rays cross its
     // wall once, from inside).
@@ -408,14 +319,14 @@ fn pbrt_cut_out_quadric_roofs_pass_one_minus_coverage_of_the_sun() {
             format!("Shape \"sphere\" \"float radius\" 30 \"float alpha\" {c}"),
         ),
     ] {
-        let under = render_mean(&shape);
+        let under = roof_mean(&shape);
         assert_fraction(
             &format!("{what} roof of coverage {c}"),
             under,
             open,
             1.0 - c,
         );
-        let (shut, _) = render_mean(&shape.replace(&format!("{c}"), "1"));
+        let (shut, _) = roof_mean(&shape.replace(&format!("{c}"), "1"));
         assert!(
             shut < 1e-6 * open.0,
             "{what}: opaque roof lets {shut} through"

@@ -7,67 +7,31 @@
 //! map, (0.5, 0.5, 1), changes nothing bit for bit; and the derivatives themselves are
 //! the finite differences of each shape's parameterisation.
 
-use glam::{DVec3, Mat4, UVec2, Vec2, Vec3};
+mod texture_support;
+
+use glam::{DVec3, Mat4, Vec2, Vec3};
 use penumbra::Rgb;
 use penumbra::geometry::curve::{CurveSegment, CurveType};
 use penumbra::geometry::{Quadric, QuadricKind, Transform};
 use penumbra::image::Image;
 use penumbra::image::io::write_image;
-use penumbra::integrator::{RenderOptions, render};
 use penumbra::scene::pbrt::parse_pbrt_str;
 use std::f32::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::Path;
+use texture_support::{MAT, RES, analytic, constant_image, lit_header, render_lit, tmpdir};
 
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("penumbra-qmap-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+/// Height of the camera over the plane z = 0 (a sphere reaches above it).
+const EYE_Z: f32 = 4.0;
 
-/// Direction the distant light comes from (off every axis).
-const FROM: [f32; 3] = [0.3, 0.5, 1.0];
-/// Irradiance of the distant light on a surface facing it.
-const E: f64 = 2.0;
-/// Diffuse reflectance.
-const RHO: f64 = 0.6;
-const MAT: &str = "\"rgb reflectance\" [0.6 0.6 0.6]";
-const RES: UVec2 = UVec2::new(32, 16);
-
-/// The camera and light of every test: the rectangle x ∈ [0, 1], y ∈ [0.25, 0.75] seen
-/// straight down by a 32×16 orthographic camera.
-fn header() -> String {
-    format!(
-        "LookAt 0.5 0.5 4  0.5 0.5 0  0 1 0\nCamera \"orthographic\" \"float screenwindow\" [-0.5 0.5 -0.25 0.25]\n\
-         PixelFilter \"box\"\nFilm \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 16\n\
-         WorldBegin\nLightSource \"distant\" \"point3 from\" [{} {} {}] \"point3 to\" [0 0 0] \"rgb L\" [1 1 1] \"float scale\" {E}\n",
-        FROM[0], FROM[1], FROM[2]
-    )
-}
-
-/// Render `body` (materials and shapes) under [`header`]; no warning may mention a map.
+/// Render `body` (materials and shapes) in the lit view; no warning may mention a map.
 fn render_body(dir: &Path, body: &str) -> Image {
-    let src = format!("{}{body}\n", header());
-    let s = parse_pbrt_str("t.pbrt", &src, dir).unwrap_or_else(|e| panic!("{e:#}"));
-    assert!(
-        s.warnings
-            .iter()
-            .all(|w| !w.contains("normal") && !w.contains("bump") && !w.contains("ignored")),
-        "{:?}",
-        s.warnings
-    );
-    let (b, cam, film, _) = s.into_builder().unwrap();
-    let scene = b.build(cam, film).unwrap();
-    let opts = RenderOptions {
-        spp: 16,
-        ..Default::default()
-    };
-    render(&scene, RES, &opts).unwrap().0
+    render_lit(dir, EYE_Z, body, &["normal", "bump", "ignored"])
 }
 
 /// World (x, y) of each pixel centre on the plane z = 0 (the orthographic view is affine:
 /// inverted from the projections of three points).
 fn pixel_points(dir: &Path) -> Vec<Vec2> {
-    let s = parse_pbrt_str("t.pbrt", &header(), dir).unwrap();
+    let s = parse_pbrt_str("t.pbrt", &lit_header(EYE_Z), dir).unwrap();
     let pr = |p: Vec3| s.camera.project(p, RES).expect("in view");
     let (o, ex, ey) = (pr(Vec3::ZERO), pr(Vec3::X), pr(Vec3::Y));
     let m = glam::Mat2::from_cols(ex - o, ey - o).inverse();
@@ -75,19 +39,6 @@ fn pixel_points(dir: &Path) -> Vec<Vec2> {
         .flat_map(|j| (0..RES.x).map(move |i| Vec2::new(i as f32 + 0.5, j as f32 + 0.5)))
         .map(|c| m * (c - o))
         .collect()
-}
-
-/// ρ/π · E · max(0, n·l) for world normal `n`.
-fn analytic(n: DVec3) -> f64 {
-    let l = Vec3::from(FROM).normalize().as_dvec3();
-    RHO / std::f64::consts::PI * E * n.normalize().dot(l).max(0.0)
-}
-
-/// A 4×4 image of one colour.
-fn constant_image(path: &Path, c: Rgb) {
-    let mut img = Image::new(4, 4);
-    img.pixels.fill(c);
-    write_image(&img, path, 0.0).unwrap();
 }
 
 /// The tangent-space normal tilted by `a` from +z toward azimuth `b` in the frame.
@@ -116,41 +67,67 @@ fn rel_errors(got: &Image, want: &[f64], keep: &[bool]) -> (f64, f64, usize) {
     (max, sum / n.max(1) as f64, n)
 }
 
+/// Render `shape` under a constant normal map of each tangent-space normal of `tilts` and
+/// check every pixel against the analytic shading of that normal in the frame [x, y, n] that
+/// `frame` gives at the pixel's point of the plane z = 0 (relative errors: max below
+/// `max_bound`, signed mean below `mean_bound`); the images, in the order of `tilts`.
+fn assert_tilts_in_frame(
+    what: &str,
+    d: &Path,
+    shape: &str,
+    tilts: [Vec3; 3],
+    frame: impl Fn(Vec2) -> [DVec3; 3],
+    (max_bound, mean_bound): (f64, f64),
+) -> Vec<Image> {
+    let pts = pixel_points(d);
+    let mut images = Vec::new();
+    for (i, local) in tilts.into_iter().enumerate() {
+        let file = format!("{what}{i}.exr");
+        tilt_map(d, &file, local);
+        let img = render_body(
+            d,
+            &format!("Material \"diffuse\" {MAT} \"string normalmap\" \"{file}\"\n{shape}"),
+        );
+        let l = local.as_dvec3();
+        let want: Vec<f64> = pts
+            .iter()
+            .map(|&p| {
+                let [x, y, n] = frame(p);
+                analytic(x * l.x + y * l.y + n * l.z)
+            })
+            .collect();
+        let (max, mean, n) = rel_errors(&img, &want, &vec![true; want.len()]);
+        eprintln!("{what} tilt {local}: max {max:.2e}, mean {mean:.2e} over {n} pixels");
+        assert!(
+            max < max_bound && mean.abs() < mean_bound,
+            "{what} {local}: {max} {mean}"
+        );
+        images.push(img);
+    }
+    images
+}
+
 #[test]
 fn disk_normal_map_tilts_in_the_disks_own_frame() {
     // A disk centred at (−1.5, −1.5) covering the view: the view sees φ ∈ [0.5, 1.1], where
     // ∂p/∂u = φmax (−y, x, 0) is the tangent and y = n × x points to the centre (∂p/∂v
     // runs inward: v = 1 − r/R).
     let d = tmpdir("disk");
-    let pts = pixel_points(&d);
     let shape =
         "AttributeBegin Translate -1.5 -1.5 0 Shape \"disk\" \"float radius\" 10 AttributeEnd";
-    for (i, local) in [tilt(0.4, 0.0), tilt(0.35, 1.9), tilt(0.5, -2.4)]
-        .into_iter()
-        .enumerate()
+    let frame = |p: Vec2| {
+        let q = (p + Vec2::splat(1.5)).as_dvec2();
+        let phi = q.y.atan2(q.x);
+        let x = DVec3::new(-phi.sin(), phi.cos(), 0.0);
+        [x, DVec3::Z.cross(x), DVec3::Z]
+    };
+    // The box filter averages the cosine over each pixel (φ turns 0.01 across one): a
+    // second-order difference from its centre's value.
+    let tilts = [tilt(0.4, 0.0), tilt(0.35, 1.9), tilt(0.5, -2.4)];
+    for (img, local) in assert_tilts_in_frame("disk", &d, shape, tilts, frame, (1e-3, 2e-4))
+        .iter()
+        .zip(tilts)
     {
-        let file = format!("t{i}.exr");
-        tilt_map(&d, &file, local);
-        let img = render_body(
-            &d,
-            &format!("Material \"diffuse\" {MAT} \"string normalmap\" \"{file}\"\n{shape}"),
-        );
-        let want: Vec<f64> = pts
-            .iter()
-            .map(|p| {
-                let q = (*p + Vec2::splat(1.5)).as_dvec2();
-                let phi = q.y.atan2(q.x);
-                let x = DVec3::new(-phi.sin(), phi.cos(), 0.0);
-                let y = DVec3::Z.cross(x);
-                let l = local.as_dvec3();
-                analytic(x * l.x + y * l.y + DVec3::Z * l.z)
-            })
-            .collect();
-        // The box filter averages the cosine over each pixel (φ turns 0.01 across one): a
-        // second-order difference from its centre's value.
-        let (max, mean, n) = rel_errors(&img, &want, &vec![true; want.len()]);
-        eprintln!("disk tilt {local}: max {max:.2e}, mean {mean:.2e} over {n} pixels");
-        assert!(max < 1e-3 && mean.abs() < 2e-4, "{local}: {max} {mean}");
         // The frame turns across the view: the image is not one value.
         let (lo, hi) = img
             .pixels
@@ -194,6 +171,24 @@ fn disk_sector_mesh(nphi: usize) -> String {
     )
 }
 
+/// `shape` and `mesh` rendered with the material line `mat`: the relative differences of the
+/// shape's image from the mesh's over the pixels `keep` selects (max, signed mean, count), and
+/// the largest from the mesh rendered without the map (what the map changes).
+fn against_mesh(
+    d: &Path,
+    mat: &str,
+    shape: &str,
+    mesh: &str,
+    keep: &[bool],
+) -> ((f64, f64, usize), f64) {
+    let got = render_body(d, &format!("{mat}\n{shape}"));
+    let mapped = render_body(d, &format!("{mat}\n{mesh}"));
+    let plain = render_body(d, &format!("Material \"diffuse\" {MAT}\n{mesh}"));
+    let red = |img: &Image| -> Vec<f64> { img.pixels.iter().map(|p| p.x as f64).collect() };
+    let errors = rel_errors(&got, &red(&mapped), keep);
+    (errors, rel_errors(&got, &red(&plain), keep).0)
+}
+
 #[test]
 fn disk_normal_map_shades_as_the_same_map_on_an_equivalent_mesh() {
     // 512 φ-steps over 0.9 rad: each triangle's ∂p/∂u is its chord's, within 0.001 rad of the
@@ -202,25 +197,19 @@ fn disk_normal_map_shades_as_the_same_map_on_an_equivalent_mesh() {
     let local = tilt(0.45, 0.7);
     tilt_map(&d, "t.exr", local);
     let mat = format!("Material \"diffuse\" {MAT} \"string normalmap\" \"t.exr\"");
-    let disk = render_body(
+    let disk =
+        "AttributeBegin Translate -1.5 -1.5 0 Shape \"disk\" \"float radius\" 10 AttributeEnd";
+    let ((max, mean, n), unmapped) = against_mesh(
         &d,
-        &format!(
-            "{mat}\nAttributeBegin Translate -1.5 -1.5 0 Shape \"disk\" \"float radius\" 10 AttributeEnd"
-        ),
+        &mat,
+        disk,
+        &disk_sector_mesh(512),
+        &vec![true; want_len()],
     );
-    let mesh = render_body(&d, &format!("{mat}\n{}", disk_sector_mesh(512)));
-    let plain = render_body(
-        &d,
-        &format!("Material \"diffuse\" {MAT}\n{}", disk_sector_mesh(512)),
-    );
-    let want: Vec<f64> = mesh.pixels.iter().map(|p| p.x as f64).collect();
-    let (max, mean, n) = rel_errors(&disk, &want, &vec![true; want.len()]);
     eprintln!("disk vs mesh: max {max:.2e}, mean {mean:.2e} over {n} pixels");
     assert!(n == 512 && max < 1e-3 && mean.abs() < 2e-4, "{max} {mean}");
     // …and both differ from the unmapped surface by far more.
-    let want: Vec<f64> = plain.pixels.iter().map(|p| p.x as f64).collect();
-    let (max, _, _) = rel_errors(&disk, &want, &vec![true; want.len()]);
-    assert!(max > 0.05, "the map changes the shading: {max}");
+    assert!(unmapped > 0.05, "the map changes the shading: {unmapped}");
 }
 
 #[test]
@@ -229,36 +218,18 @@ fn sphere_normal_map_tilts_in_the_spheres_own_frame() {
     // away from its poles: x = ∂p/∂u/|∂p/∂u| = (−y, x, 0)/ρ, y = n × x (∂p/∂v's direction,
     // toward the north pole).
     let d = tmpdir("sphere");
-    let pts = pixel_points(&d);
     let c = DVec3::new(0.5, -2.5, -4.0);
     let shape =
         "AttributeBegin Translate 0.5 -2.5 -4 Shape \"sphere\" \"float radius\" 5 AttributeEnd";
-    for (i, local) in [tilt(0.4, 0.0), tilt(0.35, 1.4), tilt(0.5, 3.5)]
-        .into_iter()
-        .enumerate()
-    {
-        let file = format!("s{i}.exr");
-        tilt_map(&d, &file, local);
-        let img = render_body(
-            &d,
-            &format!("Material \"diffuse\" {MAT} \"string normalmap\" \"{file}\"\n{shape}"),
-        );
-        let want: Vec<f64> = pts
-            .iter()
-            .map(|p| {
-                let (x, y) = (p.x as f64 - c.x, p.y as f64 - c.y);
-                let q = DVec3::new(x, y, (25.0 - x * x - y * y).sqrt());
-                let n = q / 5.0;
-                let fx = DVec3::new(-q.y, q.x, 0.0).normalize();
-                let fy = n.cross(fx);
-                let l = local.as_dvec3();
-                analytic(fx * l.x + fy * l.y + n * l.z)
-            })
-            .collect();
-        let (max, mean, n) = rel_errors(&img, &want, &vec![true; want.len()]);
-        eprintln!("sphere tilt {local}: max {max:.2e}, mean {mean:.2e} over {n} pixels");
-        assert!(max < 2e-3 && mean.abs() < 3e-4, "{local}: {max} {mean}");
-    }
+    let frame = |p: Vec2| {
+        let (x, y) = (p.x as f64 - c.x, p.y as f64 - c.y);
+        let q = DVec3::new(x, y, (25.0 - x * x - y * y).sqrt());
+        let n = q / 5.0;
+        let fx = DVec3::new(-q.y, q.x, 0.0).normalize();
+        [fx, n.cross(fx), n]
+    };
+    let tilts = [tilt(0.4, 0.0), tilt(0.35, 1.4), tilt(0.5, 3.5)];
+    assert_tilts_in_frame("sphere", &d, shape, tilts, frame, (2e-3, 3e-4));
 }
 
 /// The unit square z = 0 at x, y ∈ [0, 1] as a bilinear patch or as the quad mesh of the
@@ -303,18 +274,11 @@ fn bilinear_patch_maps_shade_as_the_equivalent_quad_mesh() {
             "Texture \"h\" \"float\" \"imagemap\" \"string filename\" \"h.exr\"\nMaterial \"diffuse\" {MAT} \"texture displacement\" \"h\""
         ),
     ] {
-        let patch = render_body(&d, &format!("{mat}\n{}", square(true)));
-        let mesh = render_body(&d, &format!("{mat}\n{}", square(false)));
-        let plain = render_body(
-            &d,
-            &format!("Material \"diffuse\" {MAT}\n{}", square(false)),
-        );
         // Columns 0 and 31 see u within half a texel of the edges, where the repeat wrap
         // blends the ramp's ends (over the mesh's filter footprint, wider than the patch's
         // point lookups: quadrics have no pixel footprint).
         let inner: Vec<bool> = (0..want_len()).map(|k| !matches!(k % 32, 0 | 31)).collect();
-        let want: Vec<f64> = mesh.pixels.iter().map(|p| p.x as f64).collect();
-        let (max, mean, _) = rel_errors(&patch, &want, &inner);
+        let ((max, mean, _), unmapped) = against_mesh(&d, &mat, square(true), square(false), &inner);
         // A bump map's slope is a forward difference in f32 over the mesh's footprint step or
         // the patch's fixed 0.0005: rounding of h over the smaller step is ~1e-4 of the tilt.
         let bound = if mat.contains("displacement") {
@@ -324,9 +288,10 @@ fn bilinear_patch_maps_shade_as_the_equivalent_quad_mesh() {
         };
         eprintln!("patch vs mesh: max {max:.2e}, mean {mean:.2e}");
         assert!(max < bound, "{mat}: patch vs mesh {max} (mean {mean})");
-        let want: Vec<f64> = plain.pixels.iter().map(|p| p.x as f64).collect();
-        let (max, _, _) = rel_errors(&patch, &want, &inner);
-        assert!(max > 0.02, "{mat}: the map changes the shading: {max}");
+        assert!(
+            unmapped > 0.02,
+            "{mat}: the map changes the shading: {unmapped}"
+        );
     }
 }
 

@@ -9,22 +9,13 @@
 //! (ReverseOrientation turns it back out). The light's own samples must agree with what a ray
 //! that hits it sees.
 
+mod render_support;
+
 use glam::{Vec2, Vec3};
 use penumbra::geometry::{Ray, RayQuery};
 use penumbra::lights::{Emitter, LightSampleContext, LightSource, SamplingMode};
 use penumbra::scene::Scene;
-use penumbra::scene::pbrt::parse_pbrt_str;
-
-fn load(world: &str) -> (Scene, Vec<String>) {
-    let src = format!(
-        "LookAt 0 0 10  0 0 0  0 1 0\nCamera \"perspective\"\n\
-         Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nWorldBegin\n{world}\n"
-    );
-    let parsed = parse_pbrt_str("s.pbrt", &src, std::path::Path::new("."))
-        .unwrap_or_else(|e| panic!("{e:#}"));
-    let (b, cam, film, warnings) = parsed.into_builder().unwrap();
-    (b.build(cam, film).unwrap(), warnings)
-}
+use render_support::pbrt_world;
 
 /// pbrt-v4's render-space normal: `n_obj` through the inverse transpose of `m`, negated for
 /// ReverseOrientation XOR a handedness swap.
@@ -91,7 +82,7 @@ fn mirrored_quadric_lights_follow_pbrt_v4_orientation() {
             for reverse in [false, true] {
                 let ro = if reverse { "ReverseOrientation\n" } else { "" };
                 let what = format!("{shape} {xf:?} {ro:?}");
-                let (scene, _) = load(&format!(
+                let (scene, _) = pbrt_world(&format!(
                     "AttributeBegin\n{xf}{ro}{LIGHT}{shape}\nAttributeEnd"
                 ));
                 let want = pbrt_v4_normal(m, n_obj(m.inverse() * target), reverse);
@@ -109,7 +100,7 @@ fn mirrored_quadric_lights_follow_pbrt_v4_orientation() {
 
 #[test]
 fn two_sided_sphere_lights_emit_inside_and_out() {
-    let (scene, warnings) = load(
+    let (scene, warnings) = pbrt_world(
         "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1] \"bool twosided\" true\n\
          Shape \"sphere\" \"float radius\" 1\nAttributeEnd",
     );

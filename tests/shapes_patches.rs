@@ -9,26 +9,16 @@
 //! a bump map on a cylinder matches the normal of the displaced surface p + h·n computed by
 //! central finite differences.
 
+mod render_support;
+
 use glam::{Vec2, Vec3};
 use penumbra::geometry::{Ray, RayQuery};
 use penumbra::material::texture::ImageRgb;
 use penumbra::material::{FloatTexture, NormalPerturbation, ShadingDerivatives, TexCoord};
 use penumbra::sampling::{PatternKind, make_pattern};
-use penumbra::scene::Scene;
-use penumbra::scene::pbrt::parse_pbrt_str;
+use render_support::pbrt_world;
 use std::f32::consts::PI;
 use std::sync::Arc;
-
-fn load(world: &str) -> (Scene, Vec<String>) {
-    let src = format!(
-        "LookAt 0 0 10  0 0 0  0 1 0\nCamera \"perspective\"\n\
-         Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nWorldBegin\n{world}\n"
-    );
-    let parsed = parse_pbrt_str("s.pbrt", &src, std::path::Path::new("."))
-        .unwrap_or_else(|e| panic!("{e:#}"));
-    let (b, cam, film, warnings) = parsed.into_builder().unwrap();
-    (b.build(cam, film).unwrap(), warnings)
-}
 
 fn uniforms(n: u32, seed: u64) -> Vec<[f32; 4]> {
     let pat = make_pattern(PatternKind::Random, seed);
@@ -46,7 +36,7 @@ fn cylinder_rays_hit_their_analytic_points() {
     // Radius 0.5, z in [-1, 2], a sweep of 270°, moved and rotated: world point of object
     // point q is R·q + T (R: 30° about x), the normal R·(x, y, 0).
     let (r, zmin, zmax, phimax) = (0.5f32, -1.0f32, 2.0f32, 270f32.to_radians());
-    let (scene, warnings) = load(
+    let (scene, warnings) = pbrt_world(
         "AttributeBegin\nTranslate 0.3 -0.2 0.1\nRotate 30 1 0 0\n\
          Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" -1 \"float zmax\" 2 \"float phimax\" 270\n\
          AttributeEnd",
@@ -141,7 +131,7 @@ fn patch_point(u: f32, v: f32) -> (Vec3, Vec3, Vec2) {
 
 #[test]
 fn bilinear_patch_rays_hit_the_true_patch() {
-    let (scene, warnings) = load(PATCH);
+    let (scene, warnings) = pbrt_world(PATCH);
     assert!(
         !warnings.iter().any(|w| w.contains("bilinear")),
         "{warnings:?}"
@@ -196,12 +186,12 @@ fn bilinear_patch_rays_hit_the_true_patch() {
 
 #[test]
 fn emissive_bilinear_mesh_stays_triangles() {
-    let (_, warnings) = load(&format!("AreaLightSource \"diffuse\"\n{PATCH}"));
+    let (_, warnings) = pbrt_world(&format!("AreaLightSource \"diffuse\"\n{PATCH}"));
     assert!(
         warnings.iter().any(|w| w.contains("non-parallelogram")),
         "{warnings:?}"
     );
-    let (_, warnings) = load(
+    let (_, warnings) = pbrt_world(
         "AreaLightSource \"diffuse\"\nShape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0] \"integer indices\" [0 1 2 3]",
     );
     assert!(
@@ -319,13 +309,13 @@ fn triangle_dndu_matches_the_cylinders() {
 #[test]
 fn straight_curves_are_ribbons_of_their_width() {
     let p = "\"point3 P\" [0 0 0  1 0 0  2 0 0  3 0 0] \"float width\" 0.2";
-    let (flat, w) = load(&format!("Shape \"curve\" {p}"));
+    let (flat, w) = pbrt_world(&format!("Shape \"curve\" {p}"));
     assert!(!w.iter().any(|w| w.contains("curve")), "{w:?}");
-    let (cyl, _) = load(&format!("Shape \"curve\" {p} \"string type\" \"cylinder\""));
-    let (edge_on, _) = load(&format!(
+    let (cyl, _) = pbrt_world(&format!("Shape \"curve\" {p} \"string type\" \"cylinder\""));
+    let (edge_on, _) = pbrt_world(&format!(
         "Shape \"curve\" {p} \"string type\" \"ribbon\" \"normal N\" [0 1 0  0 1 0]"
     ));
-    let (face_on, _) = load(&format!(
+    let (face_on, _) = pbrt_world(&format!(
         "Shape \"curve\" {p} \"string type\" \"ribbon\" \"normal N\" [0 0 1  0 0 1]"
     ));
     let mut n_hit = 0;
@@ -372,7 +362,7 @@ fn straight_curves_are_ribbons_of_their_width() {
 /// refines the arc into pieces flat to 5 % of the width).
 #[test]
 fn curved_curves_match_the_brute_force_distance() {
-    let (scene, _) = load(
+    let (scene, _) = pbrt_world(
         "Shape \"curve\" \"point3 P\" [0 0 0  1 1.2 0  2 1.2 0  3 0 0] \"float width0\" 0.1 \"float width1\" 0.3",
     );
     let cp = [
@@ -426,7 +416,7 @@ fn curved_curves_match_the_brute_force_distance() {
 #[test]
 fn mirrored_cylinder_faces_inward_as_in_pbrt_v4() {
     for (extra, outward) in [("", false), ("ReverseOrientation\n", true)] {
-        let (scene, _) = load(&format!(
+        let (scene, _) = pbrt_world(&format!(
             "AttributeBegin\nScale -1 1 1\n{extra}Shape \"cylinder\" \"float radius\" 0.5\nAttributeEnd"
         ));
         let h = scene

@@ -1,7 +1,8 @@
 //! The expected answer of a white furnace through a slab: two parallel, identical, infinite
 //! interfaces (z = 0 with the medium below, z = −d with the medium above) under a uniform sky
 //! of radiance Le, seen from outside along a direction at cos θo = `mu_o`. For the path
-//! tracer's tests (`mod furnace_support;`); nothing here renders.
+//! tracer's and the BSDFs' furnace tests (`mod furnace_support;`), with the small generator
+//! their Monte Carlo loops draw from; nothing here renders.
 //!
 //! Derivation. Everything is invariant under translations along the slab and rotations about
 //! its normal (isotropic BSDFs, uniform sky), so radiance depends only on μ = |cos θ| and on
@@ -21,8 +22,24 @@
 //! loss makes a rough slab darker, which is what this computes. Two diffuse-transmission sheets
 //! (R, T) have the closed form Le (R + T² / (1 − R)), which checks the solver.
 
+#![allow(dead_code)] // Each test file uses part of this module.
+
 use glam::Vec3;
 use std::f64::consts::PI;
+
+/// A small PCG-style generator for a test's own draws: uniform in [0, 1).
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// The next number in [0, 1).
+    pub fn f(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 40) as f32 / (1u64 << 24) as f32).min(0.999_999_9)
+    }
+}
 
 /// A BSDF evaluator f(wo, wi) (no cosine) in its viewer's local frame.
 pub type Eval<'a> = &'a dyn Fn(Vec3, Vec3) -> f64;

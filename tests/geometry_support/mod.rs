@@ -1,8 +1,10 @@
-//! Shared by the BVH tests: random query rays and the brute-force closest hit they are judged by.
+//! Shared by the BVH tests: random query rays and the brute-force closest hit they are judged
+//! by, and the agreement of every query on every backend (the cut-out tests' answers).
+#![allow(dead_code)] // Each test file uses part of this module.
 
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::triangle::intersect_triangle;
-use penumbra::geometry::{Geometry, PrimKind, Primitive, Ray, RayQuery};
+use penumbra::geometry::{Backend, Geometry, PACKET, PrimKind, Primitive, Ray, RayQuery, SurfaceHit};
 use penumbra::integrator::estimator::shadow_ray;
 use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere, uniform_triangle_point};
 use penumbra::scene::Scene;
@@ -76,7 +78,6 @@ pub fn triangle_soup(n: u32) -> Vec<Primitive> {
 
 /// A soup of `tris` random triangles plus 20 spheres of `sphere_radius` and 20 disks of
 /// `disk_radius` at random places in the same box.
-#[allow(dead_code)]
 pub fn soup_with_quadrics(tris: u32, sphere_radius: f32, disk_radius: f32) -> Geometry {
     use penumbra::geometry::{MeshShading, Quadric, QuadricKind, Transform};
     let pat = make_pattern(PatternKind::Random, 5);
@@ -112,7 +113,6 @@ pub fn soup_with_quadrics(tris: u32, sphere_radius: f32, disk_radius: f32) -> Ge
 }
 
 /// Built-in scene `name` (`triangles` for the procedural meshes of `dense`).
-#[allow(dead_code)] // Not every test file that shares this module loads scenes.
 pub fn builtin_scene(name: &str, triangles: Option<u32>) -> Scene {
     let opts = penumbra::scene::load::LoadOptions {
         builtin: penumbra::scene::builtin::BuiltinOptions {
@@ -195,4 +195,65 @@ pub fn tie_rays(g: &Geometry, packets: u32, seed: u64) -> Vec<Ray> {
         }
     }
     aimed
+}
+
+/// Per ray: the closest hit of the geometry `build` makes for each backend, with `name` (a
+/// name of the hit primitive that does not depend on the backend's leaf order), checked equal
+/// across every query and backend: any-hit ⇔ closest-hit, 16-ray packets = one-ray (t to the
+/// bit, primitive, uv, point), and the same (name, t) from all three BVHs.
+pub fn agreed_hits(
+    build: impl Fn(Backend) -> Geometry,
+    name: impl Fn(&Geometry, u32) -> u32,
+    rays: &[Ray],
+) -> Vec<Option<(u32, SurfaceHit)>> {
+    let mut first: Option<Vec<Option<(u32, SurfaceHit)>>> = None;
+    for backend in [Backend::Wide, Backend::Own, Backend::Obvhs] {
+        let g = build(backend);
+        let mut got = Vec::with_capacity(rays.len());
+        for chunk in rays.chunks(PACKET) {
+            let mut pk = [chunk[0]; PACKET];
+            pk[..chunk.len()].copy_from_slice(chunk);
+            let active = (1u32 << chunk.len()) - 1;
+            let mut out = [None; PACKET];
+            g.intersect_packet(&pk, active, &mut out);
+            let blocked = g.occluded_packet(&pk, active);
+            for (i, r) in chunk.iter().enumerate() {
+                let h = g.intersect(r);
+                assert_eq!(
+                    h.is_some(),
+                    g.occluded(r),
+                    "{backend:?}: closest and any-hit disagree on {r:?}"
+                );
+                assert_eq!(
+                    blocked >> i & 1 == 1,
+                    h.is_some(),
+                    "{backend:?}: any-hit packet"
+                );
+                match (&h, &out[i]) {
+                    (Some(a), Some(b)) => assert!(
+                        a.t.to_bits() == b.t.to_bits()
+                            && a.prim == b.prim
+                            && a.uv == b.uv
+                            && a.p == b.p,
+                        "{backend:?}: packet hit {b:?} != one-ray hit {a:?}"
+                    ),
+                    (None, None) => {}
+                    _ => panic!("{backend:?}: packet {:?} vs one-ray {h:?}", out[i]),
+                }
+                got.push(h.map(|h| (name(&g, h.prim), h)));
+            }
+        }
+        match &first {
+            None => first = Some(got),
+            Some(f) => {
+                let same = f.iter().zip(&got).all(|(a, b)| match (a, b) {
+                    (Some((qa, a)), Some((qb, b))) => qa == qb && a.t.to_bits() == b.t.to_bits(),
+                    (None, None) => true,
+                    _ => false,
+                });
+                assert!(same, "{backend:?} differs from the wide BVH");
+            }
+        }
+    }
+    first.expect("three backends")
 }
