@@ -480,8 +480,15 @@ fn build(c: &Case) -> Built {
         LightKind::SphereArea => {
             let r = dist * (0.2f32).min(0.5 * sin_e);
             let le = 10.0 * (dist * dist) / (std::f32::consts::PI * r * r);
-            b.add_sphere(Transform::translate(p_light), r, black, emission(le), false, None)
-                .unwrap();
+            b.add_sphere(
+                Transform::translate(p_light),
+                r,
+                black,
+                emission(le),
+                false,
+                None,
+            )
+            .unwrap();
             Exact::Sphere {
                 c: dv(p_light),
                 r: r as f64,

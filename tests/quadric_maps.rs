@@ -278,7 +278,8 @@ fn bilinear_patch_maps_shade_as_the_equivalent_quad_mesh() {
         // blends the ramp's ends (over the mesh's filter footprint, wider than the patch's
         // point lookups: quadrics have no pixel footprint).
         let inner: Vec<bool> = (0..want_len()).map(|k| !matches!(k % 32, 0 | 31)).collect();
-        let ((max, mean, _), unmapped) = against_mesh(&d, &mat, square(true), square(false), &inner);
+        let ((max, mean, _), unmapped) =
+            against_mesh(&d, &mat, square(true), square(false), &inner);
         // A bump map's slope is a forward difference in f32 over the mesh's footprint step or
         // the patch's fixed 0.0005: rounding of h over the smaller step is ~1e-4 of the tilt.
         let bound = if mat.contains("displacement") {

@@ -74,8 +74,15 @@ fn sphere_light(b: &mut SceneBuilder, c: Vec3, r: f32, le: f32) {
         l: Rgb::splat(le),
         two_sided: false,
     };
-    b.add_sphere(Transform::translate(c), r, black, Some(emission), false, None)
-        .unwrap();
+    b.add_sphere(
+        Transform::translate(c),
+        r,
+        black,
+        Some(emission),
+        false,
+        None,
+    )
+    .unwrap();
 }
 
 /// Mean and standard error of the radiance along `ray` over `pixels` independent sample sets
@@ -253,8 +260,15 @@ fn rough_glass_bulb_around_a_spherical_emitter() {
     let (le, alpha, r_glass, r_light) = (5.0f32, 0.1f32, 1.0f32, 0.5f32);
     let mut b = SceneBuilder::new();
     let m = b.add_material(glass(alpha));
-    b.add_sphere(Transform::translate(Vec3::ZERO), r_glass, m, None, false, None)
-        .unwrap();
+    b.add_sphere(
+        Transform::translate(Vec3::ZERO),
+        r_glass,
+        m,
+        None,
+        false,
+        None,
+    )
+    .unwrap();
     sphere_light(&mut b, Vec3::ZERO, r_light, le);
     let s = b.build(camera(), film()).unwrap();
     let hit = Vec3::new(0.0, -(25f32.to_radians().cos()), 25f32.to_radians().sin());

@@ -245,20 +245,28 @@ impl SceneBuilder {
         Ok(())
     }
 
-    /// Add quadric `q` with the cut-out `alpha`, keyed by its index (every quadric's hash
-    /// differs, in this geometry and in the emitters' copy alike).
+    /// Add the quadric `kind` under `to_world` (its outward normal negated with `flip`) with
+    /// the cut-out `alpha`, keyed by its index (every quadric's hash differs, in this geometry
+    /// and in the emitters' copy alike).
     fn add_quadric(
         &mut self,
-        mut q: Quadric,
+        kind: QuadricKind,
+        to_world: Transform,
+        flip: bool,
         material: u32,
         emission: Option<AreaEmission>,
         alpha: Option<Alpha>,
     ) -> anyhow::Result<()> {
         self.check_material(material)?;
-        q.alpha = alpha.map(|alpha| CutOut {
-            alpha,
-            key: 1 << 63 | self.quadrics.len() as u64,
-        });
+        let q = Quadric {
+            kind,
+            to_world,
+            flip,
+            alpha: alpha.map(|alpha| CutOut {
+                alpha,
+                key: 1 << 63 | self.quadrics.len() as u64,
+            }),
+        };
         let light = match emission {
             Some(e) => {
                 check_emission(&e)?;
@@ -276,6 +284,31 @@ impl SceneBuilder {
             light,
         });
         Ok(())
+    }
+
+    /// Add the partial quadric `shape` = (kind, to_world, reverse_orientation) or, when
+    /// emissive, the mesh of triangle lights [`tessellate`] makes of `surface` over `grid`
+    /// (penumbra samples no analytic partial quadric), each with the optional cut-out. Either
+    /// way pbrt-v4's quadric rule decides its side: the object-space ∂p/∂u × ∂p/∂v is negated
+    /// for ReverseOrientation XOR a handedness swap, then carried to world space as a normal
+    /// (so a mirrored cylinder faces inward).
+    fn add_tessellated_if_emissive(
+        &mut self,
+        (kind, to_world, reverse_orientation): (QuadricKind, Transform, bool),
+        material: u32,
+        emission: Option<AreaEmission>,
+        alpha: Option<Alpha>,
+        grid: (u32, u32),
+        surface: impl Fn(f32, f32) -> (Vec3, Vec3),
+    ) -> anyhow::Result<()> {
+        let flip = reverse_orientation ^ to_world.swaps_handedness();
+        if let Some(e) = emission {
+            let mesh = tessellate(&to_world, flip, grid, surface);
+            return self
+                .add_mesh_cut_out(mesh, material, Some(e), alpha)
+                .map(|_| ());
+        }
+        self.add_quadric(kind, to_world, flip, material, None, alpha)
     }
 
     /// Add a sphere of `radius` centred at the origin of `to_world`'s object space.
@@ -296,13 +329,9 @@ impl SceneBuilder {
             radius.is_finite() && radius > 0.0,
             "sphere radius must be positive and finite, got {radius}"
         );
-        let q = Quadric {
-            kind: QuadricKind::Sphere { radius },
-            to_world,
-            flip: reverse_orientation ^ to_world.swaps_handedness(),
-            alpha: None,
-        };
-        self.add_quadric(q, material, emission, alpha)
+        let flip = reverse_orientation ^ to_world.swaps_handedness();
+        let kind = QuadricKind::Sphere { radius };
+        self.add_quadric(kind, to_world, flip, material, emission, alpha)
     }
 
     /// Add a disk of `radius` in the z = `height` plane of `to_world`'s object space, normal
@@ -322,13 +351,9 @@ impl SceneBuilder {
             radius.is_finite() && radius > 0.0 && height.is_finite(),
             "disk radius must be positive and finite (radius {radius}, height {height})"
         );
-        let q = Quadric {
-            kind: QuadricKind::Disk { height, radius },
-            to_world,
-            flip: reverse_orientation ^ to_world.swaps_handedness(),
-            alpha: None,
-        };
-        self.add_quadric(q, material, emission, alpha)
+        let flip = reverse_orientation ^ to_world.swaps_handedness();
+        let kind = QuadricKind::Disk { height, radius };
+        self.add_quadric(kind, to_world, flip, material, emission, alpha)
     }
 
     /// Add pbrt-v4's partial sphere `[zmin, zmax, phimax (radians)]` of `radius` in
@@ -358,34 +383,31 @@ impl SceneBuilder {
             zmin < zmax && phimax > 0.0 && phimax.is_finite(),
             "partial sphere needs zmin < zmax within the radius and phimax > 0 (z {zmin}..{zmax}, phimax {phimax})"
         );
-        let flip = reverse_orientation ^ to_world.swaps_handedness();
-        if let Some(e) = emission {
-            let (t0, t1) = ((zmin / radius).acos(), (zmax / radius).acos());
-            let mesh = tessellate(&to_world, flip, PARTIAL_LIGHT_GRID, |u, v| {
-                let (theta, phi) = (t0 + (t1 - t0) * v, u * phimax);
-                let n = Vec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
-                );
-                (n * radius, n)
-            });
-            return self
-                .add_mesh_cut_out(mesh, material, Some(e), alpha)
-                .map(|_| ());
-        }
-        let q = Quadric {
-            kind: QuadricKind::SphereCut {
-                radius,
-                zmin,
-                zmax,
-                phimax,
-            },
-            to_world,
-            flip,
-            alpha: None,
+        let kind = QuadricKind::SphereCut {
+            radius,
+            zmin,
+            zmax,
+            phimax,
         };
-        self.add_quadric(q, material, None, alpha)
+        let (t0, t1) = ((zmin / radius).acos(), (zmax / radius).acos());
+        let surface = |u: f32, v: f32| {
+            let (theta, phi) = (t0 + (t1 - t0) * v, u * phimax);
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
+            (n * radius, n)
+        };
+        let shape = (kind, to_world, reverse_orientation);
+        self.add_tessellated_if_emissive(
+            shape,
+            material,
+            emission,
+            alpha,
+            PARTIAL_LIGHT_GRID,
+            surface,
+        )
     }
 
     /// Add pbrt-v4's annulus / partial disk (`inner` ≤ r ≤ `radius`, φ in [0, `phimax`]) in the
@@ -410,28 +432,25 @@ impl SceneBuilder {
             (0.0..radius).contains(&inner) && phimax > 0.0 && phimax.is_finite(),
             "partial disk needs 0 ≤ innerradius < radius and phimax > 0 (inner {inner}, phimax {phimax})"
         );
-        let flip = reverse_orientation ^ to_world.swaps_handedness();
-        if let Some(e) = emission {
-            let mesh = tessellate(&to_world, flip, PARTIAL_LIGHT_GRID, |u, v| {
-                let (r, phi) = (radius - (radius - inner) * v, u * phimax);
-                (Vec3::new(r * phi.cos(), r * phi.sin(), height), Vec3::Z)
-            });
-            return self
-                .add_mesh_cut_out(mesh, material, Some(e), alpha)
-                .map(|_| ());
-        }
-        let q = Quadric {
-            kind: QuadricKind::DiskCut {
-                height,
-                radius,
-                inner,
-                phimax,
-            },
-            to_world,
-            flip,
-            alpha: None,
+        let kind = QuadricKind::DiskCut {
+            height,
+            radius,
+            inner,
+            phimax,
         };
-        self.add_quadric(q, material, None, alpha)
+        let surface = |u: f32, v: f32| {
+            let (r, phi) = (radius - (radius - inner) * v, u * phimax);
+            (Vec3::new(r * phi.cos(), r * phi.sin(), height), Vec3::Z)
+        };
+        let shape = (kind, to_world, reverse_orientation);
+        self.add_tessellated_if_emissive(
+            shape,
+            material,
+            emission,
+            alpha,
+            PARTIAL_LIGHT_GRID,
+            surface,
+        )
     }
 
     /// Add pbrt-v4's cylinder `[radius, zmin, zmax, phimax (radians)]` of `to_world`'s object
@@ -455,34 +474,22 @@ impl SceneBuilder {
             zmin < zmax && phimax > 0.0 && phimax.is_finite(),
             "cylinder needs zmin < zmax and phimax > 0 (z {zmin}..{zmax}, phimax {phimax})"
         );
-        // pbrt-v4's quadric rule, as for spheres and disks: the object-space ∂p/∂u × ∂p/∂v
-        // is negated for ReverseOrientation XOR a handedness swap, then carried to world
-        // space as a normal, so a mirrored cylinder faces inward.
-        let flip = reverse_orientation ^ to_world.swaps_handedness();
-        if let Some(e) = emission {
-            // One band of quads around the sweep, wound (p1 − p0) × (p2 − p0) outward: along
-            // +φ, then +z.
-            let mesh = tessellate(&to_world, flip, (CYLINDER_LIGHT_SEGMENTS, 1), |u, v| {
-                let (s, c) = (u * phimax).sin_cos();
-                let z = if v == 0.0 { zmin } else { zmax };
-                (Vec3::new(radius * c, radius * s, z), Vec3::new(c, s, 0.0))
-            });
-            return self
-                .add_mesh_cut_out(mesh, material, Some(e), alpha)
-                .map(|_| ());
-        }
-        let q = Quadric {
-            kind: QuadricKind::Cylinder {
-                radius,
-                zmin,
-                zmax,
-                phimax,
-            },
-            to_world,
-            flip,
-            alpha: None,
+        let kind = QuadricKind::Cylinder {
+            radius,
+            zmin,
+            zmax,
+            phimax,
         };
-        self.add_quadric(q, material, None, alpha)
+        // One band of quads around the sweep, wound (p1 − p0) × (p2 − p0) outward: along +φ,
+        // then +z.
+        let surface = |u: f32, v: f32| {
+            let (s, c) = (u * phimax).sin_cos();
+            let z = if v == 0.0 { zmin } else { zmax };
+            (Vec3::new(radius * c, radius * s, z), Vec3::new(c, s, 0.0))
+        };
+        let grid = (CYLINDER_LIGHT_SEGMENTS, 1);
+        let shape = (kind, to_world, reverse_orientation);
+        self.add_tessellated_if_emissive(shape, material, emission, alpha, grid, surface)
     }
 
     /// Add a world-space bilinear patch (corners p00, p10, p01, p11, their uvs), normal
@@ -500,13 +507,8 @@ impl SceneBuilder {
             p.iter().all(|v| v.is_finite()) && uv.iter().all(|v| v.is_finite()),
             "bilinear patch corners and uvs must be finite"
         );
-        let q = Quadric {
-            kind: QuadricKind::Bilinear { p, uv },
-            to_world: Transform::IDENTITY,
-            flip,
-            alpha: None,
-        };
-        self.add_quadric(q, material, None, alpha)
+        let kind = QuadricKind::Bilinear { p, uv };
+        self.add_quadric(kind, Transform::IDENTITY, flip, material, None, alpha)
     }
 
     /// Add one cubic Bézier segment of a pbrt-v4 `curve` in `to_world`'s object space, with an
@@ -524,14 +526,10 @@ impl SceneBuilder {
                 && segment.width.iter().all(|w| w.is_finite() && *w >= 0.0),
             "curve control points and widths must be finite (widths ≥ 0)"
         );
-        let q = Quadric {
-            kind: QuadricKind::Curve(segment),
-            to_world,
-            // pbrt-v4's curves flip as its quadrics do.
-            flip: reverse_orientation ^ to_world.swaps_handedness(),
-            alpha: None,
-        };
-        self.add_quadric(q, material, None, alpha)
+        // pbrt-v4's curves flip as its quadrics do.
+        let flip = reverse_orientation ^ to_world.swaps_handedness();
+        let kind = QuadricKind::Curve(segment);
+        self.add_quadric(kind, to_world, flip, material, None, alpha)
     }
 
     /// Add a light that is not attached to geometry (point, spot, distant, infinite).

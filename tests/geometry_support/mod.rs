@@ -4,7 +4,9 @@
 
 use glam::{UVec2, Vec2, Vec3};
 use penumbra::geometry::triangle::intersect_triangle;
-use penumbra::geometry::{Backend, Geometry, PACKET, PrimKind, Primitive, Ray, RayQuery, SurfaceHit};
+use penumbra::geometry::{
+    Backend, Geometry, PACKET, PrimKind, Primitive, Ray, RayQuery, SurfaceHit,
+};
 use penumbra::integrator::estimator::shadow_ray;
 use penumbra::sampling::{PatternKind, make_pattern, uniform_sphere, uniform_triangle_point};
 use penumbra::scene::Scene;
