@@ -7,10 +7,13 @@ use crate::geometry::{
     Alpha, Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Transform,
     interaction::NO_LIGHT, quadric::CutOut,
 };
-use crate::lights::{DiskLight, Light, QuadLight, SphereLight, TriangleLight};
+use crate::lights::{DiskLight, Light, MaskedTriangleLight, QuadLight, SphereLight, TriangleLight};
 use crate::material::Material;
 use anyhow::{Context, bail, ensure};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+
+/// A full sweep in φ (2π).
+const FULL_SWEEP: f32 = std::f32::consts::TAU;
 
 /// Segments around an emissive cylinder's tessellation ([`SceneBuilder::add_cylinder`]).
 pub const CYLINDER_LIGHT_SEGMENTS: u32 = 64;
@@ -183,9 +186,23 @@ impl SceneBuilder {
                             }
                         }
                     }
-                    match TriangleLight::new(p, n, e.l, e.two_sided) {
+                    let light =
+                        TriangleLight::new(p, n, e.l, e.two_sided).and_then(|l| match &alpha {
+                            None => Some(Light::Triangle(l)),
+                            Some(a) => {
+                                // pbrt-v4's default parameterisation without uvs, as the hit
+                                // test's (0,0), (1,0), (1,1).
+                                let uv = match &uvs {
+                                    Some(uv) => v.map(|i| uv[i as usize]),
+                                    None => [Vec2::ZERO, Vec2::X, Vec2::ONE],
+                                };
+                                MaskedTriangleLight::new(l, uv, a.clone())
+                                    .map(|m| Light::MaskedTriangle(Box::new(m)))
+                            }
+                        });
+                    match light {
                         Some(l) => {
-                            self.lights.push(Light::Triangle(l));
+                            self.lights.push(l);
                             (self.lights.len() - 1) as u32
                         }
                         None => NO_LIGHT,
@@ -313,9 +330,10 @@ impl SceneBuilder {
 
     /// Add a sphere of `radius` centred at the origin of `to_world`'s object space.
     /// `reverse_orientation` flips its normals (inward-facing emission); `alpha` is an
-    /// optional cut-out over its uv (pbrt-v4's shape `alpha`). An emissive cut-out's light is
-    /// the whole sphere (the light samples ignore the mask, as a cut-out mesh's triangle
-    /// lights do).
+    /// optional cut-out over its uv (pbrt-v4's shape `alpha`). An emissive cut-out becomes
+    /// masked triangle lights: a mask over an emitter must mask its light samples too, which
+    /// triangle lights do (`MaskedTriangleLight`), so it is the partial sphere of full range,
+    /// tessellated with the same uv (the loader warns).
     pub fn add_sphere(
         &mut self,
         to_world: Transform,
@@ -329,13 +347,26 @@ impl SceneBuilder {
             radius.is_finite() && radius > 0.0,
             "sphere radius must be positive and finite, got {radius}"
         );
+        if emission.is_some() && alpha.is_some() {
+            let z = [-radius, radius, FULL_SWEEP];
+            return self.add_partial_sphere(
+                to_world,
+                radius,
+                z,
+                material,
+                emission,
+                reverse_orientation,
+                alpha,
+            );
+        }
         let flip = reverse_orientation ^ to_world.swaps_handedness();
         let kind = QuadricKind::Sphere { radius };
         self.add_quadric(kind, to_world, flip, material, emission, alpha)
     }
 
     /// Add a disk of `radius` in the z = `height` plane of `to_world`'s object space, normal
-    /// +z, with an optional alpha cut-out over its uv (see [`SceneBuilder::add_sphere`]).
+    /// +z, with an optional alpha cut-out over its uv (an emissive one: the partial disk of
+    /// full range, as [`SceneBuilder::add_sphere`]).
     #[allow(clippy::too_many_arguments)]
     pub fn add_disk(
         &mut self,
@@ -351,6 +382,18 @@ impl SceneBuilder {
             radius.is_finite() && radius > 0.0 && height.is_finite(),
             "disk radius must be positive and finite (radius {radius}, height {height})"
         );
+        if emission.is_some() && alpha.is_some() {
+            let r = [radius, 0.0, FULL_SWEEP];
+            return self.add_partial_disk(
+                to_world,
+                height,
+                r,
+                material,
+                emission,
+                reverse_orientation,
+                alpha,
+            );
+        }
         let flip = reverse_orientation ^ to_world.swaps_handedness();
         let kind = QuadricKind::Disk { height, radius };
         self.add_quadric(kind, to_world, flip, material, emission, alpha)
