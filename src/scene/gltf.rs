@@ -4,7 +4,8 @@
 //! (GLB blob, files next to the asset, base64 `data:` URIs) so no extra crate features are
 //! needed. Node hierarchies are flattened to world space. Supported: triangle primitives,
 //! the first perspective camera, metallic-roughness materials with base-colour textures
-//! ([`gltf_material`]), emissive materials (× `KHR_materials_emissive_strength`) as area
+//! ([`gltf_material`]), `alphaMode` `MASK`/`BLEND` as cut-outs ([`super::gltf_alpha`]),
+//! emissive materials (× `KHR_materials_emissive_strength`) as area
 //! lights, and `KHR_lights_punctual` point/spot/directional lights ([`punctual_light`]).
 //!
 //! Photometric units: glTF gives point/spot intensity in candela and directional
@@ -12,13 +13,14 @@
 //! efficacy at 555 nm, the same factor glTF viewers and exporters (e.g. Blender) use to map
 //! between watts and lumens; so 683 cd → 1 W/sr and 683 lux → 1 W/m².
 
+use super::gltf_alpha::material_alpha;
 use super::gltf_check::{Role, check_accessor, parse_document};
 use super::load::{LoadOptions, Loaded, warn_if_unlit};
 use super::view::{DEFAULT_FOV_DEG, apply_view_flags, auto_frame, default_film, place_auto_camera};
 use super::{AreaEmission, SceneBuilder, TriangleMesh, guard};
 use crate::Rgb;
 use crate::camera::Camera;
-use crate::geometry::Transform;
+use crate::geometry::{Alpha, Transform};
 use crate::image::io::srgb_to_linear;
 use crate::lights::{DistantLight, Light, PointLight, SpotLight};
 use crate::material::texture::ImageRgb;
@@ -51,14 +53,15 @@ fn load_inner(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     let dir = path.parent().unwrap_or(Path::new(""));
     let buffers = load_buffers(&doc, dir, &file)?;
     let mut warnings = Vec::new();
-    let mut images: Vec<ImageSlot> = vec![[None, None]; doc.images().len()];
+    let mut images: Vec<ImageSlot> = vec![[None, None, None]; doc.images().len()];
 
     let mut b = SceneBuilder::new();
     // Materials: one per glTF material (same index), plus the spec's default material.
     let mut mats = Vec::new();
     for m in doc.materials() {
-        let (mat, emission) = gltf_material(&m, &buffers, dir, &mut images, &file, &mut warnings);
-        mats.push((b.add_material(mat), emission));
+        let (mat, emission, alpha) =
+            gltf_material(&m, &buffers, dir, &mut images, &file, &mut warnings);
+        mats.push((b.add_material(mat), emission, alpha));
     }
 
     let scene = doc
@@ -163,9 +166,9 @@ pub fn gltf_camera(world: Mat4, yfov: f32, aspect: Option<f32>) -> anyhow::Resul
 /// Depth-first traversal state: accumulates geometry, lights and the first camera.
 struct Walk<'a> {
     buffers: &'a [Vec<u8>],
-    mats: &'a [(u32, Option<AreaEmission>)],
+    mats: &'a [MaterialIds],
     /// The spec's default material, added when a primitive first needs it.
-    default_id: Option<(u32, Option<AreaEmission>)>,
+    default_id: Option<MaterialIds>,
     dir: &'a Path,
     images: &'a mut [ImageSlot],
     b: &'a mut SceneBuilder,
@@ -352,15 +355,16 @@ impl Walk<'_> {
                     }
                 }
             }
-            let (mat, emission) = match prim.material().index() {
-                Some(i) => *self
+            let (mat, emission, alpha) = match prim.material().index() {
+                Some(i) => self
                     .mats
                     .get(i)
-                    .ok_or_else(|| anyhow!("material {i} out of range"))?,
-                None => match self.default_id {
-                    Some(d) => d,
+                    .ok_or_else(|| anyhow!("material {i} out of range"))?
+                    .clone(),
+                None => match &self.default_id {
+                    Some(d) => d.clone(),
                     None => {
-                        let (m, e) = gltf_material(
+                        let (m, e, a) = gltf_material(
                             &prim.material(),
                             buffers,
                             self.dir,
@@ -368,8 +372,8 @@ impl Walk<'_> {
                             self.file,
                             self.warnings,
                         );
-                        let d = (self.b.add_material(m), e);
-                        self.default_id = Some(d);
+                        let d = (self.b.add_material(m), e, a);
+                        self.default_id = Some(d.clone());
                         d
                     }
                 },
@@ -384,7 +388,7 @@ impl Walk<'_> {
             };
             let repair = self
                 .b
-                .add_mesh_repaired(mesh, mat, emission)
+                .add_mesh_cut_out(mesh, mat, emission, alpha)
                 .with_context(|| format!("{mesh_name} primitives[{}]", prim.index()))?;
             if !repair.is_clean() {
                 self.warnings.push(format!("{at}: {}", repair.describe()));
@@ -446,13 +450,13 @@ fn gltf_material(
     images: &mut [ImageSlot],
     file: &str,
     warnings: &mut Vec<String>,
-) -> (Material, Option<AreaEmission>) {
+) -> (Material, Option<AreaEmission>, Option<Alpha>) {
     let name = m
         .name()
         .map(str::to_string)
         .unwrap_or_else(|| format!("#{}", m.index().map_or(-1, |i| i as i64)));
     let pbr = m.pbr_metallic_roughness();
-    let [r, g, bl, _a] = pbr.base_color_factor();
+    let [r, g, bl, a] = pbr.base_color_factor();
     let factor = Rgb::new(r, g, bl);
     let factor = if factor.is_finite() {
         factor.max(Rgb::ZERO)
@@ -461,11 +465,11 @@ fn gltf_material(
     };
     // Image `img` decoded (sRGB-linearised for colours, as stored for data), once per use.
     let mut decoded_image =
-        |img: ::gltf::Image, srgb: bool, instead: &str, warnings: &mut Vec<String>| {
+        |img: ::gltf::Image, how: Decode, instead: &str, warnings: &mut Vec<String>| {
             let idx = img.index();
             match images.get_mut(idx) {
-                Some(slot) => slot[srgb as usize]
-                    .get_or_insert_with(|| match decode_image(&img, buffers, dir, srgb) {
+                Some(slot) => slot[how as usize]
+                    .get_or_insert_with(|| match decode_image(&img, buffers, dir, how) {
                         Ok(i) => Some(Arc::new(i)),
                         Err(e) => {
                             warnings.push(format!(
@@ -482,7 +486,7 @@ fn gltf_material(
         Some(info) => {
             let decoded = decoded_image(
                 info.texture().source(),
-                true,
+                Decode::Srgb,
                 "uses its base colour factor",
                 warnings,
             );
@@ -502,6 +506,19 @@ fn gltf_material(
         }
         None => Texture::Constant(factor),
     };
+    // The cut-out (`alphaMode`): the base-colour texture's alpha channel, where it has one
+    // that is not 1 everywhere.
+    let alpha_image = match (m.alpha_mode(), pbr.base_color_texture()) {
+        (::gltf::material::AlphaMode::Opaque, _) | (_, None) => None,
+        (_, Some(info)) => decoded_image(
+            info.texture().source(),
+            Decode::Alpha,
+            "uses its base colour factor's alpha",
+            warnings,
+        )
+        .filter(|img| img.pixels.iter().any(|p| p.x < 1.0)),
+    };
+    let cut_out = material_alpha(m.alpha_mode(), m.alpha_cutoff(), a, alpha_image);
     let at = match m.index() {
         Some(i) => format!("{file}: materials[{i}] '{name}'"),
         None => format!("{file}: default material"),
@@ -582,7 +599,7 @@ fn gltf_material(
         Some(info) => {
             let decoded = decoded_image(
                 info.texture().source(),
-                false,
+                Decode::Linear,
                 "has no normal map",
                 warnings,
             );
@@ -619,7 +636,7 @@ fn gltf_material(
         }
         None => material,
     };
-    (material, emission)
+    (material, emission, cut_out)
 }
 
 /// Bytes of every buffer: the GLB blob, a file next to the asset, or a base64 `data:` URI.
@@ -713,16 +730,28 @@ fn percent_decode(s: &str) -> String {
 
 /// A glTF image decoded as data (`[0]`: normal maps) and as sRGB-linearised colour (`[1]`),
 /// each when first used (`Some(None)`: it failed, and said so once).
-type ImageSlot = [Option<Option<Arc<ImageRgb>>>; 2];
+type ImageSlot = [Option<Option<Arc<ImageRgb>>>; 3];
 
-/// Decode a glTF image (PNG/JPEG from a buffer view or URI) into RGB: linearised when `srgb`
-/// (base-colour textures are sRGB-encoded by the spec), code value / 255 otherwise (normal
-/// textures are linear data).
+/// A glTF material as the scene holds it: material index, emission, cut-out.
+type MaterialIds = (u32, Option<AreaEmission>, Option<Alpha>);
+
+/// How an image is decoded: the slot of [`ImageSlot`] it fills.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Decode {
+    /// Code value / 255 (normal textures are linear data).
+    Linear = 0,
+    /// sRGB-linearised colour (base-colour textures).
+    Srgb = 1,
+    /// The alpha channel (linear, as the spec stores it) in every channel.
+    Alpha = 2,
+}
+
+/// Decode a glTF image (PNG/JPEG from a buffer view or URI) as `how` says.
 fn decode_image(
     img: &::gltf::Image,
     buffers: &[Vec<u8>],
     dir: &Path,
-    srgb: bool,
+    how: Decode,
 ) -> anyhow::Result<ImageRgb> {
     let owned;
     let bytes: &[u8] = match img.source() {
@@ -738,17 +767,21 @@ fn decode_image(
             &owned
         }
     };
-    let rgb = image::load_from_memory(bytes)
-        .context("cannot decode image")?
-        .to_rgb32f();
-    let (w, h) = rgb.dimensions();
-    let pixels = rgb
-        .pixels()
-        .map(|p| {
-            let f = |v: f32| if srgb { srgb_to_linear(v) } else { v };
-            Rgb::new(f(p[0]), f(p[1]), f(p[2]))
-        })
-        .collect();
+    let decoded = image::load_from_memory(bytes).context("cannot decode image")?;
+    let (w, h, pixels) = if how == Decode::Alpha {
+        let rgba = decoded.to_rgba32f();
+        let pixels = rgba.pixels().map(|p| Rgb::splat(p[3])).collect();
+        (rgba.width(), rgba.height(), pixels)
+    } else {
+        let rgb = decoded.to_rgb32f();
+        let srgb = how == Decode::Srgb;
+        let f = |v: f32| if srgb { srgb_to_linear(v) } else { v };
+        let pixels = rgb
+            .pixels()
+            .map(|p| Rgb::new(f(p[0]), f(p[1]), f(p[2])))
+            .collect();
+        (rgb.width(), rgb.height(), pixels)
+    };
     Ok(ImageRgb {
         width: w,
         height: h,

@@ -7,6 +7,7 @@ pub mod builder;
 pub mod builtin;
 pub mod film;
 pub mod gltf;
+mod gltf_alpha;
 pub mod gltf_check;
 pub mod guard;
 pub mod load;

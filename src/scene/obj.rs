@@ -4,7 +4,7 @@
 //! [`super::polygon`] (in linear time for convex ones: a 300,000-vertex face loads, BVH
 //! included, in under 2 s). MTL mapping, in [`obj_material`]: `Kd` (and `map_Kd`) → diffuse
 //! reflectance, non-zero `Ks` with `Ns` → modified Phong, `Ke` → one-sided area emission
-//! (every triangle its own light). With [`LoadOptions::obj_ka_emission`], `Ka` is emitted
+//! (every triangle its own light), `d` and `map_d` → an alpha cut-out ([`obj_alpha`]). With [`LoadOptions::obj_ka_emission`], `Ka` is emitted
 //! radiance as well (the Embree/tinyobjloader Cornell-box convention). OBJ has no camera: it
 //! comes from the view flags or an automatic framing (see [`super::view`]). Every error and
 //! every warning names `file:line` ([`super::obj_text`] finds the lines `tobj` does not give).
@@ -15,8 +15,9 @@ use super::polygon::{Split, triangulate};
 use super::view::{auto_frame, default_film, place_auto_camera};
 use super::{AreaEmission, SceneBuilder, TriangleMesh, guard};
 use crate::Rgb;
+use crate::geometry::Alpha;
 use crate::material::texture::ImageRgb;
-use crate::material::{Material, Texture};
+use crate::material::{FloatTexture, Material, Texture};
 use anyhow::{Context, anyhow, bail};
 use glam::{Vec2, Vec3};
 use std::cell::RefCell;
@@ -193,7 +194,8 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
     let mut mat_ids = Vec::with_capacity(materials.len() + 1);
     for m in &materials {
         let (mat, emission) = obj_material(m, opts, &mut textures, &at_key, &mut warnings);
-        mat_ids.push((b.add_material(mat), emission));
+        let alpha = obj_alpha(m, &mut textures, &at_key, &mut warnings);
+        mat_ids.push((b.add_material(mat), emission, alpha));
     }
     let default_id = b.add_material(Material::Diffuse {
         reflectance: Texture::Constant(Rgb::splat(DEFAULT_KD)),
@@ -243,17 +245,17 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
             .then(|| m.normals.chunks_exact(3).map(Vec3::from_slice).collect());
         let uvs = (m.texcoords.len() == 2 * nv && nv > 0)
             .then(|| m.texcoords.chunks_exact(2).map(Vec2::from_slice).collect());
-        let (material, emission) = match m.material_id {
-            Some(k) if k < mat_ids.len() => mat_ids[k],
+        let (material, emission, alpha) = match m.material_id {
+            Some(k) if k < mat_ids.len() => mat_ids[k].clone(),
             Some(k) => {
                 warnings.push(format!(
                     "{}: object '{}' uses material #{k}, which was not loaded; using grey diffuse",
                     at_mesh(i),
                     model.name
                 ));
-                (default_id, None)
+                (default_id, None, None)
             }
-            None => (default_id, None),
+            None => (default_id, None, None),
         };
         let mesh = TriangleMesh {
             positions,
@@ -263,7 +265,7 @@ pub fn load_obj(path: &Path, opts: &LoadOptions) -> anyhow::Result<Loaded> {
             flip_normals: false,
         };
         let repair = b
-            .add_mesh_repaired(mesh, material, emission)
+            .add_mesh_cut_out(mesh, material, emission, alpha)
             .map_err(|e| anyhow!("{}: object '{}': {e}", at_mesh(i), model.name))?;
         if !repair.is_clean() {
             warnings.push(format!(
@@ -426,10 +428,65 @@ pub fn obj_material(
     (material, emission)
 }
 
+/// The cut-out of MTL material `m`: coverage = `d` (dissolve, 1 if absent) × the `map_d`
+/// mask, under the stochastic alpha test (a `d` of 0.3 stops 0.3 of the light). The mask is
+/// the image's alpha channel where it has one (a colour texture with transparency), else its
+/// first channel as stored (a grey mask). `None`: opaque. (`Tr`, which exporters disagree on,
+/// is not read.)
+pub fn obj_alpha(
+    m: &tobj::Material,
+    textures: &mut TextureCache,
+    at: &dyn Fn(&str, &str) -> String,
+    warnings: &mut Vec<String>,
+) -> Option<Alpha> {
+    let d = match m.dissolve {
+        Some(d) if d.is_finite() => d.clamp(0.0, 1.0),
+        Some(d) => {
+            warnings.push(format!(
+                "{}: material '{}': d {d} is not finite; opaque",
+                at(&m.name, "d"),
+                m.name
+            ));
+            1.0
+        }
+        None => 1.0,
+    };
+    if d == 0.0 {
+        warnings.push(format!(
+            "{}: material '{}': d 0 makes it fully transparent (invisible)",
+            at(&m.name, "d"),
+            m.name
+        ));
+    }
+    let mask = m
+        .dissolve_texture
+        .as_ref()
+        .and_then(|name| match textures.get_mask(name) {
+            Ok(img) => Some(img),
+            Err(e) => {
+                warnings.push(format!(
+                    "{}: material '{}': map_d {name}: {e:#}; no mask",
+                    at(&m.name, "map_d"),
+                    m.name
+                ));
+                None
+            }
+        });
+    match mask {
+        Some(image) => Some(Alpha::Texture(Arc::new(FloatTexture::Image {
+            image,
+            scale: d,
+            invert: false,
+        }))),
+        None => (d < 1.0).then_some(Alpha::Constant(d)),
+    }
+}
+
 /// Image textures by file name, decoded once and shared between materials.
 pub struct TextureCache {
     dir: PathBuf,
     images: HashMap<String, Result<Arc<ImageRgb>, String>>,
+    masks: HashMap<String, Result<Arc<ImageRgb>, String>>,
 }
 
 impl TextureCache {
@@ -438,22 +495,51 @@ impl TextureCache {
         Self {
             dir,
             images: HashMap::new(),
+            masks: HashMap::new(),
         }
+    }
+
+    /// The path of the map named `name` (MTL options such as `-bm 1` before the name are
+    /// skipped: the file name is the last token).
+    fn path(&self, name: &str) -> PathBuf {
+        let fname = name
+            .split_whitespace()
+            .last()
+            .unwrap_or(name)
+            .replace('\\', "/");
+        self.dir.join(fname)
+    }
+
+    /// The `map_d` mask called `name`: its alpha channel if it has one, else its first channel,
+    /// as stored (no sRGB decoding), in every channel.
+    pub fn get_mask(&mut self, name: &str) -> anyhow::Result<Arc<ImageRgb>> {
+        let p = self.path(name);
+        self.masks
+            .entry(name.to_string())
+            .or_insert_with(|| {
+                let img = image::open(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+                let has_alpha = img.color().has_alpha();
+                let rgba = img.to_rgba32f();
+                let pixels = rgba
+                    .pixels()
+                    .map(|px| Rgb::splat(if has_alpha { px[3] } else { px[0] }))
+                    .collect();
+                Ok(Arc::new(ImageRgb {
+                    width: rgba.width(),
+                    height: rgba.height(),
+                    pixels,
+                }))
+            })
+            .clone()
+            .map_err(|e| anyhow!(e))
     }
 
     /// The image called `name` (MTL options such as `-bm 1` before the name are skipped).
     pub fn get(&mut self, name: &str) -> anyhow::Result<Arc<ImageRgb>> {
-        let dir = &self.dir;
+        let p = self.path(name);
         self.images
             .entry(name.to_string())
             .or_insert_with(|| {
-                // The file name is the last token: MTL map options precede it.
-                let fname = name
-                    .split_whitespace()
-                    .last()
-                    .unwrap_or(name)
-                    .replace('\\', "/");
-                let p = dir.join(fname);
                 crate::image::io::read_image(&p)
                     .map(|img| {
                         Arc::new(ImageRgb {

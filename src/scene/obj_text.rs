@@ -152,7 +152,7 @@ pub struct MtlText {
 /// Colour statements `tobj` reads as three numbers.
 const COLOURS: [&str; 4] = ["Ka", "Kd", "Ks", "Ke"];
 
-/// Read MTL text: record each material's colour lines, and rewrite what `tobj` cannot take:
+/// Read MTL text: record each material's colour and dissolve (`d`, `map_d`) lines, and rewrite what `tobj` cannot take:
 /// `Kd 0.5` (one value means grey, per the MTL format) becomes `Kd 0.5 0.5 0.5`; colours given
 /// as `spectral` or `xyz`, which are not supported, are dropped with a warning.
 pub fn read_mtl(file: &str, raw: &[u8]) -> MtlText {
@@ -171,6 +171,8 @@ pub fn read_mtl(file: &str, raw: &[u8]) -> MtlText {
         let key = words.next().unwrap_or("");
         if key == "newmtl" {
             material = trimmed[6..].trim().to_string();
+        } else if key == "d" || key == "map_d" {
+            lines.insert((material.clone(), key.to_string()), n);
         } else if COLOURS.contains(&key) {
             lines.insert((material.clone(), key.to_string()), n);
             let values: Vec<&str> = words.collect();
