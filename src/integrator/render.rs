@@ -52,8 +52,13 @@ struct TileWork {
 impl TileWork {
     fn new(pattern: &dyn crate::sampling::SamplePattern) -> Self {
         Self {
+            // The filter samples of a wave's camera packets are drawn before any is shaded.
             pxs: (0..TILE * TILE)
-                .map(|_| pattern.pixel(UVec2::ZERO))
+                .map(|_| {
+                    let mut px = pattern.pixel(UVec2::ZERO);
+                    px.read_ahead_2d(DIM_FILTER);
+                    px
+                })
                 .collect(),
             cams: Vec::with_capacity(WAVE),
             weights: Vec::with_capacity(WAVE),
