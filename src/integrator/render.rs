@@ -288,6 +288,10 @@ pub(super) fn render_with(
                     us.clear();
                     return;
                 }
+                // A pixel's consecutive samples are summed in a register, the same additions
+                // in the same order: through `sums` each waited on the previous one's store
+                // (5 % of cornell direct mis-area on AVX-512, perf record).
+                let mut run: Option<(usize, Rgb)> = None;
                 for (i, (cam, weight)) in cams.iter().zip(weights.iter()).enumerate() {
                     for k in 0..cam.n {
                         // Filters with negative lobes weight their samples (mean weight
@@ -298,12 +302,24 @@ pub(super) fn render_with(
                         } else {
                             l * weight[k]
                         };
-                        if l.is_finite() {
-                            sums[cam.pixel[k] as usize] += l;
-                        } else {
+                        if !l.is_finite() {
                             tile_bad += 1;
+                            continue;
+                        }
+                        let slot = cam.pixel[k] as usize;
+                        match &mut run {
+                            Some((s, sum)) if *s == slot => *sum += l,
+                            _ => {
+                                if let Some((s, sum)) = run {
+                                    sums[s] = sum;
+                                }
+                                run = Some((slot, sums[slot] + l));
+                            }
                         }
                     }
+                }
+                if let Some((s, sum)) = run {
+                    sums[s] = sum;
                 }
                 cams.clear();
                 weights.clear();
