@@ -331,9 +331,8 @@ impl DiffuseBsdfLanes {
     }
 }
 
-/// Bit k set where `b[k]`: read inside the kernel that wrote `b`, so that on a vector set
-/// it is one vector load and compare (outside, the store-to-load wait on 16 bytes cost 2 % of
-/// cornell direct mis-area on AVX-512, perf record).
+/// Bit k set where `b[k]`.
+// Read inside the kernel that wrote `b` (outside it: 2 % of cornell direct, AVX-512, perf).
 #[inline(always)]
 fn mask_of(b: &[bool; PACKET]) -> u32 {
     b.iter()

@@ -877,9 +877,8 @@ impl<'a> Integrator<'a> {
             return l;
         };
         // The BSDF is stored straight into the lane, a diffuse one built here, any other by
-        // the general constructor (not through one local: a slow copy per hit, 04e0d80). The
-        // context has its own array: inside the lane, its copy waited on the stores that had
-        // just written it (9 % of cornell direct mis-area, AVX-512, perf record).
+        // the general constructor (not through one local: a slow copy per hit, 04e0d80).
+        // The context has its own array (copied into the lane: 9 % of cornell direct, AVX-512).
         *ctx = LightSampleContext { p: hit.p, n: g.n };
         let lane = match material.lambert(hit) {
             Some(b) => lane.insert(LaneShading {
