@@ -19,7 +19,6 @@ use crate::Rgb;
 use crate::bsdf::{Bsdf, Lambert};
 use crate::geometry::{Geometry, HitColumns, PACKET, Ray, RayPacket};
 use crate::light_selection::ShadingPoint;
-use crate::lights::LightSampleContext;
 use glam::{Vec2, Vec3};
 
 /// One f32 per lane.
@@ -408,12 +407,11 @@ impl Receivers {
     }
 }
 
-/// The per-lane part of a hit's shading state (the geometry is in [`Receivers`]).
+/// The per-lane part of a hit's shading state (the geometry is in [`Receivers`], the light
+/// sample context beside it in the stages' queues).
 pub(super) struct LaneShading {
     /// The BSDF at the hit.
     pub(super) bsdf: Bsdf,
-    /// The hit point and the geometric normal flipped toward the viewer.
-    pub(super) ctx: LightSampleContext,
 }
 
 /// Values that count unless their ray is blocked (light samples' shadow rays, the visibility

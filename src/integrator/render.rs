@@ -52,8 +52,13 @@ struct TileWork {
 impl TileWork {
     fn new(pattern: &dyn crate::sampling::SamplePattern) -> Self {
         Self {
+            // The filter samples of a wave's camera packets are drawn before any is shaded.
             pxs: (0..TILE * TILE)
-                .map(|_| pattern.pixel(UVec2::ZERO))
+                .map(|_| {
+                    let mut px = pattern.pixel(UVec2::ZERO);
+                    px.read_ahead_2d(DIM_FILTER);
+                    px
+                })
                 .collect(),
             cams: Vec::with_capacity(WAVE),
             weights: Vec::with_capacity(WAVE),
@@ -283,6 +288,9 @@ pub(super) fn render_with(
                     us.clear();
                     return;
                 }
+                // A pixel's consecutive samples are summed in a register, the same additions
+                // in the same order (through `sums`: 3 % of cornell direct, AVX-512, perf).
+                let mut run: Option<(usize, Rgb)> = None;
                 for (i, (cam, weight)) in cams.iter().zip(weights.iter()).enumerate() {
                     for k in 0..cam.n {
                         // Filters with negative lobes weight their samples (mean weight
@@ -293,12 +301,24 @@ pub(super) fn render_with(
                         } else {
                             l * weight[k]
                         };
-                        if l.is_finite() {
-                            sums[cam.pixel[k] as usize] += l;
-                        } else {
+                        if !l.is_finite() {
                             tile_bad += 1;
+                            continue;
+                        }
+                        let slot = cam.pixel[k] as usize;
+                        match &mut run {
+                            Some((s, sum)) if *s == slot => *sum += l,
+                            _ => {
+                                if let Some((s, sum)) = run {
+                                    sums[s] = sum;
+                                }
+                                run = Some((slot, sums[slot] + l));
+                            }
                         }
                     }
+                }
+                if let Some((s, sum)) = run {
+                    sums[s] = sum;
                 }
                 cams.clear();
                 weights.clear();

@@ -629,6 +629,7 @@ impl SceneBuilder {
         Ok(Scene {
             geometry,
             emitters,
+            perturbs_normals: materials.iter().any(|m| m.normal_perturbation().is_some()),
             materials,
             lights,
             infinite_lights,

@@ -115,6 +115,10 @@ pub struct Scene {
     pub emitters: crate::geometry::Geometry,
     /// Materials, indexed by `SurfaceHit::material`.
     pub materials: Vec<Material>,
+    /// Whether some material has a normal or bump map, decided when the scene is built (keep
+    /// it true when adding such a material): without one, closest hits skip the perturbation
+    /// pass (`shading_normals::perturb_hits`).
+    pub perturbs_normals: bool,
     /// All lights; area lights are referenced by `SurfaceHit::light`.
     pub lights: Vec<Light>,
     /// Indices of infinite lights (added to rays that escape).

@@ -326,14 +326,18 @@ impl PixelSamples {
             return None;
         }
         let base = index & !(CHUNK as u32 - 1);
-        self.learned[arity][d].set(count);
+        let alone = self.alone[arity] & (1 << d) != 0;
+        if !alone {
+            self.learned[arity][d].set(count);
+        }
         let mut masks = [0u32; 2];
         masks[arity] = 1 << d;
         // Group fills only for counts that are whole blocks: the renderer's 16-lane packets
         // then stay in step with the blocks. Otherwise a packet spans two blocks and the pixel
         // filter's walk runs ahead of the shading dimensions: a group fill of its next block
         // would evict the block they still read, and every block would be filled 2–3 times.
-        for k in (0..CACHED_DIMS).filter(|_| count.is_multiple_of(CHUNK as u32)) {
+        // A dimension read ahead of the others (`alone`) fills its own chunk only.
+        for k in (0..CACHED_DIMS).filter(|_| !alone && count.is_multiple_of(CHUNK as u32)) {
             if self.learned[0][k].get() == count && !self.chunks_1d[k].holds(base, count) {
                 masks[0] |= 1 << k;
             }

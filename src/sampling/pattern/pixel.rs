@@ -36,6 +36,7 @@ impl Pattern {
             raw_mode: self.raw_mode(),
             raw: Default::default(),
             learned: Default::default(),
+            alone: [0; 2],
             strata: Cell::default(),
             fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
             chunks_1d: Default::default(),
@@ -144,6 +145,9 @@ pub struct PixelSamples {
     /// dimensions for each sample index, so the chunks of one 16-index block are computed
     /// together, their independent hash chains overlapping, with one call and one setup.
     pub(super) learned: [[Cell<u32>; CACHED_DIMS]; 2],
+    /// Per 1D / 2D: the dimensions (bits) whose chunks are filled on their own, never in a
+    /// group (see [`PixelSamples::read_ahead_2d`]); kept from pixel to pixel.
+    pub(super) alone: [u32; 2],
     /// The two most recently used sample counts' [`Strata`] (an integrator asks for two: N for
     /// the pixel filter, N·M for the shading dimensions).
     strata: Cell<[Strata; 2]>,
@@ -183,6 +187,18 @@ impl PixelSamples {
             c.len.set(0);
         }
         self.generation.set(self.generation.get() + 1);
+    }
+
+    /// Fill the 2D chunks of `dim` on their own, never with the group of the dimensions an
+    /// integrator reads in step: for a dimension read ahead of the others (the pixel filter's,
+    /// drawn for a whole wave of camera packets before any of them is shaded). Its block
+    /// fills would otherwise also fill the shading dimensions' next blocks, evicting those
+    /// they have still to read, and theirs would refill its. Values do not change; kept from
+    /// pixel to pixel.
+    pub fn read_ahead_2d(&mut self, dim: u32) {
+        if (dim as usize) < CACHED_DIMS {
+            self.alone[1] |= 1 << dim;
+        }
     }
 
     /// The pixel these samples belong to.

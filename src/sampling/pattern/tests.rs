@@ -158,6 +158,58 @@ fn group_fills_serve_every_access_order() {
 }
 
 #[test]
+fn read_ahead_dimension_serves_the_wave_order() {
+    // The renderer's order: a wave draws the pixel filter's dimension (read ahead, filled on
+    // its own) for all of a pixel's samples, then the shading dimensions block by block; the
+    // same again with whole and partial blocks, on each instruction set.
+    for isa in Isa::available() {
+        let pat = Pattern {
+            seed: 9,
+            kind: PatternKind::Stratified,
+            cpu: isa.cpu(),
+        };
+        let mut px = pat.pixel(UVec2::ZERO);
+        px.read_ahead_2d(0);
+        for (pixel, spp) in [
+            (UVec2::new(2, 3), 64u32),
+            (UVec2::new(3, 3), 40),
+            (UVec2::new(4, 3), 64),
+        ] {
+            pat.pixel_into(pixel, &mut px);
+            for i in 0..spp {
+                assert_eq!(
+                    px.sample_2d(0, i, spp).to_array().map(f32::to_bits),
+                    pat.sample_2d(pixel, 0, i, spp).to_array().map(f32::to_bits),
+                    "{isa:?} pixel {pixel} filter index {i}"
+                );
+            }
+            for i in 0..spp {
+                for dim in [1u32, 2, 4] {
+                    assert_eq!(
+                        px.sample_1d(dim, i, spp).to_bits(),
+                        pat.sample_1d(pixel, dim, i, spp).to_bits(),
+                        "{isa:?} pixel {pixel} 1d dim {dim} index {i}"
+                    );
+                    assert_eq!(
+                        px.sample_2d(dim, i, spp).to_array().map(f32::to_bits),
+                        pat.sample_2d(pixel, dim, i, spp)
+                            .to_array()
+                            .map(f32::to_bits),
+                        "{isa:?} pixel {pixel} 2d dim {dim} index {i}"
+                    );
+                }
+                // The filter's values again, after the shading dimensions' group fills.
+                assert_eq!(
+                    px.sample_2d(0, i, spp).to_array().map(f32::to_bits),
+                    pat.sample_2d(pixel, 0, i, spp).to_array().map(f32::to_bits),
+                    "{isa:?} pixel {pixel} filter again, index {i}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn non_power_of_two_chunks_equal_the_pattern_values() {
     // Every index of non-power-of-two counts through the chunk fills (cycle-walking
     // permutation, divided cell split), on each instruction set: small and large strata,
