@@ -3,14 +3,18 @@
 //! hits) and secondary ones (every later path vertex).
 //!
 //! The render runs in rounds of sample indices (`integrator::rounds`). During a round every
-//! light sample the integrator takes records what it delivered ([`LearnRecord`]): the light
-//! sample's share of the estimate f·Le·G·w/pdf_ω (w its MIS weight, 1 without MIS), zero when
-//! the shadow ray is blocked — so occlusion, which no bound knows, is learned. Each tile
+//! light sample the integrator takes records what it would deliver as the only strategy
+//! ([`LearnRecord`]): f·Le·G/pdf_ω *without* its MIS weight (the weight falls with the light's
+//! own selection probability, so a weighted record would push a light learned low ever
+//! lower), zero when the shadow ray is blocked — so occlusion, which no bound knows, is
+//! learned. Each tile
 //! sums its records per (vertex class, cell, light) ([`OnlineLearner::digest`]); at the round
 //! boundary the digests are merged in tile order ([`OnlineLearner::merge`]), which makes the
 //! running averages — and every later round's distribution — independent of the thread count
 //! and schedule. The next round samples from [`OnlineLearner::snapshot`]: per class and cell
-//! p = β·p_spatial + (1 − β)·p_learned as in [`super::adaptive`], mixed with power selection at
+//! p = β·p_spatial + (1 − β)·p_learned (the [`CellMixtures`] of [`super::adaptive`]; each
+//! light's mean shrunk toward its spatial prior by its sample count: [`OnlineConfig::shrinkage`]),
+//! mixed with power selection at
 //! a share δ ≥ [`DEFENSIVE_FLOOR`] chosen by held-out probe rays of that class
 //! ([`super::defensive`]), so every light with power keeps p > 0 and a table that does not pay
 //! leaves the selector as power selection.
@@ -19,12 +23,12 @@
 //! round's frozen distribution (which depends only on earlier rounds), so each round's image is
 //! unbiased and so is their sample-weighted sum.
 
+use super::adaptive::CellMixtures;
 use super::defensive::{self, Defensive, ProbeConfig};
 use super::power::PowerSelector;
 use super::spatial::{CellTable, SpatialSelector};
 use super::{
-    FiniteSelector, GRID_MARGIN, LightSelector, LightSet, ONE_MINUS_EPS, Selector, SelectorKind,
-    ShadingPoint,
+    FiniteSelector, GRID_MARGIN, LightSelector, LightSet, Selector, SelectorKind, ShadingPoint,
 };
 use crate::scene::Scene;
 use glam::Vec3;
@@ -38,7 +42,8 @@ pub struct LearnRecord {
     pub p: Vec3,
     /// Scene index of the selected light.
     pub light: u32,
-    /// Luminance of f·Le·G·w/pdf_ω (not divided by the selection pmf); 0 if blocked.
+    /// Luminance of f·Le·G/pdf_ω without MIS weight (not divided by the selection pmf); 0 if
+    /// blocked.
     pub value: f32,
     /// A vertex after the first (not a camera-ray hit).
     pub secondary: bool,
@@ -55,16 +60,20 @@ pub struct OnlineConfig {
     pub min_records: u64,
     /// Share β of the spatial table kept in trained cells.
     pub beta: f32,
+    /// Pseudo-count k of the prior in each light's shrunk mean ([`OnlineLearner`]'s tables):
+    /// its own n_l measurements weigh n_l / (n_l + k).
+    pub shrinkage: f64,
     /// Seed (the render's seed).
     pub seed: u64,
 }
 
 impl OnlineConfig {
-    /// Defaults: ≥ 64 measurements per cell, β = 20 %.
+    /// Defaults: ≥ 64 measurements per cell, β = 20 %, k = 8.
     pub fn new(seed: u64) -> Self {
         Self {
             min_records: 64,
             beta: 0.2,
+            shrinkage: 8.0,
             seed,
         }
     }
@@ -146,10 +155,18 @@ impl OnlineLearner {
     }
 
     /// The learned tables of class `class` (0 primary, 1 secondary) from the sums so far.
+    ///
+    /// Per cell, the mean of each measured light is shrunk toward the cell's prior, the
+    /// spatial pmf π_l scaled to the cell's measured contribution T̂ = Σ_l Σv_l / Σ_l n_l·π_l
+    /// (the scale at which the measurements agree with the prior in total):
+    /// m̂_l = (Σv_l + k·π_l·T̂) / (n_l + k), [`OnlineConfig::shrinkage`] = k. A light seen a
+    /// few times (unlucky draws behind an occluder, or once in a bright spot) stays near its
+    /// prior instead of taking its few samples' mean, and one seen many times earns its own.
     fn tables(&self, class: usize) -> LearnedTables {
         let cells = self.spatial.grid().len();
-        let mut learned: Vec<Option<(CellTable, f32)>> = vec![None; cells];
+        let mut learned = CellMixtures::new(cells);
         let mut trained = 0;
+        let k = self.cfg.shrinkage;
         for (cell, sums) in self.sums[class * cells..(class + 1) * cells]
             .iter()
             .enumerate()
@@ -158,9 +175,27 @@ impl OnlineLearner {
             if n < self.cfg.min_records {
                 continue;
             }
+            // The spatial pmf is constant over a cell: its centre stands for all of it.
+            let (c, _) = self.spatial.grid().sphere(cell);
+            let sp = ShadingPoint {
+                p: c,
+                n: Vec3::ZERO,
+                wo: Vec3::ZERO,
+            };
+            let prior: Vec<f64> = sums
+                .keys()
+                .map(|&l| f64::from(self.spatial.pmf(&sp, l)))
+                .collect();
+            let total: f64 = sums.values().map(|s| s.0).sum();
+            let seen: f64 = sums
+                .values()
+                .zip(&prior)
+                .map(|(s, &p)| s.1 as f64 * p)
+                .sum();
+            let scale = if seen > 0.0 { total / seen } else { 0.0 };
             let (mut ids, mut weights) = (Vec::new(), Vec::new());
-            for (&light, &(sum, count)) in sums {
-                let mean = (sum / count.max(1) as f64) as f32;
+            for ((&light, &(sum, count)), &p) in sums.iter().zip(&prior) {
+                let mean = ((sum + k * p * scale) / (count as f64 + k)) as f32;
                 if mean > 0.0 && mean.is_finite() {
                     ids.push(light);
                     weights.push(mean);
@@ -168,17 +203,11 @@ impl OnlineLearner {
             }
             // Spatial mass of the lights measured here (occluded ones included): what the
             // measurements have an opinion about; the rest keeps its spatial probability.
-            let (c, _) = self.spatial.grid().sphere(cell);
-            let sp = ShadingPoint {
-                p: c,
-                n: Vec3::ZERO,
-                wo: Vec3::ZERO,
-            };
-            let mass: f32 = sums.keys().map(|&l| self.spatial.pmf(&sp, l)).sum();
-            let beta = self.cfg.beta.max(1.0 - mass).clamp(0.0, 1.0);
+            let mass: f64 = prior.iter().sum();
+            let beta = self.cfg.beta.max(1.0 - mass as f32).clamp(0.0, 1.0);
             let t = CellTable::new(ids, &weights);
             if t.is_usable() && beta < 1.0 {
-                learned[cell] = Some((t, beta));
+                learned.set(cell, t, beta);
                 trained += 1;
             }
         }
@@ -218,38 +247,21 @@ impl OnlineLearner {
     }
 }
 
-/// One class's learned tables over the spatial grid (as [`super::AdaptiveSelector`]).
+/// One class's learned tables over the spatial grid (the mixture of [`super::AdaptiveSelector`]).
 pub struct LearnedTables {
     spatial: Arc<SpatialSelector>,
-    learned: Vec<Option<(CellTable, f32)>>,
+    learned: CellMixtures,
     /// Cells with a learned table.
     pub trained_cells: usize,
 }
 
-impl LearnedTables {
-    fn learned(&self, ctx: &ShadingPoint) -> (Option<&CellTable>, f32) {
-        let cell = self.spatial.grid().cell(ctx.p);
-        match self.learned.get(cell).and_then(|t| t.as_ref()) {
-            Some((t, beta)) => (Some(t), *beta),
-            None => (None, 1.0),
-        }
-    }
-}
-
 impl FiniteSelector for LearnedTables {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
-        let (learned, b) = self.learned(ctx);
-        let (i, _) = match learned {
-            Some(t) if u >= b => t.pick(((u - b) / (1.0 - b)).min(ONE_MINUS_EPS))?,
-            _ => self.spatial.sample(ctx, (u / b).min(ONE_MINUS_EPS))?,
-        };
-        Some((i, self.pmf(ctx, i)))
+        self.learned.sample(&self.spatial, ctx, u)
     }
 
     fn pmf(&self, ctx: &ShadingPoint, i: u32) -> f32 {
-        let (learned, b) = self.learned(ctx);
-        let l = learned.map_or(0.0, |t| t.prob(i));
-        b * self.spatial.pmf(ctx, i) + (1.0 - b) * l
+        self.learned.pmf(&self.spatial, ctx, i)
     }
 }
 
