@@ -12,9 +12,9 @@
 //! boundary the digests are merged in tile order ([`OnlineLearner::merge`]), which makes the
 //! running averages — and every later round's distribution — independent of the thread count
 //! and schedule. The next round samples from [`OnlineLearner::snapshot`]: per class and cell
-//! p = β·p_spatial + (1 − β)·p_learned (the [`CellMixtures`] of [`super::adaptive`]; each
-//! light's mean shrunk toward its spatial prior by its sample count: [`OnlineConfig::shrinkage`]),
-//! mixed with power selection at
+//! p = β·p_spatial + (1 − β)·p_learned (the [`CellMixtures`] of [`super::adaptive`]; a cell
+//! with few records keeps more of its spatial table: [`OnlineConfig::shrinkage`]), mixed with
+//! power selection at
 //! a share δ ≥ [`DEFENSIVE_FLOOR`] chosen by held-out probe rays of that class
 //! ([`super::defensive`]), so every light with power keeps p > 0 and a table that does not pay
 //! leaves the selector as power selection.
@@ -60,20 +60,21 @@ pub struct OnlineConfig {
     pub min_records: u64,
     /// Share β of the spatial table kept in trained cells.
     pub beta: f32,
-    /// Pseudo-count k of the prior in each light's shrunk mean ([`OnlineLearner`]'s tables):
-    /// its own n_l measurements weigh n_l / (n_l + k).
+    /// Pseudo-count k of the spatial prior in a cell: its n records' table weighs at most
+    /// n / (n + k) beside the spatial table ([`OnlineLearner`]'s tables).
     pub shrinkage: f64,
     /// Seed (the render's seed).
     pub seed: u64,
 }
 
 impl OnlineConfig {
-    /// Defaults: ≥ 64 measurements per cell, β = 20 %, k = 8.
+    /// Defaults: ≥ 16 measurements per cell, β = 20 %, k = 256 (a cell's table takes half
+    /// the probability at 256 records, 80 % from 1024 on).
     pub fn new(seed: u64) -> Self {
         Self {
-            min_records: 64,
+            min_records: 16,
             beta: 0.2,
-            shrinkage: 8.0,
+            shrinkage: 256.0,
             seed,
         }
     }
@@ -156,12 +157,11 @@ impl OnlineLearner {
 
     /// The learned tables of class `class` (0 primary, 1 secondary) from the sums so far.
     ///
-    /// Per cell, the mean of each measured light is shrunk toward the cell's prior, the
-    /// spatial pmf π_l scaled to the cell's measured contribution T̂ = Σ_l Σv_l / Σ_l n_l·π_l
-    /// (the scale at which the measurements agree with the prior in total):
-    /// m̂_l = (Σv_l + k·π_l·T̂) / (n_l + k), [`OnlineConfig::shrinkage`] = k. A light seen a
-    /// few times (unlucky draws behind an occluder, or once in a bright spot) stays near its
-    /// prior instead of taking its few samples' mean, and one seen many times earns its own.
+    /// A cell's table is shrunk toward its prior as a whole: the spatial share there is
+    /// β = max([`OnlineConfig::beta`], spatial mass of the lights never measured in the cell,
+    /// k/(n + k)) for n records and k = [`OnlineConfig::shrinkage`], so a cell with few records
+    /// leans on its spatial table and earns its learned one as its records grow (per-light
+    /// shrinkage toward the spatial prior was measured worse: see docs/many-lights.md).
     fn tables(&self, class: usize) -> LearnedTables {
         let cells = self.spatial.grid().len();
         let mut learned = CellMixtures::new(cells);
@@ -175,27 +175,9 @@ impl OnlineLearner {
             if n < self.cfg.min_records {
                 continue;
             }
-            // The spatial pmf is constant over a cell: its centre stands for all of it.
-            let (c, _) = self.spatial.grid().sphere(cell);
-            let sp = ShadingPoint {
-                p: c,
-                n: Vec3::ZERO,
-                wo: Vec3::ZERO,
-            };
-            let prior: Vec<f64> = sums
-                .keys()
-                .map(|&l| f64::from(self.spatial.pmf(&sp, l)))
-                .collect();
-            let total: f64 = sums.values().map(|s| s.0).sum();
-            let seen: f64 = sums
-                .values()
-                .zip(&prior)
-                .map(|(s, &p)| s.1 as f64 * p)
-                .sum();
-            let scale = if seen > 0.0 { total / seen } else { 0.0 };
             let (mut ids, mut weights) = (Vec::new(), Vec::new());
-            for ((&light, &(sum, count)), &p) in sums.iter().zip(&prior) {
-                let mean = ((sum + k * p * scale) / (count as f64 + k)) as f32;
+            for (&light, &(sum, count)) in sums {
+                let mean = (sum / count.max(1) as f64) as f32;
                 if mean > 0.0 && mean.is_finite() {
                     ids.push(light);
                     weights.push(mean);
@@ -203,8 +185,16 @@ impl OnlineLearner {
             }
             // Spatial mass of the lights measured here (occluded ones included): what the
             // measurements have an opinion about; the rest keeps its spatial probability.
-            let mass: f64 = prior.iter().sum();
-            let beta = self.cfg.beta.max(1.0 - mass as f32).clamp(0.0, 1.0);
+            // The spatial pmf is constant over a cell: its centre stands for all of it.
+            let (c, _) = self.spatial.grid().sphere(cell);
+            let sp = ShadingPoint {
+                p: c,
+                n: Vec3::ZERO,
+                wo: Vec3::ZERO,
+            };
+            let mass: f32 = sums.keys().map(|&l| self.spatial.pmf(&sp, l)).sum();
+            let shrink = (k / (n as f64 + k)) as f32;
+            let beta = self.cfg.beta.max(1.0 - mass).max(shrink).clamp(0.0, 1.0);
             let t = CellTable::new(ids, &weights);
             if t.is_usable() && beta < 1.0 {
                 learned.set(cell, t, beta);
