@@ -96,12 +96,20 @@ impl CellMixtures {
         ctx: &ShadingPoint,
         u: f32,
     ) -> Option<(u32, f32)> {
+        // Each branch's own pick returns its probability: only the other one is looked up
+        // (the same products and sum as `pmf`, so the same bits).
         let (learned, b) = self.at(spatial, ctx);
-        let (i, _) = match learned {
-            Some(t) if u >= b => t.pick(((u - b) / (1.0 - b)).min(ONE_MINUS_EPS))?,
-            _ => spatial.sample(ctx, (u / b).min(ONE_MINUS_EPS))?,
-        };
-        Some((i, self.pmf(spatial, ctx, i)))
+        match learned {
+            Some(t) if u >= b => {
+                let (i, pl) = t.pick(((u - b) / (1.0 - b)).min(ONE_MINUS_EPS))?;
+                Some((i, b * spatial.pmf(ctx, i) + (1.0 - b) * pl))
+            }
+            _ => {
+                let (i, ps) = spatial.sample(ctx, (u / b).min(ONE_MINUS_EPS))?;
+                let pl = learned.map_or(0.0, |t| t.prob(i));
+                Some((i, b * ps + (1.0 - b) * pl))
+            }
+        }
     }
 
     /// Probability that [`Self::sample`] draws light `i` at `ctx`.
