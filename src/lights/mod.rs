@@ -1,9 +1,10 @@
 //! Light sources. Each returns radiance and a **solid-angle** pdf (area pdfs are converted in
 //! one place, [`area_to_solid_angle`]), its power Φ and its bounds (for power and BVH selection).
 //!
-//! One light per file: [`TriangleLight`], [`QuadLight`], [`SphereLight`], [`DiskLight`] (area
-//! lights, area or solid-angle sampling), [`PointLight`], [`SpotLight`], [`DistantLight`]
-//! (delta lights), [`UniformInfiniteLight`] and [`EnvMapLight`] (infinite lights).
+//! One light per file: [`TriangleLight`], [`MaskedTriangleLight`], [`QuadLight`],
+//! [`SphereLight`], [`DiskLight`] (area lights, area or solid-angle sampling), [`PointLight`],
+//! [`SpotLight`], [`DistantLight`] (delta lights), [`UniformInfiniteLight`] and [`EnvMapLight`]
+//! (infinite lights).
 
 use crate::Rgb;
 use glam::{Vec2, Vec3};
@@ -127,6 +128,7 @@ pub(crate) fn spherical_ok(omega: f32) -> bool {
 pub mod disk;
 pub mod distant;
 pub mod envmap;
+pub mod masked;
 pub mod point;
 pub mod quad;
 pub mod sphere;
@@ -137,6 +139,7 @@ pub mod uniform_infinite;
 pub use disk::DiskLight;
 pub use distant::DistantLight;
 pub use envmap::EnvMapLight;
+pub use masked::MaskedTriangleLight;
 pub use point::PointLight;
 pub use quad::QuadLight;
 pub use sphere::SphereLight;
@@ -150,6 +153,8 @@ pub use uniform_infinite::UniformInfiniteLight;
 pub enum Light {
     /// Diffuse emissive triangle.
     Triangle(TriangleLight),
+    /// Diffuse emissive triangle under an alpha cut-out.
+    MaskedTriangle(Box<MaskedTriangleLight>),
     /// Diffuse emissive parallelogram.
     Quad(QuadLight),
     /// Diffuse emissive sphere.
@@ -173,6 +178,7 @@ macro_rules! dispatch {
     ($self:expr, $l:ident => $body:expr) => {
         match $self {
             Light::Triangle($l) => $body,
+            Light::MaskedTriangle($l) => $body,
             Light::Quad($l) => $body,
             Light::Sphere($l) => $body,
             Light::Disk($l) => $body,
@@ -250,6 +256,7 @@ macro_rules! dispatch_emitter {
     ($self:expr, $l:ident => $body:expr, $delta:expr) => {
         match $self {
             Light::Triangle($l) => $body,
+            Light::MaskedTriangle($l) => $body,
             Light::Quad($l) => $body,
             Light::Sphere($l) => $body,
             Light::Disk($l) => $body,

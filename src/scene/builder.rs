@@ -7,10 +7,10 @@ use crate::geometry::{
     Alpha, Geometry, MeshShading, PrimKind, Primitive, Quadric, QuadricKind, Transform,
     interaction::NO_LIGHT, quadric::CutOut,
 };
-use crate::lights::{DiskLight, Light, QuadLight, SphereLight, TriangleLight};
+use crate::lights::{DiskLight, Light, MaskedTriangleLight, QuadLight, SphereLight, TriangleLight};
 use crate::material::Material;
 use anyhow::{Context, bail, ensure};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// Segments around an emissive cylinder's tessellation ([`SceneBuilder::add_cylinder`]).
 pub const CYLINDER_LIGHT_SEGMENTS: u32 = 64;
@@ -183,9 +183,23 @@ impl SceneBuilder {
                             }
                         }
                     }
-                    match TriangleLight::new(p, n, e.l, e.two_sided) {
+                    let light =
+                        TriangleLight::new(p, n, e.l, e.two_sided).and_then(|l| match &alpha {
+                            None => Some(Light::Triangle(l)),
+                            Some(a) => {
+                                // pbrt-v4's default parameterisation without uvs, as the hit
+                                // test's (0,0), (1,0), (1,1).
+                                let uv = match &uvs {
+                                    Some(uv) => v.map(|i| uv[i as usize]),
+                                    None => [Vec2::ZERO, Vec2::X, Vec2::ONE],
+                                };
+                                MaskedTriangleLight::new(l, uv, a.clone())
+                                    .map(|m| Light::MaskedTriangle(Box::new(m)))
+                            }
+                        });
+                    match light {
                         Some(l) => {
-                            self.lights.push(Light::Triangle(l));
+                            self.lights.push(l);
                             (self.lights.len() - 1) as u32
                         }
                         None => NO_LIGHT,
@@ -254,6 +268,28 @@ impl SceneBuilder {
         emission: Option<AreaEmission>,
         alpha: Option<Alpha>,
     ) -> anyhow::Result<()> {
+        if emission.is_some() && alpha.is_some() {
+            // A mask over an emitter must mask its light samples too, which triangle lights
+            // do (`MaskedTriangleLight`): a full sphere or disk becomes the partial one of
+            // full range, tessellated with the same uv (the loader warns).
+            let reverse = q.flip ^ q.to_world.swaps_handedness();
+            let tau = std::f32::consts::TAU;
+            match q.kind {
+                QuadricKind::Sphere { radius } => {
+                    let z = [-radius, radius, tau];
+                    return self.add_partial_sphere(
+                        q.to_world, radius, z, material, emission, reverse, alpha,
+                    );
+                }
+                QuadricKind::Disk { height, radius } => {
+                    let r = [radius, 0.0, tau];
+                    return self.add_partial_disk(
+                        q.to_world, height, r, material, emission, reverse, alpha,
+                    );
+                }
+                _ => {}
+            }
+        }
         self.check_material(material)?;
         q.alpha = alpha.map(|alpha| CutOut {
             alpha,
@@ -299,8 +335,7 @@ impl SceneBuilder {
     }
 
     /// [`SceneBuilder::add_sphere`] with an alpha cut-out over its uv (pbrt-v4's shape
-    /// `alpha`). An emissive one's light is the whole sphere (the light samples ignore the
-    /// mask, as a cut-out mesh's triangle lights do).
+    /// `alpha`). An emissive one becomes masked triangle lights (see `add_quadric`).
     pub fn add_sphere_cut_out(
         &mut self,
         to_world: Transform,

@@ -1167,6 +1167,22 @@ impl Parser {
                 ),
             );
         }
+        if emission.is_some()
+            && alpha.is_some()
+            && matches!(
+                geom,
+                super::shapes::ShapeGeom::Sphere { .. } | super::shapes::ShapeGeom::Disk { .. }
+            )
+        {
+            let (nu, nv) = crate::scene::builder::PARTIAL_LIGHT_GRID;
+            self.warn(
+                "masked-quadric-light",
+                loc,
+                format!(
+                    "emissive \"{ty}\" with an alpha cut-out tessellated into {nu}×{nv}×2 triangle lights (penumbra masks the light samples of triangle lights only)"
+                ),
+            );
+        }
         if emission.is_some() && matches!(geom, super::shapes::ShapeGeom::Curves { .. }) {
             self.warn(
                 "curve-light",
