@@ -5,7 +5,7 @@
 use anyhow::Context;
 use glam::UVec2;
 use penumbra::image::{compare, read_image, write_image};
-use penumbra::integrator::{RenderOptions, Strategy, render};
+use penumbra::integrator::{IntegratorKind, RenderOptions, Strategy, render};
 use penumbra::light_selection::{LightSet, SelectorKind, bvh::BvhSelector, make_selector};
 use penumbra::scene::builtin::{self, BuiltinOptions};
 use penumbra::scene::load::{LoadOptions, load};
@@ -57,6 +57,13 @@ pub struct Args {
     /// With --many-lights: interleaved repetitions of every timing (the median is reported).
     #[arg(long, default_value_t = 3)]
     pub repeats: u32,
+    /// With --many-lights: the light transport of every render, references included
+    /// (`direct` or `path`).
+    #[arg(long, default_value_t = IntegratorKind::Direct)]
+    pub integrator: IntegratorKind,
+    /// With --many-lights and `--integrator path`: the paths' max depth.
+    #[arg(long, default_value_t = 5)]
+    pub max_depth: u32,
 }
 
 /// The scenes benchmarked by default.
@@ -121,7 +128,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// queries and the continuing BSDF rays' one-ray closest-hit queries), so the cost of
 /// incoherence is visible.
 fn path_section(names: &[String], spp: u32, res: UVec2) -> anyhow::Result<()> {
-    use penumbra::integrator::IntegratorKind;
     use penumbra::integrator::stages::TIME_QUERIES;
     use std::sync::atomic::Ordering;
     println!();
@@ -242,9 +248,13 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     println!(
-        "{}x{}, {spp} spp, MIS, one thread, CPU time (median of {} interleaved runs), load average {}",
+        "{}x{}, {spp} spp, MIS, {}, one thread, CPU time (median of {} interleaved runs), load average {}",
         res.x,
         res.y,
+        match args.integrator {
+            IntegratorKind::Direct => "direct lighting".to_string(),
+            IntegratorKind::Path => format!("path tracing (max depth {})", args.max_depth),
+        },
         args.repeats.max(1),
         load_average()
     );
@@ -282,7 +292,7 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
                 let opts = RenderOptions {
                     spp,
                     light_selection: sel,
-                    ..RenderOptions::default()
+                    ..transport(args)
                 };
                 let (img, build, t) = pool.install(|| timed_render(&scene, res, &opts))?;
                 times[j].push((build, t));
@@ -309,7 +319,7 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
                     spp: n_spp,
                     seed: 0x7173_0001,
                     light_selection: sel,
-                    ..RenderOptions::default()
+                    ..transport(args)
                 };
                 let (img, b, t) = pool.install(|| timed_render(&scene, res, &opts))?;
                 at_time[j] = Some((n_spp, compare(&img, &reference)?.rel_mse, b + t));
@@ -344,6 +354,16 @@ fn run_many(args: &Args) -> anyhow::Result<()> {
     bvh_build_benchmark(100_000)
 }
 
+/// The render options of `--many-lights` before spp, seed and selector: MIS, and the
+/// `--integrator` with its `--max-depth`.
+fn transport(args: &Args) -> RenderOptions {
+    RenderOptions {
+        integrator: args.integrator,
+        max_depth: args.max_depth,
+        ..RenderOptions::default()
+    }
+}
+
 /// The built-in options of `--many-lights`.
 fn many_load_options(args: &Args) -> LoadOptions {
     LoadOptions {
@@ -372,8 +392,13 @@ fn many_reference(
         "mean of {} at {ref_spp} spp",
         sels.map(|s| s.to_string()).join("+")
     );
+    // Direct lighting keeps its old file name (and cached references).
+    let depth = match args.integrator {
+        IntegratorKind::Direct => String::new(),
+        IntegratorKind::Path => format!("-path{}", args.max_depth),
+    };
     let path = dir.join(format!(
-        "{name}-{}x{}-{ref_spp}spp-mix3-{:?}-{:?}.pfm",
+        "{name}-{}x{}-{ref_spp}spp-mix3-{:?}-{:?}{depth}.pfm",
         res.x, res.y, args.light_count, args.rooms
     ));
     if let Ok(img) = read_image(&path)
@@ -388,7 +413,7 @@ fn many_reference(
             spp: ref_spp,
             seed: 0x05ee_d4ef + i as u64,
             light_selection: sel,
-            ..RenderOptions::default()
+            ..transport(args)
         };
         let (img, _) = render(scene, res, &opts)?;
         match &mut acc {

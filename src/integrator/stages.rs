@@ -481,7 +481,7 @@ impl<'a> Integrator<'a> {
             let clock = timing.then(Instant::now);
             self.trace_shadows(q);
             if q.learning {
-                self.record(q);
+                self.record(q, t);
             }
             if let Some(c) = clock {
                 let traced = q.nee.active.count_ones() + q.gathered.active.count_ones();
@@ -746,18 +746,25 @@ impl<'a> Integrator<'a> {
         }
     }
 
-    /// After *trace_shadows*, when learning: what each light sample of the round delivered,
-    /// f·Le·G·w/pdf_ω (its value times the selection pmf), zero when its shadow ray was
-    /// blocked or the sample was void, so the learned tables see occlusion.
-    fn record(&self, q: &mut Queues) {
+    /// After *trace_shadows*, when learning: what each light sample of the round would have
+    /// delivered as the only strategy, f·Le·G·V/pdf_ω (its value times the selection pmf,
+    /// without the MIS weight), zero when its shadow ray was blocked or the sample was void,
+    /// so the learned tables see occlusion. Not the MIS-weighted value: its weight falls with
+    /// the light's own selection probability (as p² under the power heuristic), so a light
+    /// learned low would record ever lower values and sink to the defensive floor.
+    fn record(&self, q: &mut Queues, t: Techniques) {
         let secondary = q.paths.depth > 0;
         for k in bits(q.chosen) {
             let sel = q.chosen_light[k];
-            let value = q
-                .nee
-                .clear_value(k)
-                .map_or(0.0, |v| crate::luminance(v) * sel.pmf);
             let Some(sh) = q.view(k) else { continue };
+            let value = match (q.nee.clear_value(k), t.mis()) {
+                (None, _) => 0.0,
+                (Some(v), None) => crate::luminance(v) * sel.pmf,
+                // The same light sample again (same draw), weighed without MIS.
+                (Some(_), Some(_)) => self
+                    .light_sample(&sh, sel, q.drawn.light(k), Techniques::Light)
+                    .map_or(0.0, |(_, v)| crate::luminance(v) * sel.pmf),
+            };
             let p = sh.ctx.p;
             q.records.push(LearnRecord {
                 p,

@@ -57,16 +57,74 @@ impl AdaptiveConfig {
 pub struct AdaptiveSelector {
     spatial: SpatialSelector,
     /// Per cell: learned table and the spatial share β kept there.
-    learned: Vec<Option<(CellTable, f32)>>,
+    learned: CellMixtures,
     /// Number of cells with a learned table.
     pub trained_cells: usize,
+}
+
+/// Per grid cell, an optional learned table and the share β of the spatial table kept beside
+/// it: p = β·p_spatial + (1 − β)·p_learned in trained cells, p_spatial elsewhere. The one
+/// mixture of [`AdaptiveSelector`] and the online selector's tables
+/// ([`super::online::LearnedTables`]), so both sample exactly the pmf they report.
+#[derive(Clone, Default)]
+pub struct CellMixtures(Vec<Option<(CellTable, f32)>>);
+
+impl CellMixtures {
+    /// `cells` untrained cells.
+    pub fn new(cells: usize) -> Self {
+        Self(vec![None; cells])
+    }
+
+    /// Give cell `cell` the learned table `t` beside spatial share `beta`.
+    pub fn set(&mut self, cell: usize, t: CellTable, beta: f32) {
+        self.0[cell] = Some((t, beta));
+    }
+
+    /// The learned table at `ctx`, if its cell was trained, and the spatial share there.
+    fn at(&self, spatial: &SpatialSelector, ctx: &ShadingPoint) -> (Option<&CellTable>, f32) {
+        let cell = spatial.grid().cell(ctx.p);
+        match self.0.get(cell).and_then(|t| t.as_ref()) {
+            Some((t, beta)) => (Some(t), *beta),
+            None => (None, 1.0),
+        }
+    }
+
+    /// Draw from the mixture at `ctx`: the spatial table for u < β, else the learned table.
+    pub fn sample(
+        &self,
+        spatial: &SpatialSelector,
+        ctx: &ShadingPoint,
+        u: f32,
+    ) -> Option<(u32, f32)> {
+        // Each branch's own pick returns its probability: only the other one is looked up
+        // (the same products and sum as `pmf`, so the same bits).
+        let (learned, b) = self.at(spatial, ctx);
+        match learned {
+            Some(t) if u >= b => {
+                let (i, pl) = t.pick(((u - b) / (1.0 - b)).min(ONE_MINUS_EPS))?;
+                Some((i, b * spatial.pmf(ctx, i) + (1.0 - b) * pl))
+            }
+            _ => {
+                let (i, ps) = spatial.sample(ctx, (u / b).min(ONE_MINUS_EPS))?;
+                let pl = learned.map_or(0.0, |t| t.prob(i));
+                Some((i, b * ps + (1.0 - b) * pl))
+            }
+        }
+    }
+
+    /// Probability that [`Self::sample`] draws light `i` at `ctx`.
+    pub fn pmf(&self, spatial: &SpatialSelector, ctx: &ShadingPoint, i: u32) -> f32 {
+        let (learned, b) = self.at(spatial, ctx);
+        let l = learned.map_or(0.0, |t| t.prob(i));
+        b * spatial.pmf(ctx, i) + (1.0 - b) * l
+    }
 }
 
 impl AdaptiveSelector {
     /// Build the grid and train it on `scene`.
     pub fn new(scene: &Scene, set: &LightSet, cfg: &AdaptiveConfig) -> Self {
         let spatial = SpatialSelector::new(scene, set);
-        let mut learned: Vec<Option<(CellTable, f32)>> = vec![None; spatial.grid().len()];
+        let mut learned = CellMixtures::new(spatial.grid().len());
         let mut trained_cells = 0;
         if !set.finite.is_empty() {
             let res = estimate_resolution(scene, cfg.resolution);
@@ -120,7 +178,7 @@ impl AdaptiveSelector {
                     let beta = cfg.beta.max(1.0 - mass).clamp(0.0, 1.0);
                     let t = CellTable::new(ids, &weights);
                     if t.is_usable() && beta < 1.0 {
-                        learned[cell as usize] = Some((t, beta));
+                        learned.set(cell as usize, t, beta);
                         trained_cells += 1;
                     }
                 }
@@ -131,15 +189,6 @@ impl AdaptiveSelector {
             spatial,
             learned,
             trained_cells,
-        }
-    }
-
-    /// The learned table at `ctx`, if its cell was trained, and the spatial share there.
-    fn learned(&self, ctx: &ShadingPoint) -> (Option<&CellTable>, f32) {
-        let cell = self.spatial.grid().cell(ctx.p);
-        match self.learned.get(cell).and_then(|t| t.as_ref()) {
-            Some((t, beta)) => (Some(t), *beta),
-            None => (None, 1.0),
         }
     }
 }
@@ -169,17 +218,10 @@ fn average(records: &[(u32, u32, f32)]) -> (Vec<u32>, Vec<f32>) {
 
 impl FiniteSelector for AdaptiveSelector {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
-        let (learned, b) = self.learned(ctx);
-        let (i, _) = match learned {
-            Some(t) if u >= b => t.pick(((u - b) / (1.0 - b)).min(ONE_MINUS_EPS))?,
-            _ => self.spatial.sample(ctx, (u / b).min(ONE_MINUS_EPS))?,
-        };
-        Some((i, self.pmf(ctx, i)))
+        self.learned.sample(&self.spatial, ctx, u)
     }
 
     fn pmf(&self, ctx: &ShadingPoint, i: u32) -> f32 {
-        let (learned, b) = self.learned(ctx);
-        let l = learned.map_or(0.0, |t| t.prob(i));
-        b * self.spatial.pmf(ctx, i) + (1.0 - b) * l
+        self.learned.pmf(&self.spatial, ctx, i)
     }
 }

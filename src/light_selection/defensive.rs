@@ -228,14 +228,17 @@ impl<S: FiniteSelector> FiniteSelector for Defensive<S> {
             return self.power.pick(u);
         }
         let d = self.delta;
-        let i = if u < d {
-            self.power.pick((u / d).min(ONE_MINUS_EPS))?.0
+        if u < d {
+            let i = self.power.pick((u / d).min(ONE_MINUS_EPS))?.0;
+            Some((i, self.pmf(ctx, i)))
         } else {
-            self.inner
-                .sample(ctx, ((u - d) / (1.0 - d)).min(ONE_MINUS_EPS))?
-                .0
-        };
-        Some((i, self.pmf(ctx, i)))
+            // Every strategy's `sample` returns its own `pmf` of the pick: reuse it (the
+            // same bits as `pmf`, without the strategy's second lookup).
+            let (i, q) = self
+                .inner
+                .sample(ctx, ((u - d) / (1.0 - d)).min(ONE_MINUS_EPS))?;
+            Some((i, d * self.power.prob(i) + (1.0 - d) * q))
+        }
     }
 
     fn pmf(&self, ctx: &ShadingPoint, i: u32) -> f32 {

@@ -3,14 +3,18 @@
 //! hits) and secondary ones (every later path vertex).
 //!
 //! The render runs in rounds of sample indices (`integrator::rounds`). During a round every
-//! light sample the integrator takes records what it delivered ([`LearnRecord`]): the light
-//! sample's share of the estimate f·Le·G·w/pdf_ω (w its MIS weight, 1 without MIS), zero when
-//! the shadow ray is blocked — so occlusion, which no bound knows, is learned. Each tile
+//! light sample the integrator takes records what it would deliver as the only strategy
+//! ([`LearnRecord`]): f·Le·G/pdf_ω *without* its MIS weight (the weight falls with the light's
+//! own selection probability, so a weighted record would push a light learned low ever
+//! lower), zero when the shadow ray is blocked — so occlusion, which no bound knows, is
+//! learned. Each tile
 //! sums its records per (vertex class, cell, light) ([`OnlineLearner::digest`]); at the round
 //! boundary the digests are merged in tile order ([`OnlineLearner::merge`]), which makes the
 //! running averages — and every later round's distribution — independent of the thread count
 //! and schedule. The next round samples from [`OnlineLearner::snapshot`]: per class and cell
-//! p = β·p_spatial + (1 − β)·p_learned as in [`super::adaptive`], mixed with power selection at
+//! p = β·p_spatial + (1 − β)·p_learned (the [`CellMixtures`] of [`super::adaptive`]; a cell
+//! with few records keeps more of its spatial table: [`OnlineConfig::shrinkage`]), mixed with
+//! power selection at
 //! a share δ ≥ [`DEFENSIVE_FLOOR`] chosen by held-out probe rays of that class
 //! ([`super::defensive`]), so every light with power keeps p > 0 and a table that does not pay
 //! leaves the selector as power selection.
@@ -19,12 +23,12 @@
 //! round's frozen distribution (which depends only on earlier rounds), so each round's image is
 //! unbiased and so is their sample-weighted sum.
 
+use super::adaptive::CellMixtures;
 use super::defensive::{self, Defensive, ProbeConfig};
 use super::power::PowerSelector;
 use super::spatial::{CellTable, SpatialSelector};
 use super::{
-    FiniteSelector, GRID_MARGIN, LightSelector, LightSet, ONE_MINUS_EPS, Selector, SelectorKind,
-    ShadingPoint,
+    FiniteSelector, GRID_MARGIN, LightSelector, LightSet, Selector, SelectorKind, ShadingPoint,
 };
 use crate::scene::Scene;
 use glam::Vec3;
@@ -38,7 +42,8 @@ pub struct LearnRecord {
     pub p: Vec3,
     /// Scene index of the selected light.
     pub light: u32,
-    /// Luminance of f·Le·G·w/pdf_ω (not divided by the selection pmf); 0 if blocked.
+    /// Luminance of f·Le·G/pdf_ω without MIS weight (not divided by the selection pmf); 0 if
+    /// blocked.
     pub value: f32,
     /// A vertex after the first (not a camera-ray hit).
     pub secondary: bool,
@@ -55,16 +60,21 @@ pub struct OnlineConfig {
     pub min_records: u64,
     /// Share β of the spatial table kept in trained cells.
     pub beta: f32,
+    /// Pseudo-count k of the spatial prior in a cell: its n records' table weighs at most
+    /// n / (n + k) beside the spatial table ([`OnlineLearner`]'s tables).
+    pub shrinkage: f64,
     /// Seed (the render's seed).
     pub seed: u64,
 }
 
 impl OnlineConfig {
-    /// Defaults: ≥ 64 measurements per cell, β = 20 %.
+    /// Defaults: ≥ 16 measurements per cell, β = 20 %, k = 256 (a cell's table takes half
+    /// the probability at 256 records, 80 % from 1024 on).
     pub fn new(seed: u64) -> Self {
         Self {
-            min_records: 64,
+            min_records: 16,
             beta: 0.2,
+            shrinkage: 256.0,
             seed,
         }
     }
@@ -146,10 +156,17 @@ impl OnlineLearner {
     }
 
     /// The learned tables of class `class` (0 primary, 1 secondary) from the sums so far.
+    ///
+    /// A cell's table is shrunk toward its prior as a whole: the spatial share there is
+    /// β = max([`OnlineConfig::beta`], spatial mass of the lights never measured in the cell,
+    /// k/(n + k)) for n records and k = [`OnlineConfig::shrinkage`], so a cell with few records
+    /// leans on its spatial table and earns its learned one as its records grow (per-light
+    /// shrinkage toward the spatial prior was measured worse: see docs/many-lights.md).
     fn tables(&self, class: usize) -> LearnedTables {
         let cells = self.spatial.grid().len();
-        let mut learned: Vec<Option<(CellTable, f32)>> = vec![None; cells];
+        let mut learned = CellMixtures::new(cells);
         let mut trained = 0;
+        let k = self.cfg.shrinkage;
         for (cell, sums) in self.sums[class * cells..(class + 1) * cells]
             .iter()
             .enumerate()
@@ -168,6 +185,7 @@ impl OnlineLearner {
             }
             // Spatial mass of the lights measured here (occluded ones included): what the
             // measurements have an opinion about; the rest keeps its spatial probability.
+            // The spatial pmf is constant over a cell: its centre stands for all of it.
             let (c, _) = self.spatial.grid().sphere(cell);
             let sp = ShadingPoint {
                 p: c,
@@ -175,10 +193,11 @@ impl OnlineLearner {
                 wo: Vec3::ZERO,
             };
             let mass: f32 = sums.keys().map(|&l| self.spatial.pmf(&sp, l)).sum();
-            let beta = self.cfg.beta.max(1.0 - mass).clamp(0.0, 1.0);
+            let shrink = (k / (n as f64 + k)) as f32;
+            let beta = self.cfg.beta.max(1.0 - mass).max(shrink).clamp(0.0, 1.0);
             let t = CellTable::new(ids, &weights);
             if t.is_usable() && beta < 1.0 {
-                learned[cell] = Some((t, beta));
+                learned.set(cell, t, beta);
                 trained += 1;
             }
         }
@@ -218,38 +237,21 @@ impl OnlineLearner {
     }
 }
 
-/// One class's learned tables over the spatial grid (as [`super::AdaptiveSelector`]).
+/// One class's learned tables over the spatial grid (the mixture of [`super::AdaptiveSelector`]).
 pub struct LearnedTables {
     spatial: Arc<SpatialSelector>,
-    learned: Vec<Option<(CellTable, f32)>>,
+    learned: CellMixtures,
     /// Cells with a learned table.
     pub trained_cells: usize,
 }
 
-impl LearnedTables {
-    fn learned(&self, ctx: &ShadingPoint) -> (Option<&CellTable>, f32) {
-        let cell = self.spatial.grid().cell(ctx.p);
-        match self.learned.get(cell).and_then(|t| t.as_ref()) {
-            Some((t, beta)) => (Some(t), *beta),
-            None => (None, 1.0),
-        }
-    }
-}
-
 impl FiniteSelector for LearnedTables {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
-        let (learned, b) = self.learned(ctx);
-        let (i, _) = match learned {
-            Some(t) if u >= b => t.pick(((u - b) / (1.0 - b)).min(ONE_MINUS_EPS))?,
-            _ => self.spatial.sample(ctx, (u / b).min(ONE_MINUS_EPS))?,
-        };
-        Some((i, self.pmf(ctx, i)))
+        self.learned.sample(&self.spatial, ctx, u)
     }
 
     fn pmf(&self, ctx: &ShadingPoint, i: u32) -> f32 {
-        let (learned, b) = self.learned(ctx);
-        let l = learned.map_or(0.0, |t| t.prob(i));
-        b * self.spatial.pmf(ctx, i) + (1.0 - b) * l
+        self.learned.pmf(&self.spatial, ctx, i)
     }
 }
 
