@@ -268,10 +268,11 @@ impl Bsdf {
     }
 
     /// `(f(wo, wi), pdf(wo, wi))` in one dispatch: MIS light sampling needs both for the same
-    /// pair, and one call instead of two saves a call and a match per light sample.
+    /// pair, and one call instead of two saves a call and a match per light sample. It is the
+    /// BxDF's own `f_pdf`, so the rough dielectrics evaluate their microfacet lobe once.
     #[inline]
     pub fn f_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        dispatch!(self, b => (b.f(wo, wi), b.pdf(wo, wi)))
+        dispatch!(self, b => b.f_pdf(wo, wi))
     }
 
     /// The BSDF for a path whose throughput is `beta`: a dispersive dielectric reached by a

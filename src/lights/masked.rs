@@ -30,6 +30,9 @@ pub struct MaskedTriangleLight {
     pub alpha: Alpha,
     /// Mean coverage over the triangle (constant masks: exact; textures: probed).
     coverage: f32,
+    /// (p1 − p0) × (p2 − p0) / its squared length: barycentrics of a point are two triple
+    /// products with it, so a light sample needs no cross product of the edges.
+    bary_axis: Vec3,
 }
 
 impl MaskedTriangleLight {
@@ -52,11 +55,14 @@ impl MaskedTriangleLight {
                 (sum / (n * n) as f32).max(MIN_POWER_SHARE)
             }
         };
+        let [p0, p1, p2] = tri.p;
+        let n = (p1 - p0).cross(p2 - p0);
         Some(Self {
             tri,
             uv,
             alpha,
             coverage,
+            bary_axis: n / n.length_squared(),
         })
     }
 
@@ -69,10 +75,8 @@ impl MaskedTriangleLight {
     /// Barycentrics of `p` (a point on the triangle's plane), clamped onto the triangle.
     fn barycentrics(&self, p: Vec3) -> [f32; 3] {
         let [p0, p1, p2] = self.tri.p;
-        let n = (p1 - p0).cross(p2 - p0);
-        let inv = 1.0 / n.length_squared();
-        let b1 = ((p - p0).cross(p2 - p0).dot(n) * inv).max(0.0);
-        let b2 = ((p1 - p0).cross(p - p0).dot(n) * inv).max(0.0);
+        let b1 = (p - p0).cross(p2 - p0).dot(self.bary_axis).max(0.0);
+        let b2 = (p1 - p0).cross(p - p0).dot(self.bary_axis).max(0.0);
         let s = b1 + b2;
         let (b1, b2) = if s > 1.0 { (b1 / s, b2 / s) } else { (b1, b2) };
         [1.0 - b1 - b2, b1, b2]
