@@ -43,6 +43,15 @@ fn pfm_bytes(img: &Image, name: &str) -> Vec<u8> {
     bytes
 }
 
+/// `f` run on a pool of `threads` threads.
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool")
+        .install(f)
+}
+
 /// The rounds merge their tiles' records in tile order: one thread and two give the same
 /// PFM bytes, for direct lighting and for paths (whose secondary vertices learn too).
 #[test]
@@ -52,11 +61,7 @@ fn online_is_the_same_image_on_one_and_two_threads() {
     for integrator in [IntegratorKind::Direct, IntegratorKind::Path] {
         let o = opts(SelectorKind::Online, 6, 3, integrator);
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("pool");
-            let (img, _) = pool.install(|| render(&scene, res, &o)).expect("render");
+            let (img, _) = on_threads(threads, || render(&scene, res, &o)).expect("render");
             pfm_bytes(&img, &format!("{integrator}-{threads}"))
         };
         assert!(run(1) == run(2), "{integrator}: online depends on threads");
@@ -257,4 +262,31 @@ fn online_keeps_every_light_with_power() {
             }
         }
     }
+}
+
+/// On many-mesh no learned distribution beats power selection (docs/many-lights.md): once
+/// the primary tables are mature and their probes still keep δ = 1, learning stops and the
+/// rest of the render is one round of power selection — fewer rounds than 1, 1, 2, 4, …
+/// would take — and the image is still the same on one and two threads.
+#[test]
+fn online_settles_on_power_where_learning_does_not_pay() {
+    let scene = load("many-mesh", &LoadOptions::default())
+        .expect("built-in scene")
+        .scene;
+    // 4800 records per spp: the tables are mature (prior share ≤ ½) after 64 spp.
+    let res = UVec2::new(80, 60);
+    let o = opts(SelectorKind::Online, 256, 7, IntegratorKind::Direct);
+    let run = |threads: usize| {
+        let (img, stats) = on_threads(threads, || render(&scene, res, &o)).expect("render");
+        (pfm_bytes(&img, &format!("settle-{threads}")), stats.rounds)
+    };
+    let (one, rounds) = run(1);
+    let full = penumbra::integrator::online_rounds(0..256).len() as u32;
+    assert!(
+        rounds < full,
+        "{rounds} rounds of {full}: online never settled"
+    );
+    let (two, rounds2) = run(2);
+    assert_eq!(rounds, rounds2);
+    assert!(one == two, "settled online depends on threads");
 }

@@ -48,8 +48,9 @@ pub fn shadow_ray(hit: &SurfaceHit, target: Vec3) -> Ray {
 /// The light-sampling estimate f·Li·cos / (pmf·pdf) of light sample `ls` (its light picked
 /// with probability `pmf`) at a receiver with BSDF `bsdf`, shading `frame`, local `wo_local`,
 /// context `ctx` and hit `hit`, weighted by heuristic `mis` against BSDF sampling when given:
-/// the shadow ray it needs and its value if that ray is clear (`None` when it is zero anyway).
-/// pbrt-v4's `SampleLd` after the light is chosen and sampled.
+/// the shadow ray it needs, its value if that ray is clear (`None` when it is zero anyway) and
+/// the MIS weight inside that value (1 without MIS or for a delta light: `online` selection
+/// records the value without it). pbrt-v4's `SampleLd` after the light is chosen and sampled.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(super) fn light_estimate(
@@ -61,7 +62,7 @@ pub(super) fn light_estimate(
     ctx: &LightSampleContext,
     hit: &SurfaceHit,
     mis: Option<MisHeuristic>,
-) -> Option<(Ray, Rgb)> {
+) -> Option<(Ray, Rgb, f32)> {
     // The hemisphere rule; a reflecting BSDF's needs no shading cosine, so it is decided
     // before the frame change, as the lane kernels have always done it.
     let transmits = bsdf.transmits();
@@ -93,7 +94,7 @@ pub(super) fn light_estimate(
         Some(h) => h.weight(pdf, bsdf_pdf),
         None => 1.0,
     };
-    Some((shadow_ray(hit, ls.p_light), f * ls.li * (w / pdf)))
+    Some((shadow_ray(hit, ls.p_light), f * ls.li * (w / pdf), w))
 }
 
 /// A sampled BSDF direction as a ray, before what it reaches is known.

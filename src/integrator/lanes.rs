@@ -254,12 +254,12 @@ impl TriangleLightLanes {
                 ),
                 None => None,
             };
-            let (ok, ray, value) = match est {
-                Some((ray, value)) => (true, ray, value),
-                None => (false, Ray::new(Vec3::ZERO, Vec3::ZERO), Rgb::ZERO),
+            let (ok, ray, value, w) = match est {
+                Some((ray, value, w)) => (true, ray, value, w),
+                None => (false, Ray::new(Vec3::ZERO, Vec3::ZERO), Rgb::ZERO, 1.0),
             };
             self.ok[k] = ok;
-            out.put(k, &ray, value);
+            out.put_weighted(k, &ray, value, w);
         }
     }
 }
@@ -469,12 +469,13 @@ mod tests {
                     });
                     let what = format!("{isa:?} round {round} lane {k}");
                     assert_eq!(out.active >> k & 1 != 0, want.is_some(), "{what}");
-                    if let Some((ray, value)) = want {
+                    if let Some((ray, value, w)) = want {
                         let got = out.rays.ray(k);
                         assert_eq!(bits(got.o), bits(ray.o), "{what}");
                         assert_eq!(bits(got.d), bits(ray.d), "{what}");
                         assert_eq!(got.t_max.to_bits(), ray.t_max.to_bits(), "{what}");
                         assert_eq!(bits(out.value(k)), bits(value), "{what}");
+                        assert_eq!(out.weight(k).to_bits(), w.to_bits(), "{what}");
                         checked += 1;
                     }
                 }

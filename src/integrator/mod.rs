@@ -17,6 +17,8 @@ mod rounds;
 pub mod stages;
 
 pub use render::{RenderStats, render};
+/// The sample ranges of `online` selection's rounds (1, 1, 2, 4, … spp) for a sample range.
+pub use rounds::rounds as online_rounds;
 
 use crate::bsdf::LobeSampling;
 use crate::light_selection::SelectorKind;

@@ -118,6 +118,15 @@ impl CameraPacket {
         }
     }
 
+    /// Copy the lanes (not the rays) into `to`, the packet's place in a wave, whose rays are
+    /// then made in place: the rays are most of a packet's bytes.
+    #[inline]
+    pub fn complete(&self, to: &mut CameraPacket) {
+        to.n = self.n;
+        to.pixel = self.pixel;
+        to.eye = self.eye;
+    }
+
     /// Mask of the lanes in use.
     pub(super) fn active(&self) -> u32 {
         ((1u64 << self.n) - 1) as u32
@@ -422,6 +431,9 @@ pub(super) struct ShadowRays {
     pub(super) active: u32,
     pub(super) rays: RayPacket,
     value: V3,
+    /// Per lane: the MIS weight inside `value` (1 without MIS), so `online`'s records can
+    /// take the light sample's unweighted value without sampling the light again.
+    weight: [f32; PACKET],
     /// After [`Self::resolve`]: the active lanes whose rays are clear.
     clear: u32,
 }
@@ -433,6 +445,7 @@ impl ShadowRays {
             active: 0,
             rays: RayPacket::from_rays(&[Ray::new(Vec3::ZERO, Vec3::Z); PACKET]),
             value: V3::ZERO,
+            weight: [1.0; PACKET],
             clear: 0,
         }
     }
@@ -442,6 +455,20 @@ impl ShadowRays {
     pub(super) fn put(&mut self, k: usize, ray: &Ray, value: Rgb) {
         self.rays.set(k, ray);
         self.value.set(k, value);
+    }
+
+    /// Lane k's ray, value and the MIS weight inside the value, not (yet) active.
+    #[inline(always)]
+    pub(super) fn put_weighted(&mut self, k: usize, ray: &Ray, value: Rgb, weight: f32) {
+        self.put(k, ray, value);
+        self.weight[k] = weight;
+    }
+
+    /// Make lane k active with `ray`, `value` and the MIS weight inside the value.
+    #[inline]
+    pub(super) fn set_weighted(&mut self, k: usize, ray: &Ray, value: Rgb, weight: f32) {
+        self.active |= 1 << k;
+        self.put_weighted(k, ray, value, weight);
     }
 
     /// Make lane k active with `ray` and `value`.
@@ -471,6 +498,12 @@ impl ShadowRays {
     #[inline]
     pub(super) fn clear_value(&self, k: usize) -> Option<Rgb> {
         (self.clear >> k & 1 != 0).then(|| self.value.get(k))
+    }
+
+    /// The MIS weight of lane k's value (as last written by a `*_weighted` call).
+    #[inline]
+    pub(super) fn weight(&self, k: usize) -> f32 {
+        self.weight[k]
     }
 
     /// Add to `sums` each lane's value where its ray is clear, zero elsewhere, for the lanes

@@ -37,7 +37,7 @@ const SPLAT_SPAN: usize = 17;
 struct TileWork {
     /// One per pixel of a tile (a pixel's slot is its index in the tile).
     pxs: Vec<PixelSamples>,
-    /// The wave's camera packets.
+    /// The wave's camera packets, all [`WAVE`] of them kept (their rays are made in place).
     cams: Vec<CameraPacket>,
     /// Per camera packet: its lanes' filter weights.
     weights: Vec<[f32; PACKET]>,
@@ -60,9 +60,9 @@ impl TileWork {
                     px
                 })
                 .collect(),
-            cams: Vec::with_capacity(WAVE),
-            weights: Vec::with_capacity(WAVE),
-            us: Vec::with_capacity(WAVE),
+            cams: vec![CameraPacket::new(); WAVE],
+            weights: vec![[1.0; PACKET]; WAVE],
+            us: vec![[Vec2::ZERO; PACKET]; WAVE],
             radiance: vec![Rgb::ZERO; WAVE * PACKET],
             queues: Queues::new(),
             wave: Wave::new(),
@@ -81,6 +81,9 @@ pub struct RenderStats {
     pub by_kind: RayCounts,
     /// Samples whose radiance was NaN/Inf and were dropped.
     pub non_finite: u64,
+    /// Render loops the samples took: 1, or `online` selection's rounds (fewer than
+    /// [`super::online_rounds`] once its learning has settled on power selection).
+    pub rounds: u32,
 }
 
 impl RenderStats {
@@ -222,16 +225,16 @@ pub(super) fn render_with(
                 queues,
                 wave,
             } = work;
-            cams.clear();
-            weights.clear();
-            us.clear();
-            queues.learning = learner.is_some();
+            queues.learning = learner.map_or(0, OnlineLearner::learning);
             queues.records.clear();
+            // The wave's packets before `filled` are complete; the lanes of the next one fill
+            // `cam`, whose rays are made straight into its place in the wave.
+            let mut filled = 0;
             let mut cam = CameraPacket::new();
             let (mut tile_rays, mut tile_bad) = (RayCounts::default(), 0u64);
-            let mut flush = |cams: &mut Vec<CameraPacket>,
-                             weights: &mut Vec<[f32; PACKET]>,
-                             us: &mut Vec<[Vec2; PACKET]>,
+            let mut flush = |cams: &[CameraPacket],
+                             weights: &[[f32; PACKET]],
+                             us: &[[Vec2; PACKET]],
                              pxs: &[PixelSamples]| {
                 let counts = est.li_wave(pxs, cams, radiance, queues, wave);
                 tile_rays.add(&counts);
@@ -283,50 +286,40 @@ pub(super) fn render_with(
                             }
                         }
                     }
-                    cams.clear();
-                    weights.clear();
-                    us.clear();
                     return;
                 }
-                // A pixel's consecutive samples are summed in a register, the same additions
-                // in the same order (through `sums`: 3 % of cornell direct, AVX-512, perf).
-                let mut run: Option<(usize, Rgb)> = None;
-                for (i, (cam, weight)) in cams.iter().zip(weights.iter()).enumerate() {
-                    for k in 0..cam.n {
-                        // Filters with negative lobes weight their samples (mean weight
-                        // 1); box, tent and gaussian samples all weigh exactly 1.
-                        let l = radiance[i * PACKET + k];
-                        let l = if filter.is_analytic() {
-                            l
-                        } else {
-                            l * weight[k]
-                        };
+                // A pixel's consecutive samples are summed in a register (`sum`, of pixel
+                // `cur`), the same additions in the same order (through `sums`: 3 % of cornell
+                // direct, AVX-512, perf).
+                // Filters with negative lobes weight their samples (mean weight 1); box, tent
+                // and gaussian samples all weigh exactly 1.
+                let analytic = filter.is_analytic();
+                let (mut cur, mut sum) = (usize::MAX, Rgb::ZERO);
+                for (i, (cam, weight)) in cams.iter().zip(weights).enumerate() {
+                    for (k, &l) in radiance[i * PACKET..][..cam.n].iter().enumerate() {
+                        let l = if analytic { l } else { l * weight[k] };
                         if !l.is_finite() {
                             tile_bad += 1;
                             continue;
                         }
                         let slot = cam.pixel[k] as usize;
-                        match &mut run {
-                            Some((s, sum)) if *s == slot => *sum += l,
-                            _ => {
-                                if let Some((s, sum)) = run {
-                                    sums[s] = sum;
-                                }
-                                run = Some((slot, sums[slot] + l));
+                        if slot != cur {
+                            if cur != usize::MAX {
+                                sums[cur] = sum;
                             }
+                            (cur, sum) = (slot, sums[slot]);
                         }
+                        sum += l;
                     }
                 }
-                if let Some((s, sum)) = run {
-                    sums[s] = sum;
+                if cur != usize::MAX {
+                    sums[cur] = sum;
                 }
-                cams.clear();
-                weights.clear();
-                us.clear();
             };
             // Per lane: the pixel and filter draw; the camera rays of a full packet are then
             // made all at once (16 lanes of vector sqrt / division instead of a scalar chain).
             let mut lanes = CameraLanes::new();
+            let lens = camera.needs_lens_sample();
             for y in y0..y1 {
                 for x in x0..x1 {
                     if opts.is_cancelled() {
@@ -340,33 +333,36 @@ pub(super) fn render_with(
                         let k = cam.n;
                         lanes.pixel[k] = pixel;
                         lanes.u[k] = pxs[slot].sample_2d(DIM_FILTER, i, opts.spp);
-                        if camera.needs_lens_sample() {
+                        if lens {
                             lanes.lens[k] = pxs[slot].sample_2d(DIM_LENS, i, opts.spp);
                         }
                         cam.pixel[k] = slot as u8;
                         cam.eye[k] = i;
                         cam.n = k + 1;
                         if cam.is_full() {
-                            lanes.rays(cpu, &camera, &filter, &mut cam.rays);
-                            cams.push(cam);
-                            weights.push(lanes.weight);
-                            us.push(lanes.u);
-                            cam.clear();
-                            if cams.len() == WAVE {
+                            cam.complete(&mut cams[filled]);
+                            lanes.rays(cpu, &camera, &filter, &mut cams[filled].rays);
+                            weights[filled] = lanes.weight;
+                            us[filled] = lanes.u;
+                            filled += 1;
+                            if filled == WAVE {
                                 flush(cams, weights, us, pxs);
+                                filled = 0;
                             }
+                            cam.clear();
                         }
                     }
                 }
             }
             if cam.n > 0 {
-                lanes.rays(cpu, &camera, &filter, &mut cam.rays);
-                cams.push(cam);
-                weights.push(lanes.weight);
-                us.push(lanes.u);
+                cam.complete(&mut cams[filled]);
+                lanes.rays(cpu, &camera, &filter, &mut cams[filled].rays);
+                weights[filled] = lanes.weight;
+                us[filled] = lanes.u;
+                filled += 1;
             }
-            if !cams.is_empty() {
-                flush(cams, weights, us, pxs);
+            if filled > 0 {
+                flush(&cams[..filled], &weights[..filled], &us[..filled], pxs);
             }
             let out = if splat {
                 TileOut::Splats(splats)
@@ -432,6 +428,7 @@ pub(super) fn render_with(
         rays: rays.into_inner(),
         by_kind: counts.into_inner().unwrap_or_default(),
         non_finite: bad.into_inner(),
+        rounds: 1,
     };
     if stats.non_finite > 0 {
         eprintln!(

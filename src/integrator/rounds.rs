@@ -4,7 +4,9 @@
 //! it, frozen for the round, and records what its light samples delivered; the tiles' records
 //! are merged in tile order at the round's end ([`OnlineLearner::merge`]), so the image is the
 //! same for any thread count. Each round is unbiased for its own distribution, and the rounds
-//! are added by their sample counts ([`Accumulator`]).
+//! are added by their sample counts ([`Accumulator`]). Once every vertex class has settled on
+//! power selection ([`OnlineLearner::advance`]), the remaining samples are one round: nothing
+//! is learned any more.
 
 use super::RenderOptions;
 use super::render::{RenderStats, render_with};
@@ -41,17 +43,29 @@ pub fn render_online(
     let secondary = opts.depth() > 1;
     let mut acc = Accumulator::new(res);
     let mut total: Option<RenderStats> = None;
-    let all = rounds(samples);
-    let last = all.len().saturating_sub(1);
-    for (i, round) in all.into_iter().enumerate() {
-        let selector = learner.selector(scene, secondary);
+    let all = rounds(samples.clone());
+    let mut next = 0;
+    while next < all.len() {
+        let selector = learner.advance(scene, secondary);
+        // Once every class has settled on power selection, the rest is one round: nothing
+        // is learned any more, and a pixel's samples share its pattern set-up again.
+        let round = if learner.settled(secondary) {
+            all[next].start..samples.end
+        } else {
+            all[next].clone()
+        };
+        next = if round.end == samples.end {
+            all.len()
+        } else {
+            next + 1
+        };
         let count = round.len() as u32;
         let ropts = RenderOptions {
             sample_range: Some(round),
             ..opts.clone()
         };
         // The last round's records would teach no later round.
-        let learn = (i < last).then_some(&learner);
+        let learn = (next < all.len() && learner.learning() != 0).then_some(&learner);
         let (img, stats, digests) = render_with(scene, res, &ropts, selector.as_ref(), learn)?;
         learner.merge(&digests);
         acc.add(&img, count);
@@ -62,6 +76,7 @@ pub fn render_online(
                 t.rays += stats.rays;
                 t.by_kind.add(&stats.by_kind);
                 t.non_finite += stats.non_finite;
+                t.rounds += stats.rounds;
                 t
             }
         });

@@ -117,9 +117,10 @@ pub struct Queues {
     gathered: ShadowRays,
     /// Per lane: the sum over this vertex's rounds.
     sums: [Rgb; PACKET],
-    /// Record what every light sample delivered (`online` selection's rounds).
-    pub learning: bool,
-    /// Lanes that selected a light this round (when `learning`).
+    /// Record what the light samples of these vertex classes delivered (`online`
+    /// selection's rounds): bit 0 primary vertices, bit 1 secondary ones; 0 records nothing.
+    pub learning: u8,
+    /// Lanes that selected a light this round (when their class is `learning`).
     chosen: u32,
     /// Per `chosen` lane: the light and its pmf.
     chosen_light: [SelectedLight; PACKET],
@@ -157,7 +158,7 @@ impl Queues {
             nee: ShadowRays::new(),
             gathered: ShadowRays::new(),
             sums: [Rgb::ZERO; PACKET],
-            learning: false,
+            learning: 0,
             chosen: 0,
             chosen_light: [SelectedLight { index: 0, pmf: 0.0 }; PACKET],
             records: Vec::new(),
@@ -480,7 +481,7 @@ impl<'a> Integrator<'a> {
             self.gather_emitters(q, t, on);
             let clock = timing.then(Instant::now);
             self.trace_shadows(q);
-            if q.learning {
+            if q.chosen != 0 {
                 self.record(q, t);
             }
             if let Some(c) = clock {
@@ -628,6 +629,7 @@ impl<'a> Integrator<'a> {
         let uniform =
             (self.selector.kind() == SelectorKind::Uniform).then_some(scene.lights.len() as u32);
         let secondary = q.paths.depth > 0;
+        let learning = q.learning >> u8::from(secondary) & 1 != 0;
         for k in bits(q.shaded) {
             let u = q.drawn.light_select[k];
             let sel = match uniform {
@@ -638,7 +640,7 @@ impl<'a> Integrator<'a> {
                 },
             };
             let Some(sel) = sel else { continue };
-            if q.learning {
+            if learning {
                 q.chosen |= 1 << k;
                 q.chosen_light[k] = sel;
             }
@@ -662,8 +664,8 @@ impl<'a> Integrator<'a> {
         }
         for k in bits(q.lone_light) {
             let Some(sh) = q.view(k) else { continue };
-            if let Some((r, v)) = self.light_sample(&sh, q.picked[k], q.drawn.light(k), t) {
-                q.nee.set(k, &r, v);
+            if let Some((r, v, w)) = self.light_sample(&sh, q.picked[k], q.drawn.light(k), t) {
+                q.nee.set_weighted(k, &r, v, w);
                 rays += 1;
             }
         }
@@ -757,13 +759,17 @@ impl<'a> Integrator<'a> {
         for k in bits(q.chosen) {
             let sel = q.chosen_light[k];
             let Some(sh) = q.view(k) else { continue };
+            let w = q.nee.weight(k);
             let value = match (q.nee.clear_value(k), t.mis()) {
                 (None, _) => 0.0,
                 (Some(v), None) => crate::luminance(v) * sel.pmf,
-                // The same light sample again (same draw), weighed without MIS.
+                // The value without its MIS weight: the weight divided out (sampling the
+                // light again cost 43 % of the recording, many-mesh callgrind), unless it
+                // underflowed, then the same light sample again (same draw) without MIS.
+                (Some(v), Some(_)) if w > 0.0 => crate::luminance(v) * (sel.pmf / w),
                 (Some(_), Some(_)) => self
                     .light_sample(&sh, sel, q.drawn.light(k), Techniques::Light)
-                    .map_or(0.0, |(_, v)| crate::luminance(v) * sel.pmf),
+                    .map_or(0.0, |(_, v, _)| crate::luminance(v) * sel.pmf),
             };
             let p = sh.ctx.p;
             q.records.push(LearnRecord {
@@ -942,7 +948,7 @@ impl<'a> Integrator<'a> {
         sel: SelectedLight,
         u: Vec2,
         t: Techniques,
-    ) -> Option<(Ray, Rgb)> {
+    ) -> Option<(Ray, Rgb, f32)> {
         let light = &self.scene.lights[sel.index as usize];
         let ls = light.sample_li(sh.ctx, u, self.mode())?;
         light_estimate(

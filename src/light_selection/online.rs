@@ -63,6 +63,9 @@ pub struct OnlineConfig {
     /// Pseudo-count k of the spatial prior in a cell: its n records' table weighs at most
     /// n / (n + k) beside the spatial table ([`OnlineLearner`]'s tables).
     pub shrinkage: f64,
+    /// A class whose probes keep power selection (δ = 1) once its tables' spatial share
+    /// ([`LearnedTables::prior_share`]) is at most this settles on power selection.
+    pub settle_below: f64,
     /// Seed (the render's seed).
     pub seed: u64,
 }
@@ -75,6 +78,7 @@ impl OnlineConfig {
             min_records: 16,
             beta: 0.2,
             shrinkage: 256.0,
+            settle_below: 0.5,
             seed,
         }
     }
@@ -92,6 +96,9 @@ pub struct OnlineLearner {
     cfg: OnlineConfig,
     /// Records merged so far, per class.
     pub records: [u64; 2],
+    /// Per class: settled on power selection for the rest of the render (see
+    /// [`Self::advance`]): no more probes, records or tables.
+    frozen: [bool; 2],
 }
 
 impl OnlineLearner {
@@ -106,7 +113,20 @@ impl OnlineLearner {
             sums: vec![CellSums::new(); 2 * cells],
             cfg,
             records: [0; 2],
+            frozen: [false; 2],
         }
+    }
+
+    /// The vertex classes whose light samples the next round records: bit 0 primary, bit 1
+    /// secondary (the classes not yet settled on power selection).
+    pub fn learning(&self) -> u8 {
+        u8::from(!self.frozen[0]) | u8::from(!self.frozen[1]) << 1
+    }
+
+    /// Whether every class the render has (`secondary`: paths past their first vertex) has
+    /// settled on power selection: the rest of the render needs no rounds.
+    pub fn settled(&self, secondary: bool) -> bool {
+        self.frozen[0] && (!secondary || self.frozen[1])
     }
 
     /// Sum one tile's records per (class, cell, light). Records of lights without bounds
@@ -167,12 +187,16 @@ impl OnlineLearner {
         let mut learned = CellMixtures::new(cells);
         let mut trained = 0;
         let k = self.cfg.shrinkage;
+        // Σ n·β over the cells with records (β = 1 where the cell keeps its spatial table).
+        let (mut records, mut prior) = (0u64, 0.0f64);
         for (cell, sums) in self.sums[class * cells..(class + 1) * cells]
             .iter()
             .enumerate()
         {
             let n: u64 = sums.values().map(|s| s.1).sum();
+            records += n;
             if n < self.cfg.min_records {
+                prior += n as f64;
                 continue;
             }
             let (mut ids, mut weights) = (Vec::new(), Vec::new());
@@ -199,12 +223,20 @@ impl OnlineLearner {
             if t.is_usable() && beta < 1.0 {
                 learned.set(cell, t, beta);
                 trained += 1;
+                prior += n as f64 * f64::from(beta);
+            } else {
+                prior += n as f64;
             }
         }
         LearnedTables {
             spatial: Arc::clone(&self.spatial),
             learned,
             trained_cells: trained,
+            prior_share: if records > 0 {
+                prior / records as f64
+            } else {
+                1.0
+            },
         }
     }
 
@@ -214,6 +246,11 @@ impl OnlineLearner {
     pub fn snapshot(&self, scene: &Scene, secondary: bool) -> OnlineSnapshot {
         let power = PowerSelector::new(&self.set.bounds);
         let mix = |class: usize| {
+            if self.frozen[class] {
+                // Settled on power selection: δ = 1 never consults the tables.
+                let tables = LearnedTables::untrained(Arc::clone(&self.spatial));
+                return Defensive::with_share(tables, power.clone(), 1.0);
+            }
             let tables = self.tables(class);
             let mut cfg = ProbeConfig::new(self.cfg.seed, GRID_MARGIN);
             cfg.primary = class == 0;
@@ -229,11 +266,32 @@ impl OnlineLearner {
 
     /// [`Self::snapshot`] wrapped as the render's selector.
     pub fn selector(&self, scene: &Scene, secondary: bool) -> Box<dyn LightSelector> {
+        self.wrap(self.snapshot(scene, secondary))
+    }
+
+    /// A snapshot as the render's selector.
+    fn wrap(&self, snap: OnlineSnapshot) -> Box<dyn LightSelector> {
         Box::new(Selector::new(
             SelectorKind::Online,
             self.set.clone(),
-            Box::new(self.snapshot(scene, secondary)),
+            Box::new(snap),
         ))
+    }
+
+    /// The next round's selector ([`Self::selector`]), settling each class whose probes kept
+    /// power selection (δ = 1) although its tables were already mature
+    /// ([`OnlineConfig::settle_below`]): on a scene where the learned distribution does not
+    /// pay (many-mesh), more records would only cost time. The decision depends only on the
+    /// merged records and the seed, so the image stays the same for any thread count.
+    pub fn advance(&mut self, scene: &Scene, secondary: bool) -> Box<dyn LightSelector> {
+        let snap = self.snapshot(scene, secondary);
+        for class in 0..1 + usize::from(secondary) {
+            let mix = snap.class(class == 1);
+            if mix.share() >= 1.0 && mix.inner().prior_share <= self.cfg.settle_below {
+                self.frozen[class] = true;
+            }
+        }
+        self.wrap(snap)
     }
 }
 
@@ -243,6 +301,23 @@ pub struct LearnedTables {
     learned: CellMixtures,
     /// Cells with a learned table.
     pub trained_cells: usize,
+    /// The spatial table's share β where the records fell (record-weighted mean over the
+    /// cells, 1 in untrained cells): how much the learned tables could still change the
+    /// distribution the probes judged.
+    pub prior_share: f64,
+}
+
+impl LearnedTables {
+    /// No learned table: the spatial grid alone.
+    fn untrained(spatial: Arc<SpatialSelector>) -> Self {
+        let cells = spatial.grid().len();
+        Self {
+            spatial,
+            learned: CellMixtures::new(cells),
+            trained_cells: 0,
+            prior_share: 1.0,
+        }
+    }
 }
 
 impl FiniteSelector for LearnedTables {
