@@ -73,6 +73,7 @@ fn estimate(scene: &Scene, strategy: Strategy, pattern: PatternKind, m: u32) -> 
         mis_light: penumbra::lights::SamplingMode::SolidAngle,
         max_depth: 1,
         roulette: false,
+        hide_emitters: false,
     };
     // A ray that reaches the origin from the side, clear of lights above it.
     let o = Vec3::new(0.0, -3.0, 1.0);

@@ -38,6 +38,7 @@ fn check(
         mis_light: SamplingMode::Area,
         max_depth: 1,
         roulette: false,
+        hide_emitters: false,
     };
     let res = UVec2::new(24, 24);
     let camera = scene.camera.rays(res);

@@ -632,6 +632,7 @@ fn measure(b: &Built, c: &Case, cfg: &Config, seed: u64) -> Vec<(f64, f64)> {
         mis_light: cfg.mis_light,
         max_depth: 1,
         roulette: false,
+        hide_emitters: false,
     };
     let mut r = Rng::new(&[0x51ed, c.id, seed]);
     let s = c.size;

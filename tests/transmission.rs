@@ -109,6 +109,7 @@ fn estimate(
         mis_light: penumbra::lights::SamplingMode::SolidAngle,
         max_depth: 1,
         roulette: false,
+        hide_emitters: false,
     };
     let pixels = 2000u32;
     let (mut s, mut s2) = (0.0f64, 0.0f64);

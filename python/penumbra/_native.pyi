@@ -48,6 +48,7 @@ class Scene:
         spp_range: Optional[Tuple[int, int]] = None,
         mis_light: str = "solid-angle",
         bsdf_sampling: str = "importance",
+        hide_emitters: bool = False,
     ) -> npt.NDArray[np.float32]:
         """Render; float32 (height, width, 3) linear RGB, bit for bit the CLI's image.
 
@@ -55,7 +56,9 @@ class Scene:
         light_selection: uniform | power | spatial | adaptive | wald | bvh | exhaustive;
         pattern: fixed | random | grid | stratified | lhs | sobol; integrator: direct | path
         (max_depth: bounces of path, default 5);
-        mis_light: solid-angle | area; bsdf_sampling: importance | cosine | uniform.
+        mis_light: solid-angle | area; bsdf_sampling: importance | cosine | uniform;
+        hide_emitters: emitters seen directly by camera rays are black (Mitsuba's
+        hide_emitters), the light they cast is unchanged.
         spp_range=(a, b) renders sample indices [a, b) of spp (see `penumbra.merge`).
         The GIL is released; Ctrl-C raises KeyboardInterrupt; bad values raise ValueError.
         """

@@ -147,7 +147,9 @@ impl Scene {
     /// the scene file's), `max_depth` (path: bounces, pbrt-v4's maxdepth; default: the file's,
     /// else 5), `res` ((w, h)
     /// or "WxH"; default: the scene's), `seed`, `threads` (the image does not depend on it),
-    /// `mis_light` (solid-angle, area), `bsdf_sampling` (importance, cosine, uniform).
+    /// `mis_light` (solid-angle, area), `bsdf_sampling` (importance, cosine, uniform),
+    /// `hide_emitters` (the CLI's `--hide-emitters`, Mitsuba 3's `hide_emitters`: emitters
+    /// seen directly by camera rays are black, the light they cast is unchanged).
     ///
     /// `spp_range=(a, b)` renders only sample indices [a, b) of the `spp` of every pixel and
     /// returns their mean; `penumbra.merge` combines such parts into the whole render.
@@ -157,7 +159,8 @@ impl Scene {
     #[pyo3(signature = (spp=None, shadow_rays=1, strategy="mis", mis="power",
                         light_selection=None, pattern="stratified", integrator=None,
                         max_depth=None, res=None, seed=0, threads=None, spp_range=None,
-                        mis_light="solid-angle", bsdf_sampling="importance"))]
+                        mis_light="solid-angle", bsdf_sampling="importance",
+                        hide_emitters=false))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -176,6 +179,7 @@ impl Scene {
         spp_range: Option<(u32, u32)>,
         mis_light: &str,
         bsdf_sampling: &str,
+        hide_emitters: bool,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         // As the CLI: the arguments override the scene file's `Integrator`; without either,
         // direct lighting with the default selector.
@@ -236,6 +240,7 @@ impl Scene {
             cancel: Some(Arc::clone(&cancel)),
             integrator: chosen.kind,
             max_depth: chosen.max_depth,
+            hide_emitters,
             ..RenderOptions::default()
         };
         opts.samples()

@@ -64,6 +64,11 @@ pub struct Args {
     /// combined from parts, so it excludes --spp-range, --progressive, --resume and --time.
     #[arg(long, conflicts_with_all = ["spp_range", "progressive", "resume", "time"])]
     pub splat: bool,
+    /// Hide the emitters camera rays see directly (Mitsuba 3's `hide_emitters`): a light's
+    /// surface, or the environment, seen straight from the camera is black; the light it
+    /// casts (on surfaces, in reflections, through glass) is unchanged.
+    #[arg(long)]
+    pub hide_emitters: bool,
     /// Estimator at every path vertex: bsdf, light-area, light-solid-angle or mis.
     #[arg(long, default_value = "mis")]
     pub strategy: Strategy,
@@ -271,6 +276,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         max_depth: choice.max_depth,
         roulette: !args.no_roulette,
         splat: args.splat,
+        hide_emitters: args.hide_emitters,
         progress: !args.quiet,
         sample_range: args.spp_range.clone(),
         ..RenderOptions::default()

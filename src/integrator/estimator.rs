@@ -266,6 +266,19 @@ pub(super) fn emission_weight(
     }
 }
 
+/// Whether the emission a path's current ray reaches is counted, the ray having left vertex
+/// `depth` − 1 (`depth` 0: a camera ray): always, except under `hide_emitters` (Mitsuba 3's
+/// `hide_emitters`) for what a camera ray sees directly, an emitter's surface or the
+/// environment. Light that reaches the camera by a bounce is unchanged: next-event estimation
+/// at the camera ray's hit, its BSDF rays that reach emitters (with their MIS weights, which
+/// never involved the camera ray's emission) and every later vertex. So the image is the
+/// lighting of the scene without the emitters' own pixels, and a renderer's choice of light
+/// sampling changes every pixel of it that it can change.
+#[inline(always)]
+pub(super) fn counts_emission(hide_emitters: bool, depth: u32) -> bool {
+    !(hide_emitters && depth == 0)
+}
+
 /// The value a BSDF ray of weight `weight` gathers from area light `light` hit at (`p`, `n`,
 /// `uv`) along unit `wi`: weight·Le·w with w its [`emission_weight`] (`None` when Le is zero).
 #[inline]
@@ -357,6 +370,17 @@ mod tests {
             assert_eq!(w, h.weight(2.0, 0.5));
             // The light sample of the same direction takes the complement.
             assert!((w + h.weight(0.5, 2.0) - 1.0).abs() < 1e-6, "{h:?}");
+        }
+    }
+
+    #[test]
+    fn hide_emitters_hides_only_what_camera_rays_see() {
+        for depth in 0..4 {
+            assert!(counts_emission(false, depth), "{depth}");
+        }
+        assert!(!counts_emission(true, 0));
+        for depth in 1..4 {
+            assert!(counts_emission(true, depth), "{depth}");
         }
     }
 

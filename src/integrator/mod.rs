@@ -185,6 +185,11 @@ pub struct RenderOptions {
     /// pixel is the weighted mean of what it received (Mitsuba's film). Off: filter
     /// importance sampling, each sample counted by its own pixel only.
     pub splat: bool,
+    /// Hide the emitters camera rays see directly (Mitsuba 3's `hide_emitters`): the
+    /// emission of the surface or environment a camera ray reaches is not added; the light
+    /// emitters cast (next-event estimation, BSDF rays that reach them, later bounces) is
+    /// unchanged. Off by default.
+    pub hide_emitters: bool,
     /// Show a progress bar.
     pub progress: bool,
     /// Render only sample indices `[start, end)` of the `spp` of every pixel (a part of a
@@ -248,6 +253,7 @@ impl Default for RenderOptions {
             max_depth: 5,
             roulette: true,
             splat: false,
+            hide_emitters: false,
             progress: false,
             sample_range: None,
             cancel: None,

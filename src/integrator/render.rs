@@ -138,6 +138,7 @@ pub(super) fn render_with(
         mis_light: opts.mis_light,
         max_depth: opts.depth(),
         roulette: opts.roulette,
+        hide_emitters: opts.hide_emitters,
     };
     let camera = scene.camera.rays(res);
     // Splatting draws each sample uniformly over its pixel (a box of radius ½) and weighs it

@@ -28,8 +28,8 @@
 
 use super::dims::{VertexDims, rounds_at, sample_index};
 use super::estimator::{
-    BsdfRay, Techniques, bsdf_ray_through, emission_weight, emitter_hit_value, escaped_radiance,
-    light_estimate, nee_pdf, roulette,
+    BsdfRay, Techniques, bsdf_ray_through, counts_emission, emission_weight, emitter_hit_value,
+    escaped_radiance, light_estimate, nee_pdf, roulette,
 };
 use super::lanes::{DiffuseBsdfLanes, TriangleLightLanes};
 use super::queues::{
@@ -77,6 +77,9 @@ pub struct Integrator<'a> {
     pub max_depth: u32,
     /// Russian roulette on the path throughput (pbrt-v4's rule, from vertex [`super::estimator::ROULETTE_FROM`]).
     pub roulette: bool,
+    /// Leave out the emission camera rays see directly (Mitsuba 3's `hide_emitters`; see
+    /// [`RenderOptions::hide_emitters`](super::RenderOptions::hide_emitters)).
+    pub hide_emitters: bool,
 }
 
 /// The work queues of one render thread (made once per tile, not per packet: every lane a
@@ -592,15 +595,20 @@ impl<'a> Integrator<'a> {
         q.rx.shade(rays, self.scene.geometry.cpu());
         q.rx.diffuse = 0;
         let mut shaded = 0;
+        let emits = counts_emission(self.hide_emitters, q.paths.depth);
         for k in bits(q.paths.active) {
             let le = match &q.hits[k] {
                 None => {
                     q.shading[k] = None;
-                    self.escaped(rays.ray(k).d.normalize(), &q.paths, k, t)
+                    if emits {
+                        self.escaped(rays.ray(k).d.normalize(), &q.paths, k, t)
+                    } else {
+                        Rgb::ZERO
+                    }
                 }
                 Some(hit) => {
                     let lane = (&mut q.shading[k], &mut q.ctx[k]);
-                    let le = self.shade_hit(k, hit, &mut q.rx, lane, &q.paths, t);
+                    let le = self.shade_hit(k, hit, &mut q.rx, lane, &q.paths, t, emits);
                     shaded |= (q.shading[k].is_some() as u32) << k;
                     le
                 }
@@ -847,9 +855,11 @@ impl<'a> Integrator<'a> {
     }
 
     /// The emitted radiance path `k`'s ray finds at `hit` (its shading geometry in `rx`),
-    /// weighted against light sampling at the vertex the ray left (in `paths`); the hit's BSDF
+    /// weighted against light sampling at the vertex the ray left (in `paths`), if it `emits`
+    /// ([`counts_emission`]; zero otherwise); the hit's BSDF
     /// and light-sample context (if it has a material) go to `lane`'s two places, and a BSDF
     /// the Lambertian kernels evaluate marks the lane diffuse in `rx`.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn shade_hit(
         &self,
@@ -859,11 +869,12 @@ impl<'a> Integrator<'a> {
         (lane, ctx): (&mut Option<LaneShading>, &mut LightSampleContext),
         paths: &PathLanes,
         t: Techniques,
+        emits: bool,
     ) -> Rgb {
         let scene = self.scene;
         let g = rx.geometry(k);
         let mut l = Rgb::ZERO;
-        if hit.light != NO_LIGHT {
+        if emits && hit.light != NO_LIGHT {
             let light = &scene.lights[hit.light as usize];
             let le = light.radiance(hit.p, hit.ng, hit.uv, g.wo);
             let w = emission_weight(t, paths.prev_delta(k), || {
