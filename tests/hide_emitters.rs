@@ -128,5 +128,10 @@ fn hide_emitters_is_off_by_default_and_every_thread_count_renders_the_same() {
         .build()
         .unwrap()
         .install(|| img(&scene, &o));
-    assert!(one.pixels.iter().map(|&p| bits(p)).eq(two.pixels.iter().map(|&p| bits(p))));
+    assert!(
+        one.pixels
+            .iter()
+            .map(|&p| bits(p))
+            .eq(two.pixels.iter().map(|&p| bits(p)))
+    );
 }

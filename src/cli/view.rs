@@ -80,6 +80,8 @@ struct Settings {
     integrator: IntegratorKind,
     max_depth: u32,
     roulette: bool,
+    /// `--hide-emitters` (not changed by the page).
+    hide_emitters: bool,
 }
 
 impl Settings {
@@ -266,6 +268,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         integrator: choice.kind,
         max_depth: choice.max_depth,
         roulette: !r.no_roulette,
+        hide_emitters: r.hide_emitters,
     };
     let pool = match r.threads {
         Some(t) => Some(
@@ -346,6 +349,7 @@ fn restart(shared: &Arc<Shared>, ch: usize) {
             integrator: s.integrator,
             max_depth: s.max_depth,
             roulette: s.roulette,
+            hide_emitters: s.hide_emitters,
             ..RenderOptions::default()
         };
         (opts, c.generation, Arc::clone(&c.cancel))
