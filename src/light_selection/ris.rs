@@ -28,19 +28,43 @@ use super::{FiniteSelector, ShadingPoint, importance};
 use crate::lights::LightBounds;
 use crate::sampling::hash::{hash_keys, hash_step, u32_to_unit};
 
+/// Where RIS draws its candidates from: a cheap selector whose probability of every light is
+/// known exactly (`power` here, the light BVH in `ris_bvh.rs`).
+pub trait CandidateSource: Send + Sync {
+    /// Draw one candidate with the uniform number `u`: (local light, its exact probability q).
+    /// `None` counts as a candidate of weight zero (the source's "nowhere" mass).
+    fn draw(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)>;
+    /// q of light `l` at `ctx`: the probability that `draw` returns it.
+    fn prob(&self, ctx: &ShadingPoint, l: u32) -> f32;
+}
+
+impl CandidateSource for PowerSelector {
+    #[inline]
+    fn draw(&self, _ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
+        self.pick(u)
+    }
+    #[inline]
+    fn prob(&self, _ctx: &ShadingPoint, l: u32) -> f32 {
+        PowerSelector::prob(self, l)
+    }
+}
+
 /// Candidates per selection unless `ris:K` says otherwise.
 pub const DEFAULT_CANDIDATES: u32 = 8;
 /// Most candidates accepted (a stack array holds them).
 pub const MAX_CANDIDATES: u32 = 256;
 
-/// RIS over power-sampled candidates.
+/// RIS over candidates from a [`CandidateSource`] `S`.
 #[derive(Clone, Debug)]
-pub struct RisSelector {
-    source: PowerSelector,
+pub struct Ris<S> {
+    source: S,
     bounds: Vec<LightBounds>,
     k: u32,
     seed: u64,
 }
+
+/// RIS over power-sampled candidates (`ris`, `ris:K`).
+pub type RisSelector = Ris<PowerSelector>;
 
 #[inline]
 fn unit(h: u64) -> f32 {
@@ -50,8 +74,15 @@ fn unit(h: u64) -> f32 {
 impl RisSelector {
     /// `k` candidates per selection from power sampling over `bounds`.
     pub fn new(bounds: &[LightBounds], k: u32, seed: u64) -> Self {
+        Ris::with_source(PowerSelector::new(bounds), bounds, k, seed)
+    }
+}
+
+impl<S: CandidateSource> Ris<S> {
+    /// `k` candidates per selection from `source` (built over the same `bounds`).
+    pub fn with_source(source: S, bounds: &[LightBounds], k: u32, seed: u64) -> Self {
         Self {
-            source: PowerSelector::new(bounds),
+            source,
             bounds: bounds.to_vec(),
             k: k.clamp(1, MAX_CANDIDATES),
             seed,
@@ -83,14 +114,14 @@ impl RisSelector {
     /// Draw candidate `i` of stream `key`: (light, p̂, w = p̂/q).
     #[inline]
     fn candidate(&self, ctx: &ShadingPoint, key: u64, i: u32) -> Option<(u32, f32, f64)> {
-        let (l, q) = self.source.pick(unit(hash_step(key, i as u64)))?;
+        let (l, q) = self.source.draw(ctx, unit(hash_step(key, i as u64)))?;
         let t = self.target(ctx, l);
         let w = if q > 0.0 { t as f64 / q as f64 } else { 0.0 };
         Some((l, t, w))
     }
 }
 
-impl FiniteSelector for RisSelector {
+impl<S: CandidateSource> FiniteSelector for Ris<S> {
     fn sample(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
         // The candidates come from u (and the point); the final choice from a further number
         // of the same stream.
@@ -98,7 +129,11 @@ impl FiniteSelector for RisSelector {
         let mut chosen: Option<(u32, f32)> = None;
         let mut sum = 0.0f64;
         for i in 0..self.k {
-            let (l, t, w) = self.candidate(ctx, key, i)?;
+            // A candidate the source could not draw weighs nothing (power never fails while it
+            // has lights; a BVH walk can end at a node whose children all score zero).
+            let Some((l, t, w)) = self.candidate(ctx, key, i) else {
+                continue;
+            };
             if w <= 0.0 {
                 continue;
             }
@@ -119,7 +154,7 @@ impl FiniteSelector for RisSelector {
             return 0.0;
         }
         let t = self.target(ctx, light);
-        let q = self.source.prob(light);
+        let q = self.source.prob(ctx, light);
         if t <= 0.0 || q <= 0.0 {
             return 0.0;
         }
