@@ -283,10 +283,44 @@ fn exact_ris_probability(q: &[f64], target: &[f64], k: u32) -> Vec<f64> {
     }
 }
 
+/// RIS's selection probability with `ris-bvh`'s stratified candidates: candidate j is the
+/// source's choice for (j + o)/K with one offset o ~ U[0, 1) for all, and the final choice
+/// keeps j with probability wⱼ/Σw, so P(y) = ∫₀¹ Σ_{j: xⱼ(o) = y} wⱼ/Σw do — integrated on a
+/// grid of `grid` offsets (its error, a few cells per boundary of the source's map, is far
+/// below what the chi² can see).
+fn stratified_ris_probability(
+    draw: impl Fn(f32) -> Option<(u32, f32)>,
+    target: &[f64],
+    k: u32,
+    grid: usize,
+) -> Vec<f64> {
+    let mut p = vec![0.0; target.len()];
+    let mut cands = Vec::with_capacity(k as usize);
+    for m in 0..grid {
+        let o = (m as f64 + 0.5) / grid as f64;
+        cands.clear();
+        for j in 0..k {
+            let v = ((j as f64 + o) / k as f64) as f32;
+            if let Some((l, q)) = draw(v) {
+                let w = if q > 0.0 { target[l as usize] / q as f64 } else { 0.0 };
+                cands.push((l as usize, w));
+            }
+        }
+        let sum: f64 = cands.iter().map(|c| c.1).sum();
+        if sum > 0.0 {
+            for &(l, w) in &cands {
+                p[l] += w / sum / grid as f64;
+            }
+        }
+    }
+    p
+}
+
 /// Chi² of the lights `ris` and `ris-bvh` choose against RIS's exact selection probability
 /// (their `pmf` is 1/W, not that probability, so the every-selector chi² in
-/// `tests/many_selection.rs` skips them): the candidates hashed from u and the point behave as
-/// i.i.d. draws from the source and the reservoir keeps one ∝ w.
+/// `tests/many_selection.rs` skips them): `ris`'s candidates hashed from u and the point
+/// behave as i.i.d. draws from power, `ris-bvh`'s as the stratified draws above, and the
+/// final choice keeps one ∝ w.
 #[test]
 fn chi2_ris_choices_match_the_exact_ris_probability() {
     let mut rng = pcg_from_keys(&[19, 5]);
@@ -321,7 +355,12 @@ fn chi2_ris_choices_match_the_exact_ris_probability() {
                     .iter()
                     .map(|b| importance(sp.p, sp.n, b) as f64)
                     .collect();
-                let exact = exact_ris_probability(&q, &target, k);
+                let exact = match source {
+                    Source::Power => exact_ris_probability(&q, &target, k),
+                    Source::Bvh => {
+                        stratified_ris_probability(|v| bvh.sample(&sp, v), &target, k, 1 << 18)
+                    }
+                };
                 let r = chi2_discrete(&cfg, &exact, |u| {
                     ris.sample(&sp, u[0]).map(|(l, _)| l as usize)
                 });
@@ -365,4 +404,42 @@ fn ris_bvh_is_the_same_image_on_one_and_two_threads() {
             .all(|(x, y)| (0..3).all(|c| x[c].to_bits() == y[c].to_bits())),
         "ris-bvh image depends on the thread count"
     );
+}
+
+/// The light BVH's batched walk (what `ris-bvh` draws its candidates with) returns, for every
+/// number, exactly what `sample` returns for it, in ascending and in any order.
+#[test]
+fn bvh_sample_many_is_sample_bit_for_bit() {
+    let mut rng = pcg_from_keys(&[19, 6]);
+    for n in [1usize, 7, 64, 3000] {
+        let bounds = random_bounds(&mut rng, n);
+        let bvh = BvhSelector::new(&bounds);
+        for _ in 0..20 {
+            let sp = ShadingPoint {
+                p: Vec3::new(
+                    u(&mut rng, -5.0, 5.0),
+                    u(&mut rng, -5.0, 5.0),
+                    u(&mut rng, -5.0, 5.0),
+                ),
+                n: unit(&mut rng),
+                wo: Vec3::Z,
+            };
+            let mut us: Vec<f32> = (0..17).map(|_| next_f32(&mut rng)).collect();
+            for sorted in [false, true] {
+                if sorted {
+                    us.sort_by(f32::total_cmp);
+                }
+                let mut out = vec![None; us.len()];
+                bvh.sample_many(&sp, &us, &mut out);
+                for (&v, o) in us.iter().zip(&out) {
+                    let one = bvh.sample(&sp, v);
+                    assert_eq!(
+                        o.map(|(l, p)| (l, p.to_bits())),
+                        one.map(|(l, p)| (l, p.to_bits())),
+                        "{n} lights, u {v}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -504,6 +504,77 @@ impl BvhSelector {
         pmf as f32
     }
 
+    /// [`Self::sample_impl`] for each of the numbers `us` (`out[i]` = `sample(ctx, us[i])`, bit
+    /// for bit), evaluating each node at most once per level while consecutive walks pass
+    /// through it: with `us` ascending (RIS's stratified candidates, `ris_bvh.rs`) the walks
+    /// go through the tree in order, so the root is scored once instead of K times and a child
+    /// holding several candidates once instead of once per candidate.
+    #[inline(always)]
+    fn sample_many_impl(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Option<(u32, f32)>]) {
+        const CACHED: usize = 8;
+        let mut cached = [u32::MAX; CACHED];
+        let mut imps = [[0.0f32; WIDTH]; CACHED];
+        let mut cums = [[0.0f64; WIDTH + 1]; CACHED];
+        let mut imp_deep = [0.0f32; WIDTH];
+        let mut cum_deep;
+        for (o, &u0) in out.iter_mut().zip(us) {
+            *o = None;
+            if self.nodes.is_empty() {
+                continue;
+            }
+            let mut probs = [0.0f64; MAX_DEPTH as usize];
+            let mut levels = 0;
+            let mut u = u0 as f64;
+            let mut i = 0usize;
+            loop {
+                let node = &self.nodes[i];
+                let (imp, cum) = if levels < CACHED {
+                    if cached[levels] != i as u32 {
+                        node.importance(ctx.p, ctx.n, &mut imps[levels]);
+                        cums[levels] = running_sums(&imps[levels]);
+                        cached[levels] = i as u32;
+                    }
+                    (&imps[levels], &cums[levels])
+                } else {
+                    node.importance(ctx.p, ctx.n, &mut imp_deep);
+                    cum_deep = running_sums(&imp_deep);
+                    (&imp_deep, &cum_deep)
+                };
+                let total = cum[WIDTH];
+                if !(total > 0.0) {
+                    break;
+                }
+                let target = u * total;
+                let pick = pick_slot(imp, cum, target);
+                let x = imp[pick] as f64;
+                u = ((target - cum[pick]) / x).clamp(0.0, 1.0 - f64::EPSILON);
+                probs[levels] = x / total;
+                levels += 1;
+                let c = node.child[pick];
+                if c & LEAF != 0 {
+                    let mut pmf = 1.0f64;
+                    for &p in probs[..levels].iter().rev() {
+                        pmf *= p;
+                    }
+                    *o = Some((c & !LEAF, pmf as f32));
+                    break;
+                }
+                i = c as usize;
+            }
+        }
+    }
+
+    /// [`FiniteSelector::sample`] for each of `us` (`out[i]` for `us[i]`; fastest with `us`
+    /// ascending, which shares the walks' common nodes).
+    pub fn sample_many(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Option<(u32, f32)>]) {
+        self.cpu.dispatch(SampleManyKernel {
+            bvh: self,
+            ctx,
+            us,
+            out,
+        })
+    }
+
     /// Importance of the eight children of node `i` (for tests and diagnostics).
     pub fn child_importance(&self, ctx: &ShadingPoint, i: usize) -> [f32; WIDTH] {
         let mut imp = [0.0; WIDTH];
@@ -524,6 +595,22 @@ impl Kernel for SampleKernel<'_> {
     #[inline(always)]
     fn run<T: Token>(self, _t: T) -> Self::Output {
         self.bvh.sample_impl(self.ctx, self.u)
+    }
+}
+
+/// `sample_many` as a [`Kernel`].
+struct SampleManyKernel<'a> {
+    bvh: &'a BvhSelector,
+    ctx: &'a ShadingPoint,
+    us: &'a [f32],
+    out: &'a mut [Option<(u32, f32)>],
+}
+
+impl Kernel for SampleManyKernel<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<T: Token>(self, _t: T) -> Self::Output {
+        self.bvh.sample_many_impl(self.ctx, self.us, self.out)
     }
 }
 

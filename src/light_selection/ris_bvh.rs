@@ -49,11 +49,15 @@ impl CandidateSource for BvhSelector {
     fn prob(&self, ctx: &ShadingPoint, l: u32) -> f32 {
         FiniteSelector::pmf(self, ctx, l)
     }
+    #[inline]
+    fn draw_many(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Option<(u32, f32)>]) {
+        self.sample_many(ctx, us, out);
+    }
 }
 
 impl RisBvhSelector {
     /// `k` candidates per selection from the light BVH over `bounds`.
     pub fn new(bounds: &[LightBounds], k: u32, seed: u64) -> Self {
-        Ris::with_source(BvhSelector::new(bounds), bounds, k, seed)
+        Ris::with_source(BvhSelector::new(bounds), bounds, k, seed).stratified(true)
     }
 }
