@@ -443,3 +443,23 @@ fn bvh_sample_many_is_sample_bit_for_bit() {
         }
     }
 }
+
+/// `ris-bvh` and `ris-bvh:K` parse, print back and reject a K out of range.
+#[test]
+fn ris_bvh_names_parse() {
+    assert_eq!("ris-bvh".parse::<SelectorKind>(), Ok(SelectorKind::RIS_BVH));
+    let k16 = SelectorKind::RisBvh { candidates: 16 };
+    assert_eq!("ris-bvh:16".parse::<SelectorKind>(), Ok(k16));
+    assert_eq!(k16.to_string(), "ris-bvh:16");
+    assert_eq!(SelectorKind::RIS_BVH.to_string(), "ris-bvh");
+    assert!(!k16.exact_pmf());
+    for bad in ["ris-bvh:0", "ris-bvh:257", "ris-bvh:x", "ris-bvh:"] {
+        let err = bad.parse::<SelectorKind>().expect_err(bad);
+        assert!(err.contains("ris-bvh:K"), "{bad}: {err}");
+    }
+    // `ris` is untouched by the new prefix.
+    assert_eq!(
+        "ris:32".parse::<SelectorKind>(),
+        Ok(SelectorKind::Ris { candidates: 32 })
+    );
+}

@@ -60,9 +60,8 @@ impl CandidateSource for PowerSelector {
 pub const DEFAULT_CANDIDATES: u32 = 8;
 /// Most candidates accepted (a stack array holds them).
 pub const MAX_CANDIDATES: u32 = 256;
-/// Strata of u kept for the final choice by [`Ris::stratified`]: up to this many samples per
-/// pixel keep their stratification.
-pub const CHOICE_STRATA: u32 = 1024;
+/// Levels of each of the two numbers [`Ris::stratified`] splits u's top 24 bits into.
+const SPLIT: u32 = 1 << 12;
 /// Candidates the stratified choice keeps on the stack (more go to the heap).
 const INLINE_CANDIDATES: usize = 16;
 
@@ -73,13 +72,25 @@ pub struct Ris<S> {
     bounds: Vec<LightBounds>,
     k: u32,
     seed: u64,
-    /// Candidate i from the stratum [i/K, (i+1)/K) of the source's sample space and the final
-    /// choice from u's stratum (instead of i.i.d. hashed numbers): see [`Ris::stratified`].
+    /// Candidate i from the stratum [i/K, (i+1)/K) of the source's sample space, candidates and
+    /// final choice from u's bits (instead of i.i.d. hashed numbers): see [`Ris::stratified`].
     stratified: bool,
 }
 
 /// RIS over power-sampled candidates (`ris`, `ris:K`).
 pub type RisSelector = Ris<PowerSelector>;
+
+/// The even and odd bits of a 24-bit number, each compacted to 12 bits (the odd ones hold the
+/// top bit).
+fn deinterleave(b: u32) -> (u32, u32) {
+    let mut x = 0;
+    let mut y = 0;
+    for i in 0..12 {
+        x |= ((b >> (2 * i)) & 1) << i;
+        y |= ((b >> (2 * i + 1)) & 1) << i;
+    }
+    (x, y)
+}
 
 #[inline]
 fn unit(h: u64) -> f32 {
@@ -108,21 +119,23 @@ impl<S: CandidateSource> Ris<S> {
         }
     }
 
-    /// Keep the stratification of `sample`'s number u in the final choice instead of throwing
-    /// it away. The K candidates share one offset o, a hash of u and the shading point:
-    /// candidate i is the source's choice for (i + o)/K, one per stratum of the source's sample
-    /// space. The final choice inverts the candidates' running sum of w (in candidate order)
-    /// with r = (⌊u·M⌋ + h)/M, M = [`CHOICE_STRATA`], h a second hash of u and the point: r has
-    /// u's stratum, and given the candidates (a hash of u) it is uniform — h is, and the
-    /// stratum ⌊u·M⌋ of a uniform u does not depend on a hash of it, the same independence of
-    /// hashed numbers `ris`'s reservoir relies on. So candidate j is kept with probability
-    /// wⱼ/Σw exactly as in the reservoir, and E[f(Y)·W | candidates] = (1/K)·Σᵢ f(xᵢ)/q(xᵢ) —
-    /// the stratified estimator of Σₗ f(l), since candidate i covers stratum i of q — and the
-    /// light estimator stays exactly unbiased. What it gains: a pixel's stratified u values
-    /// reach the final choice in the source's sample-space order, so u → light stays roughly
-    /// monotone as in `bvh`'s own inversion, where hashed candidates and a hashed reservoir
-    /// number make every choice i.i.d.: at 8 spp that stratification is worth 2.6–2.8× in
-    /// relMSE to `bvh` and `exhaustive` on `many-rooms` (docs/many-lights.md).
+    /// Keep the stratification of `sample`'s number u instead of throwing it away. u's top 24
+    /// bits are split into their even and odd bits, two 12-bit numbers x and y (independent
+    /// for a uniform u; a pixel's 2^m strata of u make a 2^⌊m/2⌋ × 2^⌈m/2⌉ grid of (x, y)),
+    /// each filled in below 2^-12 by a hash of u and the shading point. The K candidates share
+    /// the offset o = x: candidate i is the source's choice for (i + o)/K, one per stratum of
+    /// the source's sample space. The final choice inverts the candidates' running sum of w
+    /// (in candidate order) with r = y. Given the candidates, r is uniform (y is independent of
+    /// x, and the hash below it is uniform: the independence of hashed numbers `ris`'s
+    /// reservoir relies on), so candidate j is kept with probability wⱼ/Σw exactly as in the
+    /// reservoir, and E[f(Y)·W | candidates] = (1/K)·Σᵢ f(xᵢ)/q(xᵢ) — the stratified estimator
+    /// of Σₗ f(l), since candidate i covers stratum i of q — so the light estimator stays
+    /// exactly unbiased. What it gains: the pixel's stratification reaches both the candidates
+    /// and the choice (made in the source's sample-space order, so u → light stays roughly
+    /// monotone as in `bvh`'s own inversion), where hashed candidates and a hashed reservoir
+    /// number make every choice i.i.d. — and 1D-stratified selection is what makes `bvh` and
+    /// `exhaustive` 2.6–2.8× better at 8 spp on `many-rooms` than with i.i.d. numbers
+    /// (docs/many-lights.md).
     pub fn stratified(mut self, on: bool) -> Self {
         self.stratified = on;
         self
@@ -169,7 +182,12 @@ impl<S: CandidateSource> Ris<S> {
     /// ([`Ris::stratified`]).
     fn sample_stratified(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
         let key = hash_step(self.point_key(ctx, 3), u.to_bits() as u64);
-        let offset = unit(hash_step(key, 0));
+        // u's top 24 bits split into two 12-bit numbers (even and odd bits): independent for a
+        // uniform u, and a pixel's 2^m strata of u become a 2^⌊m/2⌋ × 2^⌈m/2⌉ grid of them.
+        let bits = (u.clamp(0.0, 1.0) as f64 * (1u64 << 24) as f64) as u32 & 0xff_ffff;
+        let (bx, by) = deinterleave(bits);
+        // The hashes fill in below 2^-12, so every light keeps its probability.
+        let offset = ((bx as f64 + unit(hash_step(key, 0)) as f64) / SPLIT as f64) as f32;
         let k = self.k as usize;
         let mut inline_u = [0.0f32; INLINE_CANDIDATES];
         let mut inline_d = [None; INLINE_CANDIDATES];
@@ -206,9 +224,7 @@ impl<S: CandidateSource> Ris<S> {
         if !(sum > 0.0 && sum.is_finite()) {
             return None;
         }
-        let m = CHOICE_STRATA as f64;
-        let stratum = (u as f64 * m).floor().clamp(0.0, m - 1.0);
-        let r = (stratum + unit(hash_step(key, 1)) as f64) / m;
+        let r = (by as f64 + unit(hash_step(key, 1)) as f64) / SPLIT as f64;
         let target = r * sum;
         let mut acc = 0.0f64;
         let mut chosen = None;
