@@ -434,10 +434,18 @@ fn bvh_sample_many_is_sample_bit_for_bit() {
                 for (&v, o) in us.iter().zip(&out) {
                     let one = bvh.sample(&sp, v);
                     assert_eq!(
-                        o.map(|(l, p)| (l, p.to_bits())),
+                        o.map(|(l, p, _)| (l, p.to_bits())),
                         one.map(|(l, p)| (l, p.to_bits())),
                         "{n} lights, u {v}"
                     );
+                    // The third number is the light's own importance, as the pmf's walk
+                    // scores it, and the scalar importance up to rounding.
+                    if let Some((l, p, t)) = *o {
+                        let (q, t2) = bvh.pmf_and_importance(&sp, l);
+                        assert_eq!((p.to_bits(), t.to_bits()), (q.to_bits(), t2.to_bits()));
+                        let s = importance(sp.p, sp.n, &bounds[l as usize]);
+                        assert!((t - s).abs() <= 1e-4 * s, "{t} vs scalar {s}");
+                    }
                 }
             }
         }

@@ -482,13 +482,16 @@ impl BvhSelector {
     }
 
     #[inline(always)]
-    fn pmf_impl(&self, ctx: &ShadingPoint, light: u32) -> f32 {
+    /// The pmf of `light` by walking up from its slot, and the light's own importance (its
+    /// lane in its leaf node, the first node of the walk; 0 with a zero pmf).
+    fn pmf_impl(&self, ctx: &ShadingPoint, light: u32) -> (f32, f32) {
         let Some(&code) = self.slot.get(light as usize) else {
-            return 0.0;
+            return (0.0, 0.0);
         };
         let mut code = code;
         let mut pmf = 1.0f64;
         let mut imp = [0.0f32; WIDTH];
+        let mut leaf = None;
         while code != u32::MAX {
             let i = (code >> 3) as usize;
             let node = &self.nodes[i];
@@ -496,21 +499,27 @@ impl BvhSelector {
             let total = running_sums(&imp)[WIDTH];
             let x = imp[(code & 7) as usize];
             if !(total > 0.0) || x <= 0.0 {
-                return 0.0;
+                return (0.0, 0.0);
             }
+            leaf.get_or_insert(x);
             pmf *= x as f64 / total;
             code = self.parent[i];
         }
-        pmf as f32
+        (pmf as f32, leaf.unwrap_or(0.0))
     }
 
     /// [`Self::sample_impl`] for each of the numbers `us` (`out[i]` = `sample(ctx, us[i])`, bit
-    /// for bit), evaluating each node at most once per level while consecutive walks pass
+    /// for bit, plus the light's own importance: its lane in the leaf node), evaluating each node at most once per level while consecutive walks pass
     /// through it: with `us` ascending (RIS's stratified candidates, `ris_bvh.rs`) the walks
     /// go through the tree in order, so the root is scored once instead of K times and a child
     /// holding several candidates once instead of once per candidate.
     #[inline(always)]
-    fn sample_many_impl(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Option<(u32, f32)>]) {
+    fn sample_many_impl(
+        &self,
+        ctx: &ShadingPoint,
+        us: &[f32],
+        out: &mut [Option<(u32, f32, f32)>],
+    ) {
         const CACHED: usize = 8;
         let mut cached = [u32::MAX; CACHED];
         let mut imps = [[0.0f32; WIDTH]; CACHED];
@@ -556,7 +565,7 @@ impl BvhSelector {
                     for &p in probs[..levels].iter().rev() {
                         pmf *= p;
                     }
-                    *o = Some((c & !LEAF, pmf as f32));
+                    *o = Some((c & !LEAF, pmf as f32, imp[pick]));
                     break;
                 }
                 i = c as usize;
@@ -564,9 +573,15 @@ impl BvhSelector {
         }
     }
 
-    /// [`FiniteSelector::sample`] for each of `us` (`out[i]` for `us[i]`; fastest with `us`
-    /// ascending, which shares the walks' common nodes).
-    pub fn sample_many(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Option<(u32, f32)>]) {
+    /// [`FiniteSelector::sample`] for each of `us` (`out[i]` for `us[i]`, with the chosen
+    /// light's own importance as a third number; fastest with `us` ascending, which shares the
+    /// walks' common nodes).
+    pub fn sample_many(
+        &self,
+        ctx: &ShadingPoint,
+        us: &[f32],
+        out: &mut [Option<(u32, f32, f32)>],
+    ) {
         self.cpu.dispatch(SampleManyKernel {
             bvh: self,
             ctx,
@@ -603,7 +618,7 @@ struct SampleManyKernel<'a> {
     bvh: &'a BvhSelector,
     ctx: &'a ShadingPoint,
     us: &'a [f32],
-    out: &'a mut [Option<(u32, f32)>],
+    out: &'a mut [Option<(u32, f32, f32)>],
 }
 
 impl Kernel for SampleManyKernel<'_> {
@@ -614,7 +629,7 @@ impl Kernel for SampleManyKernel<'_> {
     }
 }
 
-/// `pmf` as a [`Kernel`].
+/// `pmf` (and the light's own importance) as a [`Kernel`].
 struct PmfKernel<'a> {
     bvh: &'a BvhSelector,
     ctx: &'a ShadingPoint,
@@ -622,7 +637,7 @@ struct PmfKernel<'a> {
 }
 
 impl Kernel for PmfKernel<'_> {
-    type Output = f32;
+    type Output = (f32, f32);
     #[inline(always)]
     fn run<T: Token>(self, _t: T) -> Self::Output {
         self.bvh.pmf_impl(self.ctx, self.light)
@@ -727,6 +742,14 @@ impl FiniteSelector for BvhSelector {
     }
 
     fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32 {
+        self.pmf_and_importance(ctx, light).0
+    }
+}
+
+impl BvhSelector {
+    /// [`FiniteSelector::pmf`] of `light` and the light's own importance as the BVH scores it
+    /// (its lane in its leaf node: what [`Self::sample_many`] returns with it).
+    pub fn pmf_and_importance(&self, ctx: &ShadingPoint, light: u32) -> (f32, f32) {
         self.cpu.dispatch(PmfKernel {
             bvh: self,
             ctx,

@@ -36,14 +36,23 @@ pub trait CandidateSource: Send + Sync {
     fn draw(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)>;
     /// q of light `l` at `ctx`: the probability that `draw` returns it.
     fn prob(&self, ctx: &ShadingPoint, l: u32) -> f32;
-    /// `out[i] = draw(ctx, us[i])` for every i (a source may share work between the draws:
-    /// `us` is ascending when RIS asks).
-    fn draw_many(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Option<(u32, f32)>]) {
+    /// `out[i] = draw(ctx, us[i])` for every i, with the light's target p̂ when the source
+    /// computed it on the way (else RIS computes it; a source that gives it must give the same
+    /// in [`Self::prob_and_target`]). A source may share work between the draws: `us` is
+    /// ascending when RIS asks.
+    fn draw_many(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Drawn]) {
         for (o, &u) in out.iter_mut().zip(us) {
-            *o = self.draw(ctx, u);
+            *o = self.draw(ctx, u).map(|(l, q)| (l, q, None));
         }
     }
+    /// [`Self::prob`] of `l`, with its target p̂ if the source gives it in `draw_many`.
+    fn prob_and_target(&self, ctx: &ShadingPoint, l: u32) -> (f32, Option<f32>) {
+        (self.prob(ctx, l), None)
+    }
 }
+
+/// A drawn candidate: (local light, its probability q, its target p̂ if the source gives it).
+pub type Drawn = Option<(u32, f32, Option<f32>)>;
 
 impl CandidateSource for PowerSelector {
     #[inline]
@@ -190,10 +199,10 @@ impl<S: CandidateSource> Ris<S> {
         let offset = ((bx as f64 + unit(hash_step(key, 0)) as f64) / SPLIT as f64) as f32;
         let k = self.k as usize;
         let mut inline_u = [0.0f32; INLINE_CANDIDATES];
-        let mut inline_d = [None; INLINE_CANDIDATES];
+        let mut inline_d: [Drawn; INLINE_CANDIDATES] = [None; INLINE_CANDIDATES];
         let mut inline_w = [0.0f64; INLINE_CANDIDATES];
         let (mut heap_u, mut heap_d, mut heap_w) = (Vec::new(), Vec::new(), Vec::new());
-        let (us, drawn, ws): (&mut [f32], &mut [Option<(u32, f32)>], &mut [f64]) =
+        let (us, drawn, ws): (&mut [f32], &mut [Drawn], &mut [f64]) =
             if k <= INLINE_CANDIDATES {
                 (&mut inline_u[..k], &mut inline_d[..k], &mut inline_w[..k])
             } else {
@@ -209,15 +218,15 @@ impl<S: CandidateSource> Ris<S> {
         let mut sum = 0.0f64;
         for (d, w) in drawn.iter_mut().zip(ws.iter_mut()) {
             // Not drawn (a BVH walk that ended nowhere) or zero target: weight 0.
-            if let Some((l, q)) = *d {
-                let t = self.target(ctx, l);
+            if let Some((l, q, given)) = *d {
+                let t = given.unwrap_or_else(|| self.target(ctx, l));
                 *w = if q > 0.0 && t > 0.0 {
                     t as f64 / q as f64
                 } else {
                     0.0
                 };
                 // Keep the target where the choice needs it.
-                *d = Some((l, t));
+                *d = Some((l, q, Some(t)));
                 sum += *w;
             }
         }
@@ -233,7 +242,7 @@ impl<S: CandidateSource> Ris<S> {
                 continue;
             }
             acc += w;
-            chosen = d;
+            chosen = d.map(|(l, _, t)| (l, t.unwrap_or(0.0)));
             if target < acc {
                 break;
             }
@@ -280,17 +289,39 @@ impl<S: CandidateSource> FiniteSelector for Ris<S> {
         if light as usize >= self.bounds.len() {
             return 0.0;
         }
-        let t = self.target(ctx, light);
-        let q = self.source.prob(ctx, light);
+        let (q, given) = self.source.prob_and_target(ctx, light);
+        let t = given.unwrap_or_else(|| self.target(ctx, light));
         if t <= 0.0 || q <= 0.0 {
             return 0.0;
         }
         let w = t as f64 / q as f64;
         let key = self.point_key(ctx, 2);
         let mut sum = w;
-        for i in 1..self.k {
-            if let Some((_, _, wi)) = self.candidate(ctx, key, i) {
-                sum += wi;
+        if self.stratified {
+            // The K − 1 others through the source's batched draw, in ascending order (their
+            // sum does not depend on the order).
+            let n = (self.k - 1) as usize;
+            let mut us = [0.0f32; INLINE_CANDIDATES];
+            let mut drawn: [Drawn; INLINE_CANDIDATES] = [None; INLINE_CANDIDATES];
+            for start in (0..n).step_by(INLINE_CANDIDATES) {
+                let m = (n - start).min(INLINE_CANDIDATES);
+                for (j, v) in us[..m].iter_mut().enumerate() {
+                    *v = unit(hash_step(key, (start + j + 1) as u64));
+                }
+                us[..m].sort_unstable_by(f32::total_cmp);
+                self.source.draw_many(ctx, &us[..m], &mut drawn[..m]);
+                for &(l, qi, ti) in drawn[..m].iter().flatten() {
+                    let ti = ti.unwrap_or_else(|| self.target(ctx, l));
+                    if qi > 0.0 && ti > 0.0 {
+                        sum += ti as f64 / qi as f64;
+                    }
+                }
+            }
+        } else {
+            for i in 1..self.k {
+                if let Some((_, _, wi)) = self.candidate(ctx, key, i) {
+                    sum += wi;
+                }
             }
         }
         (self.k as f64 * t as f64 / sum) as f32

@@ -40,7 +40,7 @@
 //! shading point, never from a thread's state (same image on 1 and 2 threads: tested).
 
 use super::bvh::BvhSelector;
-use super::ris::{CandidateSource, Ris};
+use super::ris::{CandidateSource, Drawn, Ris};
 use super::{FiniteSelector, ShadingPoint};
 use crate::lights::LightBounds;
 
@@ -60,8 +60,22 @@ impl CandidateSource for BvhSelector {
         FiniteSelector::pmf(self, ctx, l)
     }
     #[inline]
-    fn draw_many(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Option<(u32, f32)>]) {
-        self.sample_many(ctx, us, out);
+    fn draw_many(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Drawn]) {
+        // The walks' own score of the light at its leaf is the target: no second importance
+        // and no random access to the light's bounds per candidate.
+        let mut walked = [None; 16];
+        for (us, out) in us.chunks(16).zip(out.chunks_mut(16)) {
+            let walked = &mut walked[..us.len()];
+            self.sample_many(ctx, us, walked);
+            for (o, w) in out.iter_mut().zip(walked.iter()) {
+                *o = w.map(|(l, q, t)| (l, q, Some(t)));
+            }
+        }
+    }
+    #[inline]
+    fn prob_and_target(&self, ctx: &ShadingPoint, l: u32) -> (f32, Option<f32>) {
+        let (q, t) = self.pmf_and_importance(ctx, l);
+        (q, Some(t))
     }
 }
 
