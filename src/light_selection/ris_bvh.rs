@@ -2,10 +2,11 @@
 //! of `ris.rs` with its K candidates drawn by walks of the light BVH (`bvh.rs`) instead of the
 //! power alias table. The BVH already picks lights roughly ∝ their importance, but from the
 //! conservative bounds of whole clusters at every level above the leaves; resampling its
-//! candidates by the light's own importance p̂ (Φ·cos θ′/d²·cos θ′ᵢ of the light's bounds,
-//! [`importance`](super::importance)) with weights w = p̂/q_bvh removes the error of those
-//! cluster bounds, so as K grows the choice goes from `bvh` (K = 1 has exactly `bvh`'s pmf) to
-//! `exhaustive`.
+//! candidates by the light's own importance p̂ (Φ·cos θ′/d²·cos θ′ᵢ of the light's bounds, the
+//! [`importance`](super::importance) formula as the BVH's leaf lane computes it: the walk
+//! returns it, so it costs no second evaluation and no access to the light's bounds) with
+//! weights w = p̂/q_bvh removes the error of those cluster bounds, so as K grows the choice
+//! goes from `bvh` (K = 1 has exactly `bvh`'s pmf) to `exhaustive`.
 //!
 //! **Stratified** ([`Ris::stratified`]): candidate i is the BVH's choice for (i + o)/K, one per
 //! stratum of the BVH's sample space, and the final choice inverts the running sum of w over
