@@ -15,8 +15,8 @@ use penumbra::light_selection::{
     ExhaustiveSelector, FiniteSelector, PowerSelector, RisBvhSelector, RisSelector, SelectorKind,
     ShadingPoint, importance,
 };
-use penumbra::sampling::chi2::{Chi2Config, chi2_discrete};
 use penumbra::lights::LightBounds;
+use penumbra::sampling::chi2::{Chi2Config, chi2_discrete};
 use penumbra::sampling::hash::{next_f32, pcg_from_keys};
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
@@ -163,10 +163,7 @@ fn ris_variance_falls_with_k() {
         .map(|&k| rel_var(Source::Bvh, k))
         .collect();
     eprintln!("ris-bvh: relative variance over K = 1, 4, 16, 64: {vb:?}");
-    assert!(
-        vb[0] > vb[1] && vb[1] > vb[2] && vb[2] > vb[3],
-        "{vb:?}"
-    );
+    assert!(vb[0] > vb[1] && vb[1] > vb[2] && vb[2] > vb[3], "{vb:?}");
     assert!(vb.iter().zip(&v).all(|(b, p)| b < p), "{vb:?} vs {v:?}");
     // Exhaustive has none (up to rounding).
     let (l, p) = ex.sample(&sp, 0.3).unwrap();
@@ -211,7 +208,10 @@ fn ris_light_strategy_render_matches_exhaustive() {
                 (mr - me) / sigma
             );
             if strategy != Strategy::Mis {
-                assert!((mr - me).abs() < 5.0 * sigma, "{ris}: {mr} vs {me} (σ {sigma})");
+                assert!(
+                    (mr - me).abs() < 5.0 * sigma,
+                    "{ris}: {mr} vs {me} (σ {sigma})"
+                );
             }
         }
     }
@@ -302,7 +302,11 @@ fn stratified_ris_probability(
         for j in 0..k {
             let v = ((j as f64 + o) / k as f64) as f32;
             if let Some((l, q)) = draw(v) {
-                let w = if q > 0.0 { target[l as usize] / q as f64 } else { 0.0 };
+                let w = if q > 0.0 {
+                    target[l as usize] / q as f64
+                } else {
+                    0.0
+                };
                 cands.push((l as usize, w));
             }
         }

@@ -576,12 +576,7 @@ impl BvhSelector {
     /// [`FiniteSelector::sample`] for each of `us` (`out[i]` for `us[i]`, with the chosen
     /// light's own importance as a third number; fastest with `us` ascending, which shares the
     /// walks' common nodes).
-    pub fn sample_many(
-        &self,
-        ctx: &ShadingPoint,
-        us: &[f32],
-        out: &mut [Option<(u32, f32, f32)>],
-    ) {
+    pub fn sample_many(&self, ctx: &ShadingPoint, us: &[f32], out: &mut [Option<(u32, f32, f32)>]) {
         self.cpu.dispatch(SampleManyKernel {
             bvh: self,
             ctx,

@@ -65,10 +65,7 @@ impl SelectorKind {
     /// Whether `pmf` is the exact probability of `sample`'s choice (all but `ris` and
     /// `ris-bvh`, whose `pmf` is an estimate: see `ris.rs`).
     pub fn exact_pmf(self) -> bool {
-        !matches!(
-            self,
-            SelectorKind::Ris { .. } | SelectorKind::RisBvh { .. }
-        )
+        !matches!(self, SelectorKind::Ris { .. } | SelectorKind::RisBvh { .. })
     }
 
     /// The selector used wherever none is named (`penumbra render`, `bench`, the lab,
@@ -126,7 +123,11 @@ impl FromStr for SelectorKind {
             ("ris-bvh", |candidates| SelectorKind::RisBvh { candidates }),
         ];
         for (name, make) in with_k {
-            if let Some(k) = s.trim().strip_prefix(name).and_then(|r| r.strip_prefix(':')) {
+            if let Some(k) = s
+                .trim()
+                .strip_prefix(name)
+                .and_then(|r| r.strip_prefix(':'))
+            {
                 return match k.parse::<u32>() {
                     Ok(k) if (1..=super::ris::MAX_CANDIDATES).contains(&k) => Ok(make(k)),
                     _ => Err(format!(

@@ -202,15 +202,14 @@ impl<S: CandidateSource> Ris<S> {
         let mut inline_d: [Drawn; INLINE_CANDIDATES] = [None; INLINE_CANDIDATES];
         let mut inline_w = [0.0f64; INLINE_CANDIDATES];
         let (mut heap_u, mut heap_d, mut heap_w) = (Vec::new(), Vec::new(), Vec::new());
-        let (us, drawn, ws): (&mut [f32], &mut [Drawn], &mut [f64]) =
-            if k <= INLINE_CANDIDATES {
-                (&mut inline_u[..k], &mut inline_d[..k], &mut inline_w[..k])
-            } else {
-                heap_u.resize(k, 0.0);
-                heap_d.resize(k, None);
-                heap_w.resize(k, 0.0);
-                (&mut heap_u, &mut heap_d, &mut heap_w)
-            };
+        let (us, drawn, ws): (&mut [f32], &mut [Drawn], &mut [f64]) = if k <= INLINE_CANDIDATES {
+            (&mut inline_u[..k], &mut inline_d[..k], &mut inline_w[..k])
+        } else {
+            heap_u.resize(k, 0.0);
+            heap_d.resize(k, None);
+            heap_w.resize(k, 0.0);
+            (&mut heap_u, &mut heap_d, &mut heap_w)
+        };
         for (i, v) in us.iter_mut().enumerate() {
             *v = ((i as f32 + offset) / self.k as f32).min(super::ONE_MINUS_EPS);
         }
