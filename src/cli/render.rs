@@ -79,7 +79,8 @@ pub struct Args {
     #[arg(long, default_value = "stratified")]
     pub pattern: PatternKind,
     /// Light selection at every path vertex: uniform, power, spatial, adaptive, online, wald,
-    /// bvh, exhaustive or ris (ris:K for K candidates, default 8). `online` learns while the
+    /// bvh, exhaustive, ris (ris:K for K power-sampled candidates, default 8) or ris-bvh
+    /// (ris-bvh:K: K light-BVH candidates, default 4). `online` learns while the
     /// image renders (rounds of 1, 1, 2, 4, … spp; separate tables for camera-ray hits and
     /// later vertices; deterministic for any thread count); `adaptive` trains in a pre-pass. Default: the scene file's
     /// `lightsampler`, else bvh (the most efficient on average over the built-in scenes,

@@ -29,11 +29,17 @@ pub enum SelectorKind {
         /// K, the candidates per selection.
         candidates: u32,
     },
+    /// Resampled importance sampling of K light-BVH-sampled candidates (`ris-bvh` or
+    /// `ris-bvh:K`).
+    RisBvh {
+        /// K, the candidates per selection.
+        candidates: u32,
+    },
 }
 
 impl SelectorKind {
     /// Every strategy, in CLI order.
-    pub const ALL: [SelectorKind; 9] = [
+    pub const ALL: [SelectorKind; 10] = [
         SelectorKind::Uniform,
         SelectorKind::Power,
         SelectorKind::Spatial,
@@ -43,6 +49,7 @@ impl SelectorKind {
         SelectorKind::Bvh,
         SelectorKind::Exhaustive,
         SelectorKind::RIS,
+        SelectorKind::RIS_BVH,
     ];
 
     /// `ris` with its default K.
@@ -50,10 +57,15 @@ impl SelectorKind {
         candidates: super::ris::DEFAULT_CANDIDATES,
     };
 
-    /// Whether `pmf` is the exact probability of `sample`'s choice (all but `ris`, whose
-    /// `pmf` is an estimate: see `ris.rs`).
+    /// `ris-bvh` with its default K.
+    pub const RIS_BVH: SelectorKind = SelectorKind::RisBvh {
+        candidates: super::ris_bvh::DEFAULT_CANDIDATES,
+    };
+
+    /// Whether `pmf` is the exact probability of `sample`'s choice (all but `ris` and
+    /// `ris-bvh`, whose `pmf` is an estimate: see `ris.rs`).
     pub fn exact_pmf(self) -> bool {
-        !matches!(self, SelectorKind::Ris { .. })
+        !matches!(self, SelectorKind::Ris { .. } | SelectorKind::RisBvh { .. })
     }
 
     /// The selector used wherever none is named (`penumbra render`, `bench`, the lab,
@@ -75,6 +87,7 @@ impl SelectorKind {
             SelectorKind::Bvh => "bvh",
             SelectorKind::Exhaustive => "exhaustive",
             SelectorKind::Ris { .. } => "ris",
+            SelectorKind::RisBvh { .. } => "ris-bvh",
         }
     }
 }
@@ -91,6 +104,11 @@ impl fmt::Display for SelectorKind {
             SelectorKind::Ris { candidates } if candidates != super::ris::DEFAULT_CANDIDATES => {
                 write!(f, "ris:{candidates}")
             }
+            SelectorKind::RisBvh { candidates }
+                if candidates != super::ris_bvh::DEFAULT_CANDIDATES =>
+            {
+                write!(f, "ris-bvh:{candidates}")
+            }
             k => f.write_str(k.name()),
         }
     }
@@ -99,16 +117,25 @@ impl fmt::Display for SelectorKind {
 impl FromStr for SelectorKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        if let Some(k) = s.trim().strip_prefix("ris:") {
-            return match k.parse::<u32>() {
-                Ok(candidates) if (1..=super::ris::MAX_CANDIDATES).contains(&candidates) => {
-                    Ok(SelectorKind::Ris { candidates })
-                }
-                _ => Err(format!(
-                    "bad light selection '{s}': ris:K needs 1 <= K <= {}",
-                    super::ris::MAX_CANDIDATES
-                )),
-            };
+        type Make = fn(u32) -> SelectorKind;
+        let with_k: [(&str, Make); 2] = [
+            ("ris", |candidates| SelectorKind::Ris { candidates }),
+            ("ris-bvh", |candidates| SelectorKind::RisBvh { candidates }),
+        ];
+        for (name, make) in with_k {
+            if let Some(k) = s
+                .trim()
+                .strip_prefix(name)
+                .and_then(|r| r.strip_prefix(':'))
+            {
+                return match k.parse::<u32>() {
+                    Ok(k) if (1..=super::ris::MAX_CANDIDATES).contains(&k) => Ok(make(k)),
+                    _ => Err(format!(
+                        "bad light selection '{s}': {name}:K needs 1 <= K <= {}",
+                        super::ris::MAX_CANDIDATES
+                    )),
+                };
+            }
         }
         Self::ALL
             .into_iter()

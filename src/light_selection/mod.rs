@@ -9,7 +9,8 @@
 //! conservative bounds), [`adaptive`] (the spatial grid, trained per cell by eye rays),
 //! [`online`] (the grid's tables learned while the image renders, per vertex class), and
 //! [`ris`] (resampled importance sampling of K power-sampled candidates; its `pmf` is RIS's
-//! contribution weight, not an exact probability: [`SelectorKind::exact_pmf`]).
+//! contribution weight, not an exact probability: [`SelectorKind::exact_pmf`]) and [`ris_bvh`]
+//! (the same over K light-BVH-sampled candidates).
 //!
 //! Every strategy except `uniform` works on the *finite* lights (those with [`LightBounds`]);
 //! [`Selector`] wraps it and gives lights without bounds (environment, sky, distant) a fixed
@@ -25,6 +26,7 @@ pub mod kind;
 pub mod online;
 pub mod power;
 pub mod ris;
+pub mod ris_bvh;
 pub mod spatial;
 pub mod uniform;
 pub mod wald;
@@ -36,6 +38,7 @@ pub use importance::importance;
 pub use kind::SelectorKind;
 pub use power::PowerSelector;
 pub use ris::RisSelector;
+pub use ris_bvh::RisBvhSelector;
 pub use spatial::SpatialSelector;
 pub use uniform::UniformSelector;
 pub use wald::WaldSelector;
@@ -271,6 +274,9 @@ pub fn make_selector(
         SelectorKind::Bvh => wrap(&|set| Box::new(BvhSelector::new(&set.bounds))),
         SelectorKind::Ris { candidates } => {
             wrap(&|set| Box::new(RisSelector::new(&set.bounds, candidates, seed)))
+        }
+        SelectorKind::RisBvh { candidates } => {
+            wrap(&|set| Box::new(RisBvhSelector::new(&set.bounds, candidates, seed)))
         }
         // The learned and grid strategies, mixed with power at the share their probes chose
         // (`defensive.rs`). The margin is what a δ < 1 must gain: little for `wald` (two
