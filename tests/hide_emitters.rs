@@ -135,3 +135,39 @@ fn hide_emitters_is_off_by_default_and_every_thread_count_renders_the_same() {
             .eq(two.pixels.iter().map(|&p| bits(p)))
     );
 }
+
+#[test]
+fn render_hide_emitters_flag_darkens_only_the_pixels_that_see_the_light() {
+    let dir = std::env::temp_dir().join(format!("penumbra-hide-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |extra: &[&str], name: &str| -> Image {
+        let out = dir.join(name);
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_penumbra"))
+            .args([
+                "render", "cornell", "--res", "24x24", "--spp", "4", "-q", "-o",
+            ])
+            .arg(&out)
+            .args(extra)
+            .status()
+            .unwrap();
+        assert!(status.success(), "{extra:?}");
+        penumbra::image::io::read_image(&out).unwrap()
+    };
+    let shown = run(&[], "shown.pfm");
+    let hidden = run(&["--hide-emitters"], "hidden.pfm");
+    std::fs::remove_dir_all(&dir).ok();
+    let (mut same, mut darker) = (0, 0);
+    for (s, h) in shown.pixels.iter().zip(&hidden.pixels) {
+        if bits(*s) == bits(*h) {
+            same += 1;
+        } else {
+            // Only the ceiling light's own pixels change: they lose its radiance (~17).
+            assert!(s.max_element() > h.max_element() + 1.0, "{s:?} → {h:?}");
+            darker += 1;
+        }
+    }
+    assert!(
+        darker > 0 && same > 10 * darker,
+        "{darker} darker, {same} unchanged"
+    );
+}

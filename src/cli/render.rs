@@ -65,8 +65,9 @@ pub struct Args {
     #[arg(long, conflicts_with_all = ["spp_range", "progressive", "resume", "time"])]
     pub splat: bool,
     /// Hide the emitters camera rays see directly (Mitsuba 3's `hide_emitters`): a light's
-    /// surface, or the environment, seen straight from the camera is black; the light it
-    /// casts (on surfaces, in reflections, through glass) is unchanged.
+    /// surface seen straight from the camera shows no emission (only what it reflects), the
+    /// environment behind the scene is black; the light they cast (on surfaces, in
+    /// reflections, through glass) is unchanged.
     #[arg(long)]
     pub hide_emitters: bool,
     /// Estimator at every path vertex: bsdf, light-area, light-solid-angle or mis.
