@@ -28,6 +28,7 @@ def cornell():
         {},
         dict(strategy="bsdf", pattern="sobol", light_selection="power", seed=7, threads=1),
         dict(strategy="light-area", shadow_rays=3, mis="balance", pattern="random", seed=3),
+        dict(hide_emitters=True, seed=2),
     ],
 )
 def test_array_equals_cli_image_bit_for_bit(cli, tmp_path, cornell, settings):
@@ -36,7 +37,9 @@ def test_array_equals_cli_image_bit_for_bit(cli, tmp_path, cornell, settings):
     assert img.dtype == np.float32 and img.shape == (32, 48, 3)
     flags = ["--res", "48x32", "--spp", "8", "-q", "-o", tmp_path / "cli.exr"]
     for k, v in settings.items():
-        flags += [f"--{k.replace('_', '-')}", v]
+        flag = f"--{k.replace('_', '-')}"
+        # A boolean keyword is a bare CLI flag.
+        flags += [flag] if v is True else [flag, v]
     cli("render", "cornell", *flags)
     ref = penumbra.read_image(tmp_path / "cli.exr")
     assert np.array_equal(img, ref), f"max |diff| {np.abs(img - ref).max()}"
