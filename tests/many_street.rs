@@ -113,6 +113,27 @@ fn many_street_light_count_scales_the_city() {
     );
 }
 
+/// Each triangle light facing the eye at `eye` whose corners all project onto the film:
+/// its index, luminance and projected corners (a perspective map takes a triangle in front of
+/// the camera to a triangle).
+fn facing_lights_on_film(
+    scene: &penumbra::scene::Scene,
+    eye: glam::Vec3,
+    res: glam::UVec2,
+) -> impl Iterator<Item = (usize, f32, Vec<glam::Vec2>)> + '_ {
+    scene.lights.iter().enumerate().filter_map(move |(i, l)| {
+        let Light::Triangle(t) = l else { return None };
+        if t.n.dot(eye - t.p[0]) <= 0.0 {
+            return None;
+        }
+        let q =
+            t.p.iter()
+                .map(|&p| scene.camera.project(p, res))
+                .collect::<Option<Vec<glam::Vec2>>>()?;
+        Some((i, penumbra::luminance(t.l), q))
+    })
+}
+
 /// Area of the part of convex polygon `poly` (raster space) inside the unit pixel at `px`:
 /// Sutherland–Hodgman against its four edges, then the shoelace formula.
 fn area_in_pixel(poly: &[glam::Vec2], px: glam::Vec2) -> f64 {
@@ -171,22 +192,11 @@ fn many_street_firefly_is_a_lamp_seen_edge_on_and_the_camera_estimate_is_its_cov
     // triangle in front of the camera to a triangle) and clipped to the pixel.
     let mut exact = 0.0f64;
     let mut covering = Vec::new();
-    for (i, l) in scene.lights.iter().enumerate() {
-        let Light::Triangle(t) = l else { continue };
-        if t.n.dot(eye - t.p[0]) <= 0.0 {
-            continue;
-        }
-        let Some(q) =
-            t.p.iter()
-                .map(|&p| scene.camera.project(p, res))
-                .collect::<Option<Vec<Vec2>>>()
-        else {
-            continue;
-        };
+    for (i, lum, q) in facing_lights_on_film(&scene, eye, res) {
         let a = area_in_pixel(&q, pixel.as_vec2());
         if a > 0.0 {
-            exact += a * penumbra::luminance(t.l) as f64;
-            covering.push((i, a, penumbra::luminance(t.l)));
+            exact += a * lum as f64;
+            covering.push((i, a, lum));
         }
     }
     let coverage: f64 = covering.iter().map(|c| c.1).sum();
@@ -248,18 +258,7 @@ fn many_street_pixels_that_see_a_light() {
     // Per pixel: coverage, coverage × Le, the covering lights.
     let mut per: std::collections::BTreeMap<(u32, u32), (f64, f64, Vec<usize>)> =
         Default::default();
-    for (i, l) in scene.lights.iter().enumerate() {
-        let Light::Triangle(t) = l else { continue };
-        if t.n.dot(eye - t.p[0]) <= 0.0 {
-            continue;
-        }
-        let Some(q) =
-            t.p.iter()
-                .map(|&p| scene.camera.project(p, res))
-                .collect::<Option<Vec<Vec2>>>()
-        else {
-            continue;
-        };
+    for (i, lum, q) in facing_lights_on_film(&scene, eye, res) {
         let lo = q.iter().fold(Vec2::MAX, |a, &b| a.min(b)).floor();
         let hi = q.iter().fold(Vec2::MIN, |a, &b| a.max(b)).floor();
         let (lo, hi) = (lo.max(Vec2::ZERO), hi.min(res.as_vec2() - 1.0));
@@ -272,7 +271,7 @@ fn many_street_pixels_that_see_a_light() {
                 if a > 0.0 {
                     let e = per.entry((x, y)).or_default();
                     e.0 += a;
-                    e.1 += a * penumbra::luminance(t.l) as f64;
+                    e.1 += a * lum as f64;
                     e.2.push(i);
                 }
             }

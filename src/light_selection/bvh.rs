@@ -234,6 +234,33 @@ fn running_sums(imp: &[f32; WIDTH]) -> [f64; WIDTH + 1] {
     ]
 }
 
+/// One level of the walk: the child picked ∝ importance by `u`, `u` rescaled to that
+/// child's share, and the child's probability; `None` where no child has importance.
+#[inline(always)]
+fn descend(imp: &[f32; WIDTH], cum: &[f64; WIDTH + 1], u: f64) -> Option<(usize, f64, f64)> {
+    let total = cum[WIDTH];
+    if !(total > 0.0) {
+        return None;
+    }
+    let target = u * total;
+    let pick = pick_slot(imp, cum, target);
+    let x = imp[pick] as f64;
+    // `target − cum[pick]` ≥ 0 is exact in sign (cum[pick] ≤ target, or the fallback slot's
+    // sum, below the total).
+    let next = ((target - cum[pick]) / x).clamp(0.0, 1.0 - f64::EPSILON);
+    Some((pick, next, x / total))
+}
+
+/// The pmf of a walk: its levels' probabilities multiplied bottom-up (as `pmf_impl` does).
+#[inline(always)]
+fn walk_pmf(probs: &[f64]) -> f32 {
+    let mut pmf = 1.0f64;
+    for &p in probs.iter().rev() {
+        pmf *= p;
+    }
+    pmf as f32
+}
+
 /// The child whose share of the running sums `cum` (from [`running_sums`]) holds `target`:
 /// cum[pick] ≤ target < cum[pick + 1], i.e. the number of running sums past slot 0 that do not
 /// exceed it. Such a slot has a positive importance (its running sum grows), so this is the
@@ -456,26 +483,13 @@ impl BvhSelector {
         loop {
             let node = &self.nodes[i];
             node.importance(ctx.p, ctx.n, &mut imp);
-            let cum = running_sums(&imp);
-            let total = cum[WIDTH];
-            if !(total > 0.0) {
-                return None;
-            }
-            let target = u * total;
-            let pick = pick_slot(&imp, &cum, target);
-            let x = imp[pick] as f64;
-            // `target − cum[pick]` ≥ 0 is exact in sign (cum[pick] ≤ target, or the fallback
-            // slot's sum, below the total).
-            u = ((target - cum[pick]) / x).clamp(0.0, 1.0 - f64::EPSILON);
-            probs[levels] = x / total;
+            let (pick, next, prob) = descend(&imp, &running_sums(&imp), u)?;
+            u = next;
+            probs[levels] = prob;
             levels += 1;
             let c = node.child[pick];
             if c & LEAF != 0 {
-                let mut pmf = 1.0f64;
-                for &p in probs[..levels].iter().rev() {
-                    pmf *= p;
-                }
-                return Some((c & !LEAF, pmf as f32));
+                return Some((c & !LEAF, walk_pmf(&probs[..levels])));
             }
             i = c as usize;
         }
@@ -549,23 +563,15 @@ impl BvhSelector {
                     cum_deep = running_sums(&imp_deep);
                     (&imp_deep, &cum_deep)
                 };
-                let total = cum[WIDTH];
-                if !(total > 0.0) {
+                let Some((pick, next, prob)) = descend(imp, cum, u) else {
                     break;
-                }
-                let target = u * total;
-                let pick = pick_slot(imp, cum, target);
-                let x = imp[pick] as f64;
-                u = ((target - cum[pick]) / x).clamp(0.0, 1.0 - f64::EPSILON);
-                probs[levels] = x / total;
+                };
+                u = next;
+                probs[levels] = prob;
                 levels += 1;
                 let c = node.child[pick];
                 if c & LEAF != 0 {
-                    let mut pmf = 1.0f64;
-                    for &p in probs[..levels].iter().rev() {
-                        pmf *= p;
-                    }
-                    *o = Some((c & !LEAF, pmf as f32, imp[pick]));
+                    *o = Some((c & !LEAF, walk_pmf(&probs[..levels]), imp[pick]));
                     break;
                 }
                 i = c as usize;
