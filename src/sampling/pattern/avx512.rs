@@ -14,7 +14,7 @@ use {
     super::{Pattern, TAG_1D, TAG_2D, TAG_JITTER},
     crate::isa::{Avx512, Kernel, Token},
     crate::sampling::ONE_MINUS_EPSILON,
-    glam::{UVec2, Vec2},
+    glam::Vec2,
 };
 
 /// The key material of one tag's (1D or 2D) sets of a pixel's [`CACHED_DIMS`] dimensions
@@ -46,17 +46,17 @@ impl Pattern {
     /// ([`RawSets`]): the keys of the 8 cached dimensions are 8 u64 lanes, so every hash of a
     /// pixel's set keys is one vector op, and they are stored as they come (6 vector stores;
     /// the round keys of a dimension are derived when its chunk is filled, for the few
-    /// dimensions an integrator uses).
+    /// dimensions an integrator uses). `prefix`: the pixel's [`Pattern::pixel_hash`].
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    pub(super) fn raw_stratified_avx512(&self, t: Avx512, pixel: UVec2, raw: &mut [RawSets; 2]) {
+    pub(super) fn raw_stratified_avx512(&self, t: Avx512, prefix: u64, raw: &mut [RawSets; 2]) {
         use crate::sampling::hash::{hash_step_avx512, mix64_avx512};
         use std::arch::x86_64::*;
         const _: () = assert!(CACHED_DIMS == 8, "one 8-lane vector of dimensions");
         // SAFETY: `t` proves the CPU runs AVX-512.
         let (prefix, lanes) = unsafe {
             (
-                _mm512_set1_epi64(self.pixel_hash(pixel) as i64),
+                _mm512_set1_epi64(prefix as i64),
                 _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7),
             )
         };

@@ -240,11 +240,12 @@ impl SamplePattern for Pattern {
     }
 
     fn pixel_into(&self, pixel: UVec2, out: &mut PixelSamples) {
-        out.reset(*self, pixel);
+        let prefix = self.pixel_hash(pixel);
+        out.reset(*self, pixel, prefix);
         #[cfg(target_arch = "x86_64")]
         if out.raw_mode {
             /// [`Pattern::raw_stratified_avx512`] as a kernel.
-            struct Raw<'a>(&'a Pattern, UVec2, &'a mut [RawSets; 2]);
+            struct Raw<'a>(&'a Pattern, u64, &'a mut [RawSets; 2]);
             impl Kernel for Raw<'_> {
                 type Output = ();
                 #[inline(always)]
@@ -255,10 +256,9 @@ impl SamplePattern for Pattern {
                     }
                 }
             }
-            self.cpu.dispatch(Raw(self, pixel, &mut out.raw));
+            self.cpu.dispatch(Raw(self, prefix, &mut out.raw));
             return;
         }
-        let prefix = self.pixel_hash(pixel);
         for d in 0..CACHED_DIMS {
             let dim = hash_step(prefix, d as u64);
             out.sets_1d[d] = self.set_of_dim(dim, TAG_1D);

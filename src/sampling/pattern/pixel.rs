@@ -1,6 +1,7 @@
 //! The per-pixel cache: [`PixelSamples`] hashes the keys of one pixel's first [`CACHED_DIMS`]
 //! dimensions once, then evaluates each of those sample sets 16 consecutive indices at a time
 //! (integrators walk a pixel's indices in order), so most samples cost one compare and a load.
+//! Later dimensions (a path's later vertices) get their keys at first use and the same batches.
 //! Values are bit-identical to the pattern's `sample_1d` / `sample_2d` (tests/pat_golden.rs).
 
 use glam::{UVec2, Vec2};
@@ -31,6 +32,7 @@ impl Pattern {
         PixelSamples {
             pattern: *self,
             pixel,
+            prefix: self.pixel_hash(pixel),
             sets_1d,
             sets_2d,
             raw_mode: self.raw_mode(),
@@ -43,6 +45,8 @@ impl Pattern {
             chunks_2d: Default::default(),
             deep: Default::default(),
             deep_tag: Default::default(),
+            deep_1d: Default::default(),
+            deep_2d: Default::default(),
             generation: Cell::new(1),
         }
     }
@@ -132,6 +136,8 @@ impl<T: Copy> Chunk<T> {
 pub struct PixelSamples {
     pub(super) pattern: Pattern,
     pixel: UVec2,
+    /// The pixel's [`Pattern::pixel_hash`], from which the deep dimensions' keys are derived.
+    prefix: u64,
     pub(super) sets_1d: [SetKeys; CACHED_DIMS],
     pub(super) sets_2d: [SetKeys; CACHED_DIMS],
     /// The `stratified` AVX-512 form: `raw` holds the keys instead of `sets_1d` / `sets_2d`
@@ -158,12 +164,17 @@ pub struct PixelSamples {
     pub(super) chunks_2d: [Chunk<Vec2>; CACHED_DIMS],
     /// The keys of the 1D and 2D sets of dimensions past [`CACHED_DIMS`] (a path's later
     /// vertices), computed at their first use in this pixel: slot `dim % DEEP` holds the
-    /// keys of the last such dim, valid when its tag is (`generation`, dim). Values are
-    /// evaluated one at a time as [`Pattern::sample_1d`] / [`Pattern::sample_2d`] do, from the
-    /// same keys and strata.
+    /// keys of the last such dim, valid when its tag is (`generation`, dim); its values are
+    /// batched in `deep_1d` / `deep_2d` as a cached dimension's are.
     deep: [[Cell<SetKeys>; DEEP]; 2],
     /// Per slot of `deep`: (generation, dim) of its keys.
     deep_tag: [[Cell<(u64, u32)>; DEEP]; 2],
+    /// Per slot of `deep`: a batch of its set's values, as `chunks_1d` / `chunks_2d` hold for
+    /// the cached dimensions (emptied when the slot takes another set's keys). A later
+    /// vertex's draws come one per path but all the paths of a pixel reach it in index
+    /// order, so one fill of 16 serves them as it does at the first vertex.
+    deep_1d: [Chunk<f32>; DEEP],
+    deep_2d: [Chunk<Vec2>; DEEP],
     /// Bumped by every reset to a new pixel, which so empties `deep` in one store.
     generation: Cell<u64>,
 }
@@ -176,9 +187,10 @@ impl PixelSamples {
     /// caller writes next): every chunk emptied, the per-count caches kept (they depend on
     /// the count only).
     #[inline]
-    pub(super) fn reset(&mut self, pattern: Pattern, pixel: UVec2) {
+    pub(super) fn reset(&mut self, pattern: Pattern, pixel: UVec2, prefix: u64) {
         self.pattern = pattern;
         self.pixel = pixel;
+        self.prefix = prefix;
         self.raw_mode = pattern.raw_mode();
         for c in &self.chunks_1d {
             c.len.set(0);
@@ -243,7 +255,7 @@ impl PixelSamples {
     /// The 1D sample `index` of `count` for `dim`.
     #[inline(always)]
     pub fn sample_1d(&self, dim: u32, index: u32, count: u32) -> f32 {
-        if let Some(c) = self.chunks_1d.get(dim as usize)
+        if let Some(c) = self.chunk(0, dim, &self.chunks_1d, &self.deep_1d)
             && let Some(v) = c.get(index, count)
         {
             return v;
@@ -268,7 +280,7 @@ impl PixelSamples {
         }
         self.miss(
             self.set_keys(0, dim),
-            &self.chunks_1d,
+            (&self.chunks_1d, &self.deep_1d),
             Arity {
                 dim,
                 index,
@@ -285,7 +297,7 @@ impl PixelSamples {
     /// The 2D sample `index` of `count` for `dim`.
     #[inline(always)]
     pub fn sample_2d(&self, dim: u32, index: u32, count: u32) -> Vec2 {
-        if let Some(c) = self.chunks_2d.get(dim as usize)
+        if let Some(c) = self.chunk(1, dim, &self.chunks_2d, &self.deep_2d)
             && let Some(v) = c.get(index, count)
         {
             return v;
@@ -305,7 +317,7 @@ impl PixelSamples {
         }
         self.miss(
             self.set_keys(1, dim),
-            &self.chunks_2d,
+            (&self.chunks_2d, &self.deep_2d),
             Arity {
                 dim,
                 index,
@@ -317,6 +329,25 @@ impl PixelSamples {
                 },
             },
         )
+    }
+
+    /// The chunk that may hold `dim`'s values (`arity` 0: 1D, 1: 2D): a cached dimension's
+    /// own, or the deep slot holding `dim`'s keys in this pixel (looked up before the call to
+    /// the miss path: a later vertex's draws mostly hit their slot's batch).
+    #[inline(always)]
+    fn chunk<'a, T: Copy>(
+        &self,
+        arity: usize,
+        dim: u32,
+        chunks: &'a [Chunk<T>; CACHED_DIMS],
+        deep: &'a [Chunk<T>; DEEP],
+    ) -> Option<&'a Chunk<T>> {
+        let d = dim as usize;
+        if d < CACHED_DIMS {
+            return Some(&chunks[d]);
+        }
+        let i = d % DEEP;
+        (self.deep_tag[arity][i].get() == (self.generation.get(), dim)).then_some(&deep[i])
     }
 
     /// The keys of the 1D (`arity` 0) or 2D (1) set of `dim`, if it is a cached dimension.
@@ -342,7 +373,7 @@ impl PixelSamples {
     fn miss<T, E, F>(
         &self,
         set: Option<SetKeys>,
-        chunks: &[Chunk<T>; CACHED_DIMS],
+        (chunks, deep): (&[Chunk<T>; CACHED_DIMS], &[Chunk<T>; DEEP]),
         a: Arity<E, F>,
     ) -> T
     where
@@ -371,14 +402,26 @@ impl PixelSamples {
                 } else {
                     super::TAG_2D
                 };
-                slot.set(
-                    self.pattern
-                        .set(self.pattern.pixel_hash(self.pixel), dim, set_tag),
-                );
+                slot.set(self.pattern.set(self.prefix, dim, set_tag));
                 tag.set(want);
+                deep[i].len.set(0);
             }
             let keys = slot.get();
-            return eval(&keys, self.pattern.kind, index, &self.strata(count));
+            let kind = self.pattern.kind;
+            // The slot's batch, filled the fast way as a cached dimension's chunk is (the same
+            // values); other patterns and wrapped indices take the general evaluation.
+            if kind == PatternKind::Stratified && index < count {
+                let chunk = &deep[i];
+                if let Some(v) = chunk.get(index, count) {
+                    return v;
+                }
+                let f = self.fast(count);
+                if f.valid {
+                    let base = index & !(CHUNK as u32 - 1);
+                    return chunk.store(index, count, &fast(&f, &keys, base));
+                }
+            }
+            return eval(&keys, kind, index, &self.strata(count));
         };
         let set = &set;
         let kind = self.pattern.kind;

@@ -256,3 +256,42 @@ fn non_power_of_two_chunks_equal_the_pattern_values() {
         }
     }
 }
+
+#[test]
+fn deep_dimension_batches_serve_slot_sharing_dimensions_and_new_pixels() {
+    // Dimensions past CACHED_DIMS keep a batch of values per slot (dim mod 16): two dims that
+    // share a slot, read in turn, and the same dims after a reset to another pixel, must each
+    // still get their own pixel's values (a stale batch would serve the other's).
+    for (kind, isa) in PatternKind::ALL
+        .into_iter()
+        .flat_map(|k| Isa::available().into_iter().map(move |i| (k, i)))
+    {
+        let pat = Pattern {
+            seed: 11,
+            kind,
+            cpu: isa.cpu(),
+        };
+        let mut px = pat.pixel(UVec2::new(2, 2));
+        for pixel in [UVec2::new(2, 2), UVec2::new(2, 3), UVec2::new(40, 3)] {
+            pat.pixel_into(pixel, &mut px);
+            for count in [16u32, 64, 37] {
+                for index in 0..count + 2 {
+                    for dim in [9u32, 25, 9, 41] {
+                        assert_eq!(
+                            px.sample_1d(dim, index, count).to_bits(),
+                            pat.sample_1d(pixel, dim, index, count).to_bits(),
+                            "{kind} {isa:?} 1d dim {dim} count {count} index {index}"
+                        );
+                        assert_eq!(
+                            px.sample_2d(dim, index, count).to_array().map(f32::to_bits),
+                            pat.sample_2d(pixel, dim, index, count)
+                                .to_array()
+                                .map(f32::to_bits),
+                            "{kind} {isa:?} 2d dim {dim} count {count} index {index}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
