@@ -24,9 +24,9 @@
 //! 1D versions are analogous (`grid`: stratum centres, `stratified`/`lhs`: jittered strata).
 //! What they share: `sets.rs` (a sample set's keys and strata, and the dispatch by kind).
 //!
-//! Hot path: [`SamplePattern::pixel`] hashes the keys of one pixel's first [`CACHED_DIMS`]
-//! dimensions once ([`PixelSamples`], in `pixel.rs`), which then evaluates each of those sample
-//! sets 16 consecutive indices at a time (integrators walk a pixel's indices in order), so most
+//! Hot path: [`SamplePattern::pixel`] makes one pixel's [`PixelSamples`] (in `pixel.rs`), which
+//! derives each sample set's keys once, at its first use, then evaluates the set 16
+//! consecutive indices at a time (integrators walk a pixel's indices in order), so most
 //! samples cost one compare and a load. `stratified` batches run in an integer form (`fast.rs`:
 //! lane-parallel permutation rounds; stratum and jitter as one fixed-point number; its portable
 //! loops compiled for every instruction set by `Cpu::dispatch`) or with AVX-512 intrinsics
@@ -234,7 +234,7 @@ impl SamplePattern for Pattern {
     }
 
     fn pixel(&self, pixel: UVec2) -> PixelSamples {
-        let mut px = self.pixel_of_sets(pixel, Default::default(), Default::default());
+        let mut px = self.pixel_empty(pixel);
         self.pixel_into(pixel, &mut px);
         px
     }
@@ -257,12 +257,7 @@ impl SamplePattern for Pattern {
                 }
             }
             self.cpu.dispatch(Raw(self, prefix, &mut out.raw));
-            return;
         }
-        for d in 0..CACHED_DIMS {
-            let dim = hash_step(prefix, d as u64);
-            out.sets_1d[d] = self.set_of_dim(dim, TAG_1D);
-            out.sets_2d[d] = self.set_of_dim(dim, TAG_2D);
-        }
+        // Otherwise each set's keys are derived at its first chunk fill (`PixelSamples`).
     }
 }

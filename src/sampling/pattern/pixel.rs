@@ -1,7 +1,8 @@
-//! The per-pixel cache: [`PixelSamples`] hashes the keys of one pixel's first [`CACHED_DIMS`]
-//! dimensions once, then evaluates each of those sample sets 16 consecutive indices at a time
+//! The per-pixel cache: [`PixelSamples`] hashes the keys of each of one pixel's sample sets
+//! once, at its first use, then evaluates the set 16 consecutive indices at a time
 //! (integrators walk a pixel's indices in order), so most samples cost one compare and a load.
-//! Later dimensions (a path's later vertices) get their keys at first use and the same batches.
+//! The first [`CACHED_DIMS`] dimensions have their own slots; later ones (a path's later
+//! vertices) share [`DEEP`] slots.
 //! Values are bit-identical to the pattern's `sample_1d` / `sample_2d` (tests/pat_golden.rs).
 
 use glam::{UVec2, Vec2};
@@ -21,20 +22,15 @@ impl Pattern {
             && self.cpu.isa() == Isa::Avx512
     }
 
-    /// The [`PixelSamples`] of `pixel` with these sets' keys and empty caches.
+    /// The [`PixelSamples`] of `pixel` with no keys yet and empty caches.
     #[inline(always)]
-    pub(super) fn pixel_of_sets(
-        &self,
-        pixel: UVec2,
-        sets_1d: [SetKeys; CACHED_DIMS],
-        sets_2d: [SetKeys; CACHED_DIMS],
-    ) -> PixelSamples {
+    pub(super) fn pixel_empty(&self, pixel: UVec2) -> PixelSamples {
         PixelSamples {
             pattern: *self,
             pixel,
             prefix: self.pixel_hash(pixel),
-            sets_1d,
-            sets_2d,
+            sets: Default::default(),
+            keyed: Default::default(),
             raw_mode: self.raw_mode(),
             raw: Default::default(),
             learned: Default::default(),
@@ -60,6 +56,9 @@ pub(super) const CHUNK: usize = 16;
 /// (keys read once, no per-request lookups) serves the next `len` requests with one compare.
 #[derive(Clone, Debug)]
 pub(super) struct Chunk<T: Copy> {
+    /// The dimension the values belong to (read for the deep slots only, which several
+    /// dimensions share: checking it here reads no other cache line than the values').
+    dim: Cell<u32>,
     /// The count the values belong to.
     count: Cell<u32>,
     /// First index.
@@ -73,6 +72,7 @@ pub(super) struct Chunk<T: Copy> {
 impl<T: Copy + Default> Default for Chunk<T> {
     fn default() -> Self {
         Self {
+            dim: Cell::new(0),
             count: Cell::new(0),
             base: Cell::new(0),
             len: Cell::new(0),
@@ -130,18 +130,21 @@ impl<T: Copy> Chunk<T> {
     }
 }
 
-/// One pixel's sample sets with the keys of the first [`CACHED_DIMS`] dimensions precomputed;
-/// returns exactly what the pattern's `sample_1d` / `sample_2d` return for this pixel.
+/// One pixel's sample sets, each set's keys derived once, its values batched; returns exactly what the pattern's `sample_1d` / `sample_2d` return for this pixel.
 #[derive(Clone, Debug)]
 pub struct PixelSamples {
     pub(super) pattern: Pattern,
     pixel: UVec2,
-    /// The pixel's [`Pattern::pixel_hash`], from which the deep dimensions' keys are derived.
+    /// The pixel's [`Pattern::pixel_hash`], from which its sets' keys are derived.
     prefix: u64,
-    pub(super) sets_1d: [SetKeys; CACHED_DIMS],
-    pub(super) sets_2d: [SetKeys; CACHED_DIMS],
-    /// The `stratified` AVX-512 form: `raw` holds the keys instead of `sets_1d` / `sets_2d`
-    /// (which are then unused), and a miss fills a whole group of chunks (see `learned`).
+    /// The keys of the 1D and 2D sets of the cached dimensions, derived at a dimension's
+    /// first chunk fill in this pixel (an integrator reads few of them: a diffuse scene's
+    /// path tracer 6 of the 16), valid where `keyed` has the dimension's bit.
+    sets: [[Cell<SetKeys>; CACHED_DIMS]; 2],
+    /// Per 1D / 2D: the cached dimensions (bits) whose keys `sets` holds for this pixel.
+    keyed: [Cell<u32>; 2],
+    /// The `stratified` AVX-512 form: `raw` holds the keys instead of `sets` (which is then
+    /// unused), and a miss fills a whole group of chunks (see `learned`).
     pub(super) raw_mode: bool,
     /// Raw keys of the 1D and 2D sets (raw mode).
     pub(super) raw: [RawSets; 2],
@@ -170,7 +173,8 @@ pub struct PixelSamples {
     /// Per slot of `deep`: (generation, dim) of its keys.
     deep_tag: [[Cell<(u64, u32)>; DEEP]; 2],
     /// Per slot of `deep`: a batch of its set's values, as `chunks_1d` / `chunks_2d` hold for
-    /// the cached dimensions (emptied when the slot takes another set's keys). A later
+    /// the cached dimensions, tagged with their dimension (emptied by a reset; a fill for
+    /// another dimension of the slot retags it). A later
     /// vertex's draws come one per path but all the paths of a pixel reach it in index
     /// order, so one fill of 16 serves them as it does at the first vertex.
     deep_1d: [Chunk<f32>; DEEP],
@@ -179,8 +183,9 @@ pub struct PixelSamples {
     generation: Cell<u64>,
 }
 
-/// Slots of [`PixelSamples::deep`] per arity.
-const DEEP: usize = 16;
+/// Slots of [`PixelSamples::deep`] per arity: more than the dimensions of one path vertex
+/// (the stages take a wave's paths one depth at a time, so those are the ones in use).
+const DEEP: usize = 8;
 
 impl PixelSamples {
     /// Make these the samples of `pixel` under `pattern` except for the set keys (which the
@@ -191,11 +196,18 @@ impl PixelSamples {
         self.pattern = pattern;
         self.pixel = pixel;
         self.prefix = prefix;
+        self.keyed = Default::default();
         self.raw_mode = pattern.raw_mode();
         for c in &self.chunks_1d {
             c.len.set(0);
         }
         for c in &self.chunks_2d {
+            c.len.set(0);
+        }
+        for c in &self.deep_1d {
+            c.len.set(0);
+        }
+        for c in &self.deep_2d {
             c.len.set(0);
         }
         self.generation.set(self.generation.get() + 1);
@@ -255,7 +267,7 @@ impl PixelSamples {
     /// The 1D sample `index` of `count` for `dim`.
     #[inline(always)]
     pub fn sample_1d(&self, dim: u32, index: u32, count: u32) -> f32 {
-        if let Some(c) = self.chunk(0, dim, &self.chunks_1d, &self.deep_1d)
+        if let Some(c) = self.chunk(dim, &self.chunks_1d, &self.deep_1d)
             && let Some(v) = c.get(index, count)
         {
             return v;
@@ -297,7 +309,7 @@ impl PixelSamples {
     /// The 2D sample `index` of `count` for `dim`.
     #[inline(always)]
     pub fn sample_2d(&self, dim: u32, index: u32, count: u32) -> Vec2 {
-        if let Some(c) = self.chunk(1, dim, &self.chunks_2d, &self.deep_2d)
+        if let Some(c) = self.chunk(dim, &self.chunks_2d, &self.deep_2d)
             && let Some(v) = c.get(index, count)
         {
             return v;
@@ -331,13 +343,12 @@ impl PixelSamples {
         )
     }
 
-    /// The chunk that may hold `dim`'s values (`arity` 0: 1D, 1: 2D): a cached dimension's
-    /// own, or the deep slot holding `dim`'s keys in this pixel (looked up before the call to
-    /// the miss path: a later vertex's draws mostly hit their slot's batch).
+    /// The chunk that may hold `dim`'s values: a cached dimension's own, or the deep slot's
+    /// batch if it is `dim`'s (looked up before the call to the miss path: a later vertex's
+    /// draws mostly hit their slot's batch).
     #[inline(always)]
     fn chunk<'a, T: Copy>(
         &self,
-        arity: usize,
         dim: u32,
         chunks: &'a [Chunk<T>; CACHED_DIMS],
         deep: &'a [Chunk<T>; DEEP],
@@ -346,8 +357,8 @@ impl PixelSamples {
         if d < CACHED_DIMS {
             return Some(&chunks[d]);
         }
-        let i = d % DEEP;
-        (self.deep_tag[arity][i].get() == (self.generation.get(), dim)).then_some(&deep[i])
+        let c = &deep[d % DEEP];
+        (c.dim.get() == dim).then_some(c)
     }
 
     /// The keys of the 1D (`arity` 0) or 2D (1) set of `dim`, if it is a cached dimension.
@@ -357,13 +368,16 @@ impl PixelSamples {
         if d >= CACHED_DIMS {
             return None;
         }
-        Some(if self.raw_mode {
-            self.raw[arity].set(d)
-        } else if arity == 0 {
-            self.sets_1d[d]
-        } else {
-            self.sets_2d[d]
-        })
+        if self.raw_mode {
+            return Some(self.raw[arity].set(d));
+        }
+        let (slot, keyed) = (&self.sets[arity][d], &self.keyed[arity]);
+        if keyed.get() & 1 << d == 0 {
+            let tag = [super::TAG_1D, super::TAG_2D][arity];
+            slot.set(self.pattern.set(self.prefix, dim, tag));
+            keyed.set(keyed.get() | 1 << d);
+        }
+        Some(slot.get())
     }
 
     /// A value no chunk holds: refill the chunk of `index` (< count; the `stratified` fast form
@@ -397,14 +411,9 @@ impl PixelSamples {
             let (slot, tag) = (&self.deep[arity][i], &self.deep_tag[arity][i]);
             let want = (self.generation.get(), dim);
             if tag.get() != want {
-                let set_tag = if arity == 0 {
-                    super::TAG_1D
-                } else {
-                    super::TAG_2D
-                };
+                let set_tag = [super::TAG_1D, super::TAG_2D][arity];
                 slot.set(self.pattern.set(self.prefix, dim, set_tag));
                 tag.set(want);
-                deep[i].len.set(0);
             }
             let keys = slot.get();
             let kind = self.pattern.kind;
@@ -412,12 +421,15 @@ impl PixelSamples {
             // values); other patterns and wrapped indices take the general evaluation.
             if kind == PatternKind::Stratified && index < count {
                 let chunk = &deep[i];
-                if let Some(v) = chunk.get(index, count) {
+                if chunk.dim.get() == dim
+                    && let Some(v) = chunk.get(index, count)
+                {
                     return v;
                 }
                 let f = self.fast(count);
                 if f.valid {
                     let base = index & !(CHUNK as u32 - 1);
+                    chunk.dim.set(dim);
                     return chunk.store(index, count, &fast(&f, &keys, base));
                 }
             }
