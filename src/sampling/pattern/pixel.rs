@@ -39,8 +39,6 @@ impl Pattern {
             fast: [Cell::new(FastStrata::NONE), Cell::new(FastStrata::NONE)],
             chunks_1d: Default::default(),
             chunks_2d: Default::default(),
-            deep: Default::default(),
-            deep_tag: Default::default(),
             deep_1d: Default::default(),
             deep_2d: Default::default(),
             generation: Cell::new(1),
@@ -165,27 +163,34 @@ pub struct PixelSamples {
     /// Batches of precomputed `stratified` values per cached 1D / 2D dimension.
     pub(super) chunks_1d: [Chunk<f32>; CACHED_DIMS],
     pub(super) chunks_2d: [Chunk<Vec2>; CACHED_DIMS],
-    /// The keys of the 1D and 2D sets of dimensions past [`CACHED_DIMS`] (a path's later
-    /// vertices), computed at their first use in this pixel: slot `dim % DEEP` holds the
-    /// keys of the last such dim, valid when its tag is (`generation`, dim); its values are
-    /// batched in `deep_1d` / `deep_2d` as a cached dimension's are.
-    deep: [[Cell<SetKeys>; DEEP]; 2],
-    /// Per slot of `deep`: (generation, dim) of its keys.
-    deep_tag: [[Cell<(u64, u32)>; DEEP]; 2],
-    /// Per slot of `deep`: a batch of its set's values, as `chunks_1d` / `chunks_2d` hold for
-    /// the cached dimensions, tagged with their dimension (emptied by a reset; a fill for
-    /// another dimension of the slot retags it). A later
-    /// vertex's draws come one per path but all the paths of a pixel reach it in index
-    /// order, so one fill of 16 serves them as it does at the first vertex.
-    deep_1d: [Chunk<f32>; DEEP],
-    deep_2d: [Chunk<Vec2>; DEEP],
-    /// Bumped by every reset to a new pixel, which so empties `deep` in one store.
+    /// The 1D and 2D sets of dimensions past [`CACHED_DIMS`] (a path's later vertices):
+    /// slot `dim % DEEP` holds the last such dim's keys and a batch of its values.
+    deep_1d: [DeepSlot<f32>; DEEP],
+    deep_2d: [DeepSlot<Vec2>; DEEP],
+    /// Bumped by every reset to a new pixel, which so invalidates every deep slot's keys in
+    /// one store.
     generation: Cell<u64>,
 }
 
-/// Slots of [`PixelSamples::deep`] per arity: more than the dimensions of one path vertex
+/// Slots of [`PixelSamples::deep_1d`] / `deep_2d`: more than the dimensions of one path vertex
 /// (the stages take a wave's paths one depth at a time, so those are the ones in use).
 const DEEP: usize = 8;
+
+/// One deep slot: the keys of a set past [`CACHED_DIMS`], computed at its first use in the
+/// pixel, and a batch of its values, as a cached dimension has. A later vertex's draws come
+/// one per path, but all the paths of a pixel reach it in index order, so one fill of 16
+/// serves them as it does at the first vertex. Tag, keys and batch side by side: a miss reads
+/// neighbouring cache lines, not three arrays' (the wave's pixels do not all stay in cache).
+#[derive(Clone, Debug, Default)]
+struct DeepSlot<T: Copy> {
+    /// (generation, dim) of `keys`.
+    tag: Cell<(u64, u32)>,
+    /// The set's keys.
+    keys: Cell<SetKeys>,
+    /// Its values, tagged with their dimension (emptied by a reset; a fill for another
+    /// dimension of the slot retags it).
+    chunk: Chunk<T>,
+}
 
 impl PixelSamples {
     /// Make these the samples of `pixel` under `pattern` except for the set keys (which the
@@ -204,11 +209,11 @@ impl PixelSamples {
         for c in &self.chunks_2d {
             c.len.set(0);
         }
-        for c in &self.deep_1d {
-            c.len.set(0);
+        for d in &self.deep_1d {
+            d.chunk.len.set(0);
         }
-        for c in &self.deep_2d {
-            c.len.set(0);
+        for d in &self.deep_2d {
+            d.chunk.len.set(0);
         }
         self.generation.set(self.generation.get() + 1);
     }
@@ -351,13 +356,13 @@ impl PixelSamples {
         &self,
         dim: u32,
         chunks: &'a [Chunk<T>; CACHED_DIMS],
-        deep: &'a [Chunk<T>; DEEP],
+        deep: &'a [DeepSlot<T>; DEEP],
     ) -> Option<&'a Chunk<T>> {
         let d = dim as usize;
         if d < CACHED_DIMS {
             return Some(&chunks[d]);
         }
-        let c = &deep[d % DEEP];
+        let c = &deep[d % DEEP].chunk;
         (c.dim.get() == dim).then_some(c)
     }
 
@@ -387,7 +392,7 @@ impl PixelSamples {
     fn miss<T, E, F>(
         &self,
         set: Option<SetKeys>,
-        (chunks, deep): (&[Chunk<T>; CACHED_DIMS], &[Chunk<T>; DEEP]),
+        (chunks, deep): (&[Chunk<T>; CACHED_DIMS], &[DeepSlot<T>; DEEP]),
         a: Arity<E, F>,
     ) -> T
     where
@@ -408,7 +413,7 @@ impl PixelSamples {
             // `Pattern::sample_1d` / `sample_2d` derive from the pixel, dim and arity at
             // each call), then the same evaluation with the same strata.
             let i = dim as usize % DEEP;
-            let (slot, tag) = (&self.deep[arity][i], &self.deep_tag[arity][i]);
+            let (slot, tag) = (&deep[i].keys, &deep[i].tag);
             let want = (self.generation.get(), dim);
             if tag.get() != want {
                 let set_tag = [super::TAG_1D, super::TAG_2D][arity];
@@ -420,7 +425,7 @@ impl PixelSamples {
             // The slot's batch, filled the fast way as a cached dimension's chunk is (the same
             // values); other patterns and wrapped indices take the general evaluation.
             if kind == PatternKind::Stratified && index < count {
-                let chunk = &deep[i];
+                let chunk = &deep[i].chunk;
                 if chunk.dim.get() == dim
                     && let Some(v) = chunk.get(index, count)
                 {
