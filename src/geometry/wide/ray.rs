@@ -104,7 +104,7 @@ impl WideBvh {
     /// Closest hit of the ray (o, d) in (0, t_max): (leaf-order id, t, barycentrics).
     /// Triangles are tested here; `other(id, t_best)` returns the hit distance of a
     /// non-triangle primitive if below `t_best`, else +∞.
-    #[inline]
+    #[inline(always)]
     pub fn closest(
         &self,
         o: Vec3,
