@@ -521,7 +521,11 @@ impl Geometry {
                 ray.d,
                 ray.t_max,
                 |id, t_max| self.other_t_outlined(id, ray.o, ray.d, t_max),
-                |id| self.prefetch_hit(id),
+                |id| {
+                    if bvh.is_large() {
+                        self.prefetch_hit(id)
+                    }
+                },
             )?,
             _ => self.closest_by_callback(ray)?,
         };

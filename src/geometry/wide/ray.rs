@@ -171,7 +171,9 @@ impl WideBvh {
                         let i = bits.trailing_zeros() as usize & 3;
                         bits &= bits - 1;
                         let item = (node.child[i], near[i]);
-                        self.prefetch(item.0);
+                        if self.large {
+                            self.prefetch(item.0);
+                        }
                         let mut j = sp;
                         // SAFETY: slots base..sp were written in this loop, and sp < STACK:
                         // at wide depth d at most 3·(d − 1) entries are pending below `base`
