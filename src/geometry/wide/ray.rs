@@ -161,10 +161,33 @@ impl WideBvh {
                         cur = node.child[mask.trailing_zeros() as usize & 3];
                         continue;
                     }
-                    // Two to four children: insertion-sorted straight onto the stack, far
+                    let near = near.to_array();
+                    let rest = mask & (mask - 1);
+                    if rest & (rest - 1) == 0 {
+                        // Two children (the commonest case): the nearer is visited, the other
+                        // pushed; of equal distances the lower lane first, the order of the
+                        // insertion sort below. Selects, not the sort's data-dependent loop
+                        // branches (cornell path 64², 16 spp, callgrind --branch-sim: 5.50 →
+                        // 5.34 mispredicted branches and 1063 → 1048 Ir per query).
+                        let (i, j) = (
+                            mask.trailing_zeros() as usize & 3,
+                            rest.trailing_zeros() as usize & 3,
+                        );
+                        let lower_first = near[i] <= near[j];
+                        let (go, other) = if lower_first { (i, j) } else { (j, i) };
+                        let item = (node.child[other], near[other]);
+                        if self.large {
+                            self.prefetch(item.0);
+                        }
+                        // SAFETY: sp < STACK, as for the pushes below.
+                        unsafe { stack.get_unchecked_mut(sp) }.write(item);
+                        sp += 1;
+                        cur = node.child[go];
+                        continue;
+                    }
+                    // Three or four children: insertion-sorted straight onto the stack, far
                     // below near (of equal distances the lower lane ends up higher), and the
                     // top one is visited. No separate array to sort and copy.
-                    let near = near.to_array();
                     let base = sp;
                     let mut bits = mask;
                     while bits != 0 {
