@@ -2,6 +2,8 @@
 //! selection while it renders is the same image for any thread count, agrees in the mean with
 //! power selection (unbiased), and never takes a light's probability away.
 
+mod selection_support;
+
 use glam::{UVec2, Vec3};
 use penumbra::image::{Image, write_image};
 use penumbra::integrator::{IntegratorKind, RenderOptions, render};
@@ -12,6 +14,7 @@ use penumbra::light_selection::{
 use penumbra::sampling::hash::{next_f32, pcg_from_keys};
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
+use selection_support::on_threads;
 
 fn scene(name: &str, lights: u32) -> penumbra::scene::Scene {
     let opts = LoadOptions {
@@ -41,15 +44,6 @@ fn pfm_bytes(img: &Image, name: &str) -> Vec<u8> {
     let bytes = std::fs::read(&path).expect("read pfm");
     let _ = std::fs::remove_file(&path);
     bytes
-}
-
-/// `f` run on a pool of `threads` threads.
-fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("pool")
-        .install(f)
 }
 
 /// The rounds merge their tiles' records in tile order: one thread and two give the same

@@ -18,10 +18,23 @@ use penumbra::light_selection::{
 use penumbra::lights::LightBounds;
 use penumbra::sampling::chi2::{Chi2Config, chi2_discrete};
 use penumbra::sampling::hash::{next_f32, pcg_from_keys};
+use penumbra::scene::Scene;
 use penumbra::scene::builtin::BuiltinOptions;
 use penumbra::scene::load::{LoadOptions, load};
 use rand_pcg::Pcg32;
-use selection_support::{mean_and_variance, u, unit};
+use selection_support::{mean_and_variance, on_threads, random_point, u, unit};
+
+/// `many-rooms` with three rooms: small enough for a test render.
+fn three_rooms() -> Scene {
+    let opts = LoadOptions {
+        builtin: BuiltinOptions {
+            rooms: Some(3),
+            ..BuiltinOptions::default()
+        },
+        ..LoadOptions::default()
+    };
+    load("many-rooms", &opts).unwrap().scene
+}
 
 /// Random small emitters: boxes of random size, axis and power (some two-sided).
 fn random_bounds(rng: &mut Pcg32, n: usize) -> Vec<LightBounds> {
@@ -175,14 +188,7 @@ fn ris_variance_falls_with_k() {
 /// each). Under MIS their estimated pmf makes them consistent only: printed, not asserted.
 #[test]
 fn ris_light_strategy_render_matches_exhaustive() {
-    let opts = LoadOptions {
-        builtin: BuiltinOptions {
-            rooms: Some(3),
-            ..BuiltinOptions::default()
-        },
-        ..LoadOptions::default()
-    };
-    let scene = load("many-rooms", &opts).unwrap().scene;
+    let scene = three_rooms();
     let res = UVec2::new(40, 30);
     let run = |kind: SelectorKind, strategy: Strategy, seed: u64| {
         let o = RenderOptions {
@@ -225,15 +231,7 @@ fn ris_bvh_with_one_candidate_is_the_bvh() {
     let bvh = BvhSelector::new(&bounds);
     let ris = RisBvhSelector::new(&bounds, 1, 3);
     for _ in 0..20 {
-        let sp = ShadingPoint {
-            p: Vec3::new(
-                u(&mut rng, -5.0, 5.0),
-                u(&mut rng, -5.0, 5.0),
-                u(&mut rng, -5.0, 5.0),
-            ),
-            n: unit(&mut rng),
-            wo: Vec3::Z,
-        };
+        let sp = random_point(&mut rng, 5.0);
         for _ in 0..50 {
             if let Some((l, p)) = ris.sample(&sp, next_f32(&mut rng)) {
                 let q = bvh.pmf(&sp, l);
@@ -340,15 +338,7 @@ fn chi2_ris_choices_match_the_exact_ris_probability() {
         for k in [2u32, 3] {
             let ris = ris_over(source, &bounds, k, 11);
             for _ in 0..3 {
-                let sp = ShadingPoint {
-                    p: Vec3::new(
-                        u(&mut rng, -3.0, 3.0),
-                        u(&mut rng, -3.0, 3.0),
-                        u(&mut rng, -3.0, 3.0),
-                    ),
-                    n: unit(&mut rng),
-                    wo: Vec3::Z,
-                };
+                let sp = random_point(&mut rng, 3.0);
                 let q: Vec<f64> = (0..bounds.len() as u32)
                     .map(|l| match source {
                         Source::Power => power.prob(l) as f64,
@@ -379,14 +369,7 @@ fn chi2_ris_choices_match_the_exact_ris_probability() {
 /// of the sample number and the shading point, not from a thread's state).
 #[test]
 fn ris_bvh_is_the_same_image_on_one_and_two_threads() {
-    let opts = LoadOptions {
-        builtin: BuiltinOptions {
-            rooms: Some(3),
-            ..BuiltinOptions::default()
-        },
-        ..LoadOptions::default()
-    };
-    let scene = load("many-rooms", &opts).unwrap().scene;
+    let scene = three_rooms();
     let run = |threads: usize| {
         let o = RenderOptions {
             spp: 4,
@@ -394,11 +377,9 @@ fn ris_bvh_is_the_same_image_on_one_and_two_threads() {
             light_selection: SelectorKind::RisBvh { candidates: 4 },
             ..RenderOptions::default()
         };
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| render(&scene, UVec2::new(40, 30), &o).unwrap().0)
+        on_threads(threads, || {
+            render(&scene, UVec2::new(40, 30), &o).unwrap().0
+        })
     };
     let (a, b) = (run(1), run(2));
     assert!(
@@ -419,15 +400,7 @@ fn bvh_sample_many_is_sample_bit_for_bit() {
         let bounds = random_bounds(&mut rng, n);
         let bvh = BvhSelector::new(&bounds);
         for _ in 0..20 {
-            let sp = ShadingPoint {
-                p: Vec3::new(
-                    u(&mut rng, -5.0, 5.0),
-                    u(&mut rng, -5.0, 5.0),
-                    u(&mut rng, -5.0, 5.0),
-                ),
-                n: unit(&mut rng),
-                wo: Vec3::Z,
-            };
+            let sp = random_point(&mut rng, 5.0);
             let mut us: Vec<f32> = (0..17).map(|_| next_f32(&mut rng)).collect();
             for sorted in [false, true] {
                 if sorted {

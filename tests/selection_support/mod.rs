@@ -5,6 +5,7 @@
 
 use glam::Vec3;
 use penumbra::image::Image;
+use penumbra::light_selection::ShadingPoint;
 use penumbra::sampling::hash::next_f32;
 use rand_pcg::Pcg32;
 
@@ -21,6 +22,24 @@ pub fn unit(rng: &mut Pcg32) -> Vec3 {
             return v.normalize();
         }
     }
+}
+
+/// A shading point uniformly inside the cube [−h, h]³, with a random normal and wo = +z.
+pub fn random_point(rng: &mut Pcg32, h: f32) -> ShadingPoint {
+    ShadingPoint {
+        p: Vec3::new(u(rng, -h, h), u(rng, -h, h), u(rng, -h, h)),
+        n: unit(rng),
+        wo: Vec3::Z,
+    }
+}
+
+/// `f` run on a pool of `threads` threads.
+pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool")
+        .install(f)
 }
 
 /// Mean of all channels of all pixels, and the variance of that mean from the per-pixel
