@@ -50,8 +50,8 @@ impl WideBvh {
                 });
             }
         }
-        w.large = size_of_val(w.nodes.as_slice()) + size_of_val(w.packets.as_slice())
-            > PREFETCH_BYTES;
+        w.large =
+            size_of_val(w.nodes.as_slice()) + size_of_val(w.packets.as_slice()) > PREFETCH_BYTES;
         Some(w)
     }
 

@@ -248,7 +248,10 @@ impl WideBvh {
             use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
             // A node is two cache lines, a packet three (both line-aligned).
             let (p, lines) = if child & LEAF == 0 {
-                (self.nodes.as_ptr().wrapping_add(child as usize) as *const i8, 64)
+                (
+                    self.nodes.as_ptr().wrapping_add(child as usize) as *const i8,
+                    64,
+                )
             } else {
                 let p = self.packets.as_ptr().wrapping_add((child & !LEAF) as usize);
                 (p as *const i8, 128)
