@@ -12,7 +12,7 @@ use super::tree2::Tree2;
 use super::triangle::{RayShear, barycentric_error};
 use super::wide::{Bary, WideBvh};
 use super::{Ray, RayQuery, SurfaceHit};
-use crate::isa::{Cpu, Isa};
+use crate::isa::{Cpu, Isa, Kernel, Token};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
@@ -309,6 +309,12 @@ impl Geometry {
 
     /// The hit record of primitive `id` hit at `t` with triangle barycentrics `b`.
     pub(super) fn surface_hit(&self, id: usize, ray: &Ray, t: f32, b: Bary) -> SurfaceHit {
+        self.surface_hit_body(id, ray, t, b)
+    }
+
+    /// [`Self::surface_hit`], inlined into [`Self::intersect_full`]'s instruction-set versions.
+    #[inline(always)]
+    fn surface_hit_body(&self, id: usize, ray: &Ray, t: f32, b: Bary) -> SurfaceHit {
         // SAFETY: `id` comes from a traversal, which reports only ids it has tested: leaf-order
         // ids < prims.len() stored by the wide BVH's build, or ids the callback backends passed
         // to `prim_hit`, which indexes `prims` with a bounds check. `tri_ng` has one entry per
@@ -467,17 +473,63 @@ impl Geometry {
     }
 
     /// [`RayQuery::intersect`] after the cheap pre-test, out of line, so that rays the
-    /// pre-test rejects skip its setup (mis-area 2771 → 2731 Ir/sample, c225f85).
+    /// pre-test rejects skip its setup (mis-area 2771 → 2731 Ir/sample, c225f85). Compiled
+    /// for the detected instruction set ([`Cpu::dispatch`]): the same operations, VEX-encoded
+    /// on AVX2 (three-operand forms, fewer register copies), hence the same bits.
     #[inline(never)]
     pub(super) fn intersect_full(&self, ray: &Ray) -> Option<SurfaceHit> {
+        /// [`Geometry::intersect_body`] as a [`Kernel`].
+        struct Closest1<'a>(&'a Geometry, &'a Ray);
+        impl Kernel for Closest1<'_> {
+            type Output = Option<SurfaceHit>;
+            #[inline(always)]
+            fn run<T: Token>(self, _: T) -> Self::Output {
+                self.0.intersect_body(self.1)
+            }
+        }
+        self.cpu.dispatch(Closest1(self, ray))
+    }
+
+    /// Start loading what [`Self::surface_hit`] reads of primitive `id` (its record and
+    /// geometric normal), called at each new best hit of the traversal: on large scenes these
+    /// are cache misses, which then overlap the rest of the traversal.
+    #[inline(always)]
+    fn prefetch_hit(&self, id: usize) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let p = self.prims.as_ptr().wrapping_add(id) as *const i8;
+            let n = self.tri_ng.as_ptr().wrapping_add(id) as *const i8;
+            // SAFETY: a prefetch is a hint that never faults, whatever the address.
+            unsafe {
+                _mm_prefetch(p, _MM_HINT_T0);
+                _mm_prefetch(p.wrapping_add(size_of::<Primitive>() - 1), _MM_HINT_T0);
+                _mm_prefetch(n, _MM_HINT_T0);
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = id;
+    }
+
+    /// The body of [`Self::intersect_full`], inlined into each instruction set's version.
+    #[inline(always)]
+    fn intersect_body(&self, ray: &Ray) -> Option<SurfaceHit> {
         let (id, t, b) = match &self.accel {
             // The wide BVH tests triangles itself; only quadrics come back here.
-            Accel::Wide(bvh) => bvh.closest(ray.o, ray.d, ray.t_max, |id, t_max| {
-                self.other_t_outlined(id, ray.o, ray.d, t_max)
-            })?,
+            Accel::Wide(bvh) => bvh.closest_hinted(
+                ray.o,
+                ray.d,
+                ray.t_max,
+                |id, t_max| self.other_t_outlined(id, ray.o, ray.d, t_max),
+                |id| {
+                    if bvh.is_large() {
+                        self.prefetch_hit(id)
+                    }
+                },
+            )?,
             _ => self.closest_by_callback(ray)?,
         };
-        Some(self.surface_hit(id, ray, t, self.final_bary(id, ray, b)))
+        Some(self.surface_hit_body(id, ray, t, self.final_bary(id, ray, b)))
     }
 }
 

@@ -1,6 +1,6 @@
 //! Collapsing a binary BVH into the 4-wide one, and its leaves into 4-triangle packets.
 
-use super::{LEAF, MAX_TREE_DEPTH, Node4, SingleLeaf, WideBvh};
+use super::{LEAF, MAX_TREE_DEPTH, Node4, PREFETCH_BYTES, SingleLeaf, WideBvh};
 use crate::geometry::primitive::{PrimKind, Primitive};
 use crate::geometry::tree2::Tree2;
 use crate::geometry::tri4::TriPacket;
@@ -50,7 +50,16 @@ impl WideBvh {
                 });
             }
         }
+        w.large =
+            size_of_val(w.nodes.as_slice()) + size_of_val(w.packets.as_slice()) > PREFETCH_BYTES;
         Some(w)
+    }
+
+    /// True if the tree is too large to stay in cache ([`PREFETCH_BYTES`]), so that
+    /// prefetching what a query will read soon pays.
+    #[inline(always)]
+    pub fn is_large(&self) -> bool {
+        self.large
     }
 
     /// True if the whole tree is one leaf (most scenes' emitter-only geometry).

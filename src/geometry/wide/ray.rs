@@ -104,13 +104,27 @@ impl WideBvh {
     /// Closest hit of the ray (o, d) in (0, t_max): (leaf-order id, t, barycentrics).
     /// Triangles are tested here; `other(id, t_best)` returns the hit distance of a
     /// non-triangle primitive if below `t_best`, else +∞.
-    #[inline]
+    #[cfg(test)]
     pub fn closest(
         &self,
         o: Vec3,
         d: Vec3,
         t_max: f32,
+        other: impl FnMut(usize, f32) -> f32,
+    ) -> Option<(usize, f32, Bary)> {
+        self.closest_hinted(o, d, t_max, other, |_| {})
+    }
+
+    /// [`Self::closest`], calling `found(id)` at each new best triangle hit, so that the caller
+    /// can start loading what its hit record needs while the traversal goes on.
+    #[inline(always)]
+    pub fn closest_hinted(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
         mut other: impl FnMut(usize, f32) -> f32,
+        found: impl Fn(usize),
     ) -> Option<(usize, f32, Bary)> {
         if let Some(leaf) = &self.single_leaf {
             // The traversal would test the root's one box and then this leaf with
@@ -119,7 +133,8 @@ impl WideBvh {
                 return None;
             }
             let mut best = t_max;
-            let hit = self.leaf_closest(leaf.child, &RayShear4::new(o, d), &mut best, &mut other);
+            let shear = RayShear4::new(o, d);
+            let hit = self.leaf_closest(leaf.child, &shear, &mut best, &mut other, &found);
             return hit.map(|(id, b)| (id, best, b));
         }
         if self.nodes.is_empty() {
@@ -146,17 +161,42 @@ impl WideBvh {
                         cur = node.child[mask.trailing_zeros() as usize & 3];
                         continue;
                     }
-                    // Two to four children: insertion-sorted straight onto the stack, far
+                    let near = near.to_array();
+                    let rest = mask & (mask - 1);
+                    if rest & (rest - 1) == 0 {
+                        // Two children (the commonest case): the nearer is visited, the other
+                        // pushed; of equal distances the lower lane first, the order of the
+                        // insertion sort below. Selects, not the sort's data-dependent loop
+                        // branches (cornell path 64², 16 spp, callgrind --branch-sim: 5.50 →
+                        // 5.34 mispredicted branches and 1063 → 1048 Ir per query).
+                        let (i, j) = (
+                            mask.trailing_zeros() as usize & 3,
+                            rest.trailing_zeros() as usize & 3,
+                        );
+                        let lower_first = near[i] <= near[j];
+                        let (go, other) = if lower_first { (i, j) } else { (j, i) };
+                        let item = (node.child[other], near[other]);
+                        if self.large {
+                            self.prefetch(item.0);
+                        }
+                        // SAFETY: sp < STACK, as for the pushes below.
+                        unsafe { stack.get_unchecked_mut(sp) }.write(item);
+                        sp += 1;
+                        cur = node.child[go];
+                        continue;
+                    }
+                    // Three or four children: insertion-sorted straight onto the stack, far
                     // below near (of equal distances the lower lane ends up higher), and the
                     // top one is visited. No separate array to sort and copy.
-                    let near = near.to_array();
                     let base = sp;
                     let mut bits = mask;
                     while bits != 0 {
                         let i = bits.trailing_zeros() as usize & 3;
                         bits &= bits - 1;
                         let item = (node.child[i], near[i]);
-                        self.prefetch(item.0);
+                        if self.large {
+                            self.prefetch(item.0);
+                        }
                         let mut j = sp;
                         // SAFETY: slots base..sp were written in this loop, and sp < STACK:
                         // at wide depth d at most 3·(d − 1) entries are pending below `base`
@@ -179,7 +219,7 @@ impl WideBvh {
                 }
             } else {
                 let shear = shear.get_or_insert_with(|| RayShear4::new(o, d));
-                if let Some(h) = self.leaf_closest(cur, shear, &mut best, &mut other) {
+                if let Some(h) = self.leaf_closest(cur, shear, &mut best, &mut other, &found) {
                     hit = Some(h);
                 }
             }
@@ -206,15 +246,21 @@ impl WideBvh {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            let p = if child & LEAF == 0 {
-                self.nodes.as_ptr().wrapping_add(child as usize) as *const i8
+            // A node is two cache lines, a packet three (both line-aligned).
+            let (p, lines) = if child & LEAF == 0 {
+                (
+                    self.nodes.as_ptr().wrapping_add(child as usize) as *const i8,
+                    64,
+                )
             } else {
-                self.packets.as_ptr().wrapping_add((child & !LEAF) as usize) as *const i8
+                let p = self.packets.as_ptr().wrapping_add((child & !LEAF) as usize);
+                (p as *const i8, 128)
             };
             // SAFETY: a prefetch is a hint that never faults, whatever the address.
             unsafe {
                 _mm_prefetch(p, _MM_HINT_T0);
                 _mm_prefetch(p.wrapping_add(64), _MM_HINT_T0);
+                _mm_prefetch(p.wrapping_add(lines), _MM_HINT_T0);
             }
         }
     }
@@ -228,6 +274,7 @@ impl WideBvh {
         shear: &RayShear4,
         best: &mut f32,
         other: &mut impl FnMut(usize, f32) -> f32,
+        found: &impl Fn(usize),
     ) -> Option<(usize, Bary)> {
         let mut hit = None;
         let mut pi = (child & !LEAF) as usize;
@@ -240,7 +287,9 @@ impl WideBvh {
                 && let Some((lane, t, b)) = shear.closest(pk, *best)
             {
                 *best = t;
-                hit = Some((pk.ids[lane & 3] as usize, b));
+                let id = pk.ids[lane & 3] as usize;
+                found(id);
+                hit = Some((id, b));
             }
             let mut others = pk.other;
             while others != 0 {
