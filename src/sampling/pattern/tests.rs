@@ -4,19 +4,50 @@
 use super::*;
 use crate::isa::Isa;
 
+/// Every pattern kind with `seed` on every instruction set this CPU runs (the set, for messages).
+fn every_pattern(seed: u64) -> impl Iterator<Item = (Pattern, Isa)> {
+    PatternKind::ALL.into_iter().flat_map(move |kind| {
+        Isa::available().into_iter().map(move |isa| {
+            let pat = Pattern {
+                seed,
+                kind,
+                cpu: isa.cpu(),
+            };
+            (pat, isa)
+        })
+    })
+}
+
+/// `px`'s 1D and 2D values of (`dim`, `index`, `count`) are the pattern's definition at
+/// `pixel`, bit for bit.
+fn assert_defined_values(
+    px: &PixelSamples,
+    pat: &Pattern,
+    dim: u32,
+    index: u32,
+    count: u32,
+    what: &str,
+) {
+    let pixel = px.pixel();
+    assert_eq!(
+        px.sample_1d(dim, index, count).to_bits(),
+        pat.sample_1d(pixel, dim, index, count).to_bits(),
+        "{what} 1d dim {dim} count {count} index {index}"
+    );
+    assert_eq!(
+        px.sample_2d(dim, index, count).to_array().map(f32::to_bits),
+        pat.sample_2d(pixel, dim, index, count)
+            .to_array()
+            .map(f32::to_bits),
+        "{what} 2d dim {dim} count {count} index {index}"
+    );
+}
+
 #[test]
 fn pixel_samples_equal_the_pattern_values() {
     // The cached per-pixel path must return bit-identical values, in cached dimensions
     // and past them, for stratified counts and wrapped indices.
-    for (kind, isa) in PatternKind::ALL
-        .into_iter()
-        .flat_map(|k| Isa::available().into_iter().map(move |i| (k, i)))
-    {
-        let pat = Pattern {
-            seed: 7,
-            kind,
-            cpu: isa.cpu(),
-        };
+    for (pat, isa) in every_pattern(7) {
         for pixel in [UVec2::new(0, 0), UVec2::new(13, 511)] {
             let px = pat.pixel(pixel);
             assert_eq!(px.pixel(), pixel);
@@ -30,17 +61,13 @@ fn pixel_samples_equal_the_pattern_values() {
                     (40_000, 1 << 16),
                     (17, 1 << 18),
                 ] {
-                    assert_eq!(
-                        px.sample_1d(dim, index, count).to_bits(),
-                        pat.sample_1d(pixel, dim, index, count).to_bits(),
-                        "{kind} dim {dim} index {index}"
-                    );
-                    assert_eq!(
-                        px.sample_2d(dim, index, count).to_array().map(f32::to_bits),
-                        pat.sample_2d(pixel, dim, index, count)
-                            .to_array()
-                            .map(f32::to_bits),
-                        "{kind} dim {dim} index {index}"
+                    assert_defined_values(
+                        &px,
+                        &pat,
+                        dim,
+                        index,
+                        count,
+                        &format!("{} {isa:?}", pat.kind),
                     );
                 }
             }
@@ -52,15 +79,8 @@ fn pixel_samples_equal_the_pattern_values() {
 fn pixel_into_reuses_samples_bit_identically() {
     // One PixelSamples refilled pixel after pixel (warm chunks and count caches of the
     // previous pixel) returns what a fresh one returns.
-    for (kind, isa) in PatternKind::ALL
-        .into_iter()
-        .flat_map(|k| Isa::available().into_iter().map(move |i| (k, i)))
-    {
-        let pat = Pattern {
-            seed: 5,
-            kind,
-            cpu: isa.cpu(),
-        };
+    for (pat, isa) in every_pattern(5) {
+        let kind = pat.kind;
         let mut px = pat.pixel(UVec2::new(9, 9));
         for (n, pixel) in [UVec2::new(0, 0), UVec2::new(3, 1), UVec2::new(3, 2)]
             .into_iter()
@@ -238,18 +258,7 @@ fn non_power_of_two_chunks_equal_the_pattern_values() {
                 let first = if count > 5000 { count - 40 } else { 0 };
                 for index in (first..count).chain([0, 17, count - 1]) {
                     for dim in [0u32, 5] {
-                        assert_eq!(
-                            px.sample_1d(dim, index, count).to_bits(),
-                            pat.sample_1d(pixel, dim, index, count).to_bits(),
-                            "{isa:?} 1d count {count} index {index}"
-                        );
-                        assert_eq!(
-                            px.sample_2d(dim, index, count).to_array().map(f32::to_bits),
-                            pat.sample_2d(pixel, dim, index, count)
-                                .to_array()
-                                .map(f32::to_bits),
-                            "{isa:?} 2d count {count} index {index}"
-                        );
+                        assert_defined_values(&px, &pat, dim, index, count, &format!("{isa:?}"));
                     }
                 }
             }
@@ -259,35 +268,23 @@ fn non_power_of_two_chunks_equal_the_pattern_values() {
 
 #[test]
 fn deep_dimension_batches_serve_slot_sharing_dimensions_and_new_pixels() {
-    // Dimensions past CACHED_DIMS keep a batch of values per slot (dim mod 16): two dims that
+    // Dimensions past CACHED_DIMS keep a batch of values per slot (dim mod DEEP = 8): two dims that
     // share a slot, read in turn, and the same dims after a reset to another pixel, must each
     // still get their own pixel's values (a stale batch would serve the other's).
-    for (kind, isa) in PatternKind::ALL
-        .into_iter()
-        .flat_map(|k| Isa::available().into_iter().map(move |i| (k, i)))
-    {
-        let pat = Pattern {
-            seed: 11,
-            kind,
-            cpu: isa.cpu(),
-        };
+    for (pat, isa) in every_pattern(11) {
         let mut px = pat.pixel(UVec2::new(2, 2));
         for pixel in [UVec2::new(2, 2), UVec2::new(2, 3), UVec2::new(40, 3)] {
             pat.pixel_into(pixel, &mut px);
             for count in [16u32, 64, 37] {
                 for index in 0..count + 2 {
                     for dim in [9u32, 25, 9, 41] {
-                        assert_eq!(
-                            px.sample_1d(dim, index, count).to_bits(),
-                            pat.sample_1d(pixel, dim, index, count).to_bits(),
-                            "{kind} {isa:?} 1d dim {dim} count {count} index {index}"
-                        );
-                        assert_eq!(
-                            px.sample_2d(dim, index, count).to_array().map(f32::to_bits),
-                            pat.sample_2d(pixel, dim, index, count)
-                                .to_array()
-                                .map(f32::to_bits),
-                            "{kind} {isa:?} 2d dim {dim} count {count} index {index}"
+                        assert_defined_values(
+                            &px,
+                            &pat,
+                            dim,
+                            index,
+                            count,
+                            &format!("{} {isa:?}", pat.kind),
                         );
                     }
                 }
