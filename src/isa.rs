@@ -23,7 +23,10 @@ impl Isa {
     pub fn detect() -> Isa {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::is_x86_feature_detected!("avx512f")
+            // AVX-512 only with AVX2 (which every AVX-512 CPU has): its token also stands for
+            // AVX2 (`Token::with_avx2`).
+            if std::is_x86_feature_detected!("avx2")
+                && std::is_x86_feature_detected!("avx512f")
                 && std::is_x86_feature_detected!("avx512bw")
                 && std::is_x86_feature_detected!("avx512dq")
                 && std::is_x86_feature_detected!("avx512vl")
@@ -72,6 +75,12 @@ pub trait Token: Copy + Send + Sync + 'static {
     fn avx2(self) -> Option<Avx2> {
         None
     }
+    /// An AVX2 token if this token's set includes AVX2 (AVX2 and AVX-512 tokens), for
+    /// kernels whose widest form is AVX2.
+    #[inline(always)]
+    fn with_avx2(self) -> Option<Avx2> {
+        None
+    }
 }
 
 /// The token of plain code: every CPU runs it.
@@ -96,6 +105,10 @@ impl Token for Avx2 {
     fn avx2(self) -> Option<Avx2> {
         Some(self)
     }
+    #[inline(always)]
+    fn with_avx2(self) -> Option<Avx2> {
+        Some(self)
+    }
 }
 
 impl Token for Avx512 {
@@ -103,6 +116,12 @@ impl Token for Avx512 {
     #[inline(always)]
     fn avx512(self) -> Option<Avx512> {
         Some(self)
+    }
+    #[inline(always)]
+    fn with_avx2(self) -> Option<Avx2> {
+        // `Isa::detect` reports AVX-512 only where it also detected AVX2, and an AVX-512
+        // token exists only for a set it reported.
+        Some(Avx2(()))
     }
 }
 

@@ -4,6 +4,7 @@ use super::{LEAF, MAX_TREE_DEPTH, Node4, PREFETCH_BYTES, SingleLeaf, WideBvh};
 use crate::geometry::primitive::{PrimKind, Primitive};
 use crate::geometry::tree2::Tree2;
 use crate::geometry::tri4::TriPacket;
+use crate::isa::Isa;
 use glam::{Vec3, Vec4};
 use std::ops::Range;
 
@@ -30,7 +31,13 @@ impl WideBvh {
             if tree.depth() > MAX_TREE_DEPTH {
                 return None;
             }
-            w.collapse(tree, prims, called_back, 0);
+            // The leaf reference of each binary node that became a leaf, for the 8-wide
+            // collapse, which shares the packets (its leaves are the same binary nodes).
+            let mut leaf_of = vec![u32::MAX; tree.nodes.len()];
+            w.collapse(tree, prims, called_back, &mut leaf_of, 0);
+            if Isa::detect() >= Isa::Avx2 {
+                w.nodes8 = super::build8::collapse8(tree, &leaf_of);
+            }
         }
         // One node whose lanes 1..3 are unused (inverted boxes, which every ray misses) and
         // whose lane 0 is therefore a leaf.
@@ -62,6 +69,13 @@ impl WideBvh {
         self.large
     }
 
+    /// True if the 8-wide nodes exist (built when the CPU runs AVX2), which the one-ray
+    /// queries `closest8` and `any8` traverse.
+    #[inline(always)]
+    pub fn has_nodes8(&self) -> bool {
+        !self.nodes8.is_empty()
+    }
+
     /// True if the whole tree is one leaf (most scenes' emitter-only geometry).
     pub fn is_single_leaf(&self) -> bool {
         self.single_leaf.is_some()
@@ -71,7 +85,15 @@ impl WideBvh {
     /// repeatedly replaced by its two children (largest surface area first, as in the SAH) until
     /// there are four. Subtrees of at most [`LEAF_PRIMS`] primitives become one leaf: a packet
     /// tests four triangles for little more than the price of one.
-    fn collapse(&mut self, tree: &Tree2, prims: &[Primitive], called_back: &[bool], n2: usize) {
+    /// `leaf_of[k]` is set to the `LEAF` reference made for binary node k.
+    fn collapse(
+        &mut self,
+        tree: &Tree2,
+        prims: &[Primitive],
+        called_back: &[bool],
+        leaf_of: &mut [u32],
+        n2: usize,
+    ) {
         let nodes = &tree.nodes;
         let is_leaf = |k: usize| nodes[k].range.len() <= LEAF_PRIMS || nodes[k].children.is_none();
         let mut kids: Vec<usize> = match nodes[n2].children {
@@ -95,10 +117,12 @@ impl WideBvh {
         self.nodes.push(Node4::EMPTY);
         for (lane, &k) in kids.iter().enumerate() {
             let child = if is_leaf(k) {
-                LEAF | self.leaf(tree, prims, called_back, nodes[k].range.clone())
+                let child = LEAF | self.leaf(tree, prims, called_back, nodes[k].range.clone());
+                leaf_of[k] = child;
+                child
             } else {
                 let child = self.nodes.len() as u32;
-                self.collapse(tree, prims, called_back, k);
+                self.collapse(tree, prims, called_back, leaf_of, k);
                 child
             };
             let node = &mut self.nodes[idx];

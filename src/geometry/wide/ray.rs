@@ -268,7 +268,7 @@ impl WideBvh {
     /// The closest hit below `*best` among the primitives of leaf `child` (a `LEAF`
     /// reference): lowers `*best` to its t and returns (leaf-order id, barycentrics).
     #[inline(always)]
-    fn leaf_closest(
+    pub(super) fn leaf_closest(
         &self,
         child: u32,
         shear: &RayShear4,
@@ -311,7 +311,7 @@ impl WideBvh {
     /// True if leaf `child` (a `LEAF` reference) holds a triangle, or a primitive for which
     /// `other(id)` is true, that blocks the ray in (0, t_max).
     #[inline(always)]
-    fn leaf_any(
+    pub(super) fn leaf_any(
         &self,
         child: u32,
         shear: &RayShear4,
