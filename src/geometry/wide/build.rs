@@ -76,6 +76,16 @@ impl WideBvh {
         !self.nodes8.is_empty()
     }
 
+    /// Bytes of the 4-wide nodes, the 8-wide nodes and the leaf packets.
+    #[cfg(test)]
+    pub fn bytes(&self) -> [usize; 3] {
+        [
+            size_of_val(self.nodes.as_slice()),
+            size_of_val(self.nodes8.as_slice()),
+            size_of_val(self.packets.as_slice()),
+        ]
+    }
+
     /// True if the whole tree is one leaf (most scenes' emitter-only geometry).
     pub fn is_single_leaf(&self) -> bool {
         self.single_leaf.is_some()
