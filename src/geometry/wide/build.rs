@@ -36,10 +36,7 @@ impl WideBvh {
             let mut leaf_of = vec![u32::MAX; tree.nodes.len()];
             w.collapse(tree, prims, called_back, &mut leaf_of, 0);
             if Isa::detect() >= Isa::Avx2 {
-                // Leaf pairs only where the tree leaves the cache (see `build8`).
-                let large = size_of_val(w.nodes.as_slice()) + size_of_val(w.packets.as_slice())
-                    > PREFETCH_BYTES;
-                w.nodes8 = super::build8::collapse8(tree, &leaf_of, &w.packets, large);
+                w.nodes8 = super::build8::collapse8(tree, &leaf_of, &w.packets);
             }
         }
         // One node whose lanes 1..3 are unused (inverted boxes, which every ray misses) and

@@ -9,9 +9,7 @@
 //! eight triangles: two leaves). A child that is such a pair, when no slot is left to split it
 //! into, is instead one reference to both leaves ([`PAIR`]): the 4-wide build places a leaf's
 //! sibling leaf's packets right after its own, so the pair is one run of packets with two
-//! `last` marks. A pair trades a node's fetch for testing both leaves when one box would
-//! have culled the other, so it is made only for trees larger than the caches
-//! (`PREFETCH_BYTES`): on the cornell box (in L1) it cost instructions (below).
+//! `last` marks.
 
 use super::{LEAF, Node8, PAIR};
 use crate::geometry::tree2::Tree2;
@@ -32,17 +30,11 @@ impl Node8 {
 /// 4-wide collapse made for each of its leaf nodes k (`u32::MAX` for the others). Empty (the
 /// queries then use the 4-wide nodes) if a leaf has no reference, which the argument above
 /// rules out: the traversal follows references unchecked, so this is checked, not assumed.
-/// With `pairs`, two-leaf children become [`PAIR`] references.
-pub(super) fn collapse8(
-    tree: &Tree2,
-    leaf_of: &[u32],
-    packets: &[TriPacket],
-    pairs: bool,
-) -> Vec<Node8> {
+pub(super) fn collapse8(tree: &Tree2, leaf_of: &[u32], packets: &[TriPacket]) -> Vec<Node8> {
     let mut nodes = Vec::new();
     if tree.nodes.is_empty()
         || packets.len() >= PAIR as usize
-        || collapse(tree, leaf_of, pairs.then_some(packets), &mut nodes, 0).is_none()
+        || collapse(tree, leaf_of, packets, &mut nodes, 0).is_none()
     {
         return Vec::new();
     }
@@ -50,11 +42,11 @@ pub(super) fn collapse8(
 }
 
 /// Emit the 8-wide node of binary node `n2` and, depth first, its interior children; `None`
-/// if a leaf has no reference. Pairs are made from `packets` if given.
+/// if a leaf has no reference.
 fn collapse(
     tree: &Tree2,
     leaf_of: &[u32],
-    packets: Option<&[TriPacket]>,
+    packets: &[TriPacket],
     out: &mut Vec<Node8>,
     n2: usize,
 ) -> Option<()> {
@@ -90,7 +82,7 @@ fn collapse(
         };
         let child = if is_leaf(k) {
             LEAF | leaf(k)?
-        } else if let (Some((a, b)), Some(packets)) = (pair, packets)
+        } else if let Some((a, b)) = pair
             && let Some(first) = adjacent(packets, a, b)
         {
             LEAF | PAIR | first
