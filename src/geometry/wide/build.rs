@@ -36,7 +36,7 @@ impl WideBvh {
             let mut leaf_of = vec![u32::MAX; tree.nodes.len()];
             w.collapse(tree, prims, called_back, &mut leaf_of, 0);
             if Isa::detect() >= Isa::Avx2 {
-                w.nodes8 = super::build8::collapse8(tree, &leaf_of, &w.packets);
+                w.nodes8 = super::build8::collapse8(tree, &leaf_of);
             }
         }
         // One node whose lanes 1..3 are unused (inverted boxes, which every ray misses) and
@@ -110,11 +110,6 @@ impl WideBvh {
             Some(c) if !is_leaf(n2) => c.to_vec(),
             _ => vec![n2],
         };
-        // The binary sibling of each kid made by a split (both kids of a pair).
-        let mut sibling: Vec<(usize, usize)> = match nodes[n2].children {
-            Some([a, b]) if kids.len() == 2 => vec![(a, b)],
-            _ => Vec::new(),
-        };
         while kids.len() < 4 {
             let widest = kids
                 .iter()
@@ -127,28 +122,13 @@ impl WideBvh {
             };
             kids[i] = a;
             kids.push(b);
-            sibling.push((a, b));
         }
         let idx = self.nodes.len();
         self.nodes.push(Node4::EMPTY);
         for (lane, &k) in kids.iter().enumerate() {
-            let child = if leaf_of[k] != u32::MAX {
-                // Emitted with its sibling.
-                leaf_of[k]
-            } else if is_leaf(k) {
+            let child = if is_leaf(k) {
                 let child = LEAF | self.leaf(tree, prims, called_back, nodes[k].range.clone());
                 leaf_of[k] = child;
-                // A sibling leaf's packets right after these: the 8-wide nodes may then
-                // reference the two leaves as one (see `build8`). Only the packets' places
-                // change, not what any traversal tests or in which order.
-                let pair = sibling.iter().find_map(|&(a, b)| match k {
-                    _ if k == a => Some(b),
-                    _ if k == b => Some(a),
-                    _ => None,
-                });
-                if let Some(s) = pair.filter(|&s| is_leaf(s)) {
-                    leaf_of[s] = LEAF | self.leaf(tree, prims, called_back, nodes[s].range.clone());
-                }
                 child
             } else {
                 let child = self.nodes.len() as u32;

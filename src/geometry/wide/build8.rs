@@ -4,16 +4,9 @@
 //! replaced by its two children until there are eight. A binary node is a leaf of either tree
 //! exactly when it is a leaf candidate whose ancestors are not (leaves are never split), so
 //! both trees have the same leaves and share their packets.
-//!
-//! Eight slots leave many nodes near the bottom with two children only (a subtree of five to
-//! eight triangles: two leaves). A child that is such a pair, when no slot is left to split it
-//! into, is instead one reference to both leaves ([`PAIR`]): the 4-wide build places a leaf's
-//! sibling leaf's packets right after its own, so the pair is one run of packets with two
-//! `last` marks.
 
-use super::{LEAF, Node8, PAIR};
+use super::{LEAF, Node8};
 use crate::geometry::tree2::Tree2;
-use crate::geometry::tri4::TriPacket;
 
 /// Subtrees with at most this many primitives are leaves (as in the 4-wide collapse).
 const LEAF_PRIMS: usize = 4;
@@ -30,12 +23,9 @@ impl Node8 {
 /// 4-wide collapse made for each of its leaf nodes k (`u32::MAX` for the others). Empty (the
 /// queries then use the 4-wide nodes) if a leaf has no reference, which the argument above
 /// rules out: the traversal follows references unchecked, so this is checked, not assumed.
-pub(super) fn collapse8(tree: &Tree2, leaf_of: &[u32], packets: &[TriPacket]) -> Vec<Node8> {
+pub(super) fn collapse8(tree: &Tree2, leaf_of: &[u32]) -> Vec<Node8> {
     let mut nodes = Vec::new();
-    if tree.nodes.is_empty()
-        || packets.len() >= PAIR as usize
-        || collapse(tree, leaf_of, packets, &mut nodes, 0).is_none()
-    {
+    if tree.nodes.is_empty() || collapse(tree, leaf_of, &mut nodes, 0).is_none() {
         return Vec::new();
     }
     nodes
@@ -43,13 +33,7 @@ pub(super) fn collapse8(tree: &Tree2, leaf_of: &[u32], packets: &[TriPacket]) ->
 
 /// Emit the 8-wide node of binary node `n2` and, depth first, its interior children; `None`
 /// if a leaf has no reference.
-fn collapse(
-    tree: &Tree2,
-    leaf_of: &[u32],
-    packets: &[TriPacket],
-    out: &mut Vec<Node8>,
-    n2: usize,
-) -> Option<()> {
+fn collapse(tree: &Tree2, leaf_of: &[u32], out: &mut Vec<Node8>, n2: usize) -> Option<()> {
     let nodes = &tree.nodes;
     let is_leaf = |k: usize| nodes[k].range.len() <= LEAF_PRIMS || nodes[k].children.is_none();
     let mut kids: Vec<usize> = match nodes[n2].children {
@@ -72,23 +56,15 @@ fn collapse(
     let idx = out.len();
     out.push(Node8::EMPTY);
     for (lane, &k) in kids.iter().enumerate() {
-        let leaf = |k: usize| {
-            let child = leaf_of[k];
-            (child & LEAF != 0 && child != u32::MAX).then_some(child & !LEAF)
-        };
-        let pair = match nodes[k].children {
-            Some([a, b]) if !is_leaf(k) && is_leaf(a) && is_leaf(b) => Some((leaf(a)?, leaf(b)?)),
-            _ => None,
-        };
         let child = if is_leaf(k) {
-            LEAF | leaf(k)?
-        } else if let Some((a, b)) = pair
-            && let Some(first) = adjacent(packets, a, b)
-        {
-            LEAF | PAIR | first
+            let child = leaf_of[k];
+            if child & LEAF == 0 || child == u32::MAX {
+                return None;
+            }
+            child
         } else {
             let child = out.len() as u32;
-            collapse(tree, leaf_of, packets, out, k)?;
+            collapse(tree, leaf_of, out, k)?;
             child
         };
         let node = &mut out[idx];
@@ -99,21 +75,4 @@ fn collapse(
         node.child[lane] = child;
     }
     Some(())
-}
-
-/// The first packet of leaf runs `a` and `b` (first packets) if one run ends right before the
-/// other starts.
-fn adjacent(packets: &[TriPacket], a: u32, b: u32) -> Option<u32> {
-    let end = |first: u32| {
-        (first as usize..packets.len())
-            .find(|&i| packets[i].last)
-            .map(|i| i as u32 + 1)
-    };
-    if end(a)? == b {
-        Some(a)
-    } else if end(b)? == a {
-        Some(b)
-    } else {
-        None
-    }
 }

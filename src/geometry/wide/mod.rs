@@ -24,8 +24,6 @@ use glam::{Vec3, Vec4};
 
 /// Child-reference flag: the low bits are the first packet of a leaf, not a node index.
 const LEAF: u32 = 1 << 31;
-/// 8-wide child-reference flag (with [`LEAF`]): two leaves, whose packet runs are adjacent.
-const PAIR: u32 = 1 << 30;
 /// Deepest binary tree that is collapsed (deeper ones are rejected by [`WideBvh::build`]).
 const MAX_TREE_DEPTH: usize = 96;
 /// Traversal stack depth: each wide level consumes at least one binary level, and a node

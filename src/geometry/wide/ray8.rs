@@ -9,7 +9,7 @@
 //! intrinsics run only where AVX2 was detected, and they are inlined into the function
 //! [`crate::isa::Cpu::dispatch`] compiles for AVX2.
 
-use super::{Bary, LEAF, Node8, PAIR, STACK8, WideBvh};
+use super::{Bary, LEAF, Node8, STACK8, WideBvh};
 use crate::geometry::bvh::{NEAR_SLACK, ROUNDING_SLACK, safe_inverse};
 use crate::geometry::tri4::RayShear4;
 use crate::isa::Avx2;
@@ -249,13 +249,10 @@ impl WideBvh {
         found: &impl Fn(usize),
     ) -> Leaf8 {
         let mut hit = Leaf8::Miss;
-        let mut pi = (child & !(LEAF | PAIR)) as usize;
-        // Runs still to end at a `last` mark: two for a pair.
-        let mut runs = 1 + (child & PAIR != 0) as u32;
+        let mut pi = (child & !LEAF) as usize;
         loop {
             // SAFETY: a leaf reference is the first packet of a non-empty run inside
-            // `packets` whose final packet has `last` set (see `WideBvh::leaf`); a pair's is
-            // followed by a second such run (checked by `build8::adjacent`).
+            // `packets` whose final packet has `last` set (see `WideBvh::leaf`).
             let pk = unsafe { self.packets.get_unchecked(pi) };
             if pk.tri != 0
                 && let Some((lane, t, b)) = shear.closest(pk, best.next_up())
@@ -279,10 +276,7 @@ impl WideBvh {
                 }
             }
             if pk.last {
-                runs -= 1;
-                if runs == 0 {
-                    return hit;
-                }
+                return hit;
             }
             pi += 1;
         }
@@ -320,7 +314,7 @@ impl WideBvh {
                 let c = node.child[i];
                 if c & LEAF == 0 {
                     inner |= 1 << i;
-                } else if self.leaf_any8(c, &shear, t_max, &mut other) {
+                } else if self.leaf_any(c, &shear, t_max, &mut other) {
                     return true;
                 }
             }
@@ -347,41 +341,6 @@ impl WideBvh {
         }
     }
 
-    /// [`Self::leaf_any`] of an 8-wide leaf reference (one leaf or a [`PAIR`]).
-    #[inline(always)]
-    fn leaf_any8(
-        &self,
-        child: u32,
-        shear: &RayShear4,
-        t_max: f32,
-        other: &mut impl FnMut(usize) -> bool,
-    ) -> bool {
-        let mut pi = (child & !(LEAF | PAIR)) as usize;
-        let mut runs = 1 + (child & PAIR != 0) as u32;
-        loop {
-            // SAFETY: as in `leaf_closest8`, the runs lie inside `packets`.
-            let pk = unsafe { self.packets.get_unchecked(pi) };
-            if pk.tri != 0 && shear.any(pk, t_max) {
-                return true;
-            }
-            let mut others = pk.other;
-            while others != 0 {
-                let id = pk.ids[others.trailing_zeros() as usize] as usize;
-                others &= others - 1;
-                if other(id) {
-                    return true;
-                }
-            }
-            if pk.last {
-                runs -= 1;
-                if runs == 0 {
-                    return false;
-                }
-            }
-            pi += 1;
-        }
-    }
-
     /// Start loading child reference `child` (8-wide node or leaf packet) into the cache.
     #[inline(always)]
     fn prefetch8(&self, child: u32) {
@@ -391,11 +350,8 @@ impl WideBvh {
             let p = self.nodes8.as_ptr().wrapping_add(child as usize);
             (p as *const i8, 4)
         } else {
-            let p = self.packets.as_ptr();
-            (
-                p.wrapping_add((child & !(LEAF | PAIR)) as usize) as *const i8,
-                3,
-            )
+            let p = self.packets.as_ptr().wrapping_add((child & !LEAF) as usize);
+            (p as *const i8, 3)
         };
         // SAFETY: a prefetch is a hint that never faults, whatever the address.
         unsafe {
