@@ -9,6 +9,7 @@
 //! integrator's solid-angle lane kernel draws 16 samples at once (with that kernel, dbcda06:
 //! light-solid-angle cornell 256² 64 spp 0.79 → 0.37 s).
 
+use super::f64_lanes::{R3, Real, atan2, sin_cos_0_8};
 use super::warps::DIRECTION_SLACK;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -30,78 +31,70 @@ pub struct SphericalTriangle {
     /// Solid angle in f64.
     area64: f64,
     /// What [`Self::sample`] needs.
-    arvo: Arvo,
+    arvo: Arvo<f64>,
     /// +1 or −1: orientation of (a, b, c), for the inside test.
     orientation: f64,
 }
 
 /// Solid angle of the spherical triangle of unit vectors (Van Oosterom & Strackee 1983);
 /// accurate for tiny triangles, unlike the angle excess α + β + γ − π.
-/// The atan2 is [`super::warps::atan2_f64`] (arithmetic and selects, no libm call).
+/// The atan2 is [`atan2`] (arithmetic and selects, no libm call).
 #[inline(always)]
-fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+fn solid_angle<R: Real>(a: R3<R>, b: R3<R>, c: R3<R>) -> R {
     let num = a.dot(b.cross(c)).abs();
-    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
-    2.0 * super::warps::atan2_f64(num, den)
+    let den = num.lit(1.0) + a.dot(b) + b.dot(c) + c.dot(a);
+    num.lit(2.0) * atan2(num, den)
 }
 
 /// `v` normalised, and whether that is possible: `DVec3::try_normalize`'s arithmetic (the same
 /// bits) with a flag instead of an `Option`, so callers combine flags by select rather than
-/// branch on each (lanes of the solid-angle kernel take different branches).
+/// branch on each (lanes take different branches).
 #[inline(always)]
-fn unit(v: DVec3) -> (DVec3, bool) {
+fn unit<R: Real>(v: R3<R>) -> (R3<R>, R::Mask) {
     let rcp = v.length_recip();
-    (v * rcp, rcp.is_finite() && rcp > 0.0)
+    (v.scale(rcp), rcp.is_finite() & rcp.gt(rcp.lit(0.0)))
 }
 
 /// Unit tangent at `a` of the great-circle arc towards `b`; the flag is false if b = ±a.
 #[inline(always)]
-fn tangent(a: DVec3, b: DVec3) -> (DVec3, bool) {
-    unit(b - a * a.dot(b))
+fn tangent<R: Real>(a: R3<R>, b: R3<R>) -> (R3<R>, R::Mask) {
+    unit(b - a.scale(a.dot(b)))
 }
 
-/// The first, cheap half of [`SphericalTriangle::new`]: the vertex directions and the solid
-/// angle. A light decides from the solid angle whether to sample by solid angle at all, then
-/// finishes the same projection with [`SphericalProjection::sampler`] instead of normalising
-/// and measuring the triangle a second time.
+/// The unit directions from a viewpoint to a triangle's vertices and its solid angle, for one
+/// lane or several.
 #[derive(Clone, Copy, Debug)]
-pub struct SphericalProjection {
-    da: DVec3,
-    db: DVec3,
-    dc: DVec3,
-    area64: f64,
+struct Projection<R> {
+    da: R3<R>,
+    db: R3<R>,
+    dc: R3<R>,
+    area64: R,
 }
 
-impl SphericalProjection {
-    /// Unit directions from `p` to (v0, v1, v2); `None` if a vertex coincides with `p`.
-    /// Everything is computed and the flags combined at the end (no early return), so all 16
-    /// lanes of the solid-angle kernel run it together, whichever of them fail.
+impl<R: Real> Projection<R> {
+    /// Unit directions from `p` to (v0, v1, v2) and the solid angle; the flag is false where
+    /// a vertex coincides with `p`. Everything is computed and the flags combined at the end
+    /// (no early return), so lanes run it together, whichever of them fail.
     #[inline(always)]
-    pub fn new(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<Self> {
-        let p = p.as_dvec3();
-        let (da, ok_a) = unit(v0.as_dvec3() - p);
-        let (db, ok_b) = unit(v1.as_dvec3() - p);
-        let (dc, ok_c) = unit(v2.as_dvec3() - p);
+    fn new(p: R3<R>, v0: R3<R>, v1: R3<R>, v2: R3<R>) -> (Self, R::Mask) {
+        let (da, ok_a) = unit(v0 - p);
+        let (db, ok_b) = unit(v1 - p);
+        let (dc, ok_c) = unit(v2 - p);
         let proj = Self {
             da,
             db,
             dc,
             area64: solid_angle(da, db, dc),
         };
-        (ok_a & ok_b & ok_c).then_some(proj)
+        (proj, ok_a & ok_b & ok_c)
     }
 
-    /// Solid angle (sr), f64.
+    /// The sampler's state; the flag is false where the triangle is too small or degenerate
+    /// to sample.
     #[inline(always)]
-    pub fn solid_angle(&self) -> f64 {
-        self.area64
-    }
-
-    /// The sampler's state, without the inside-test data (`None` as for [`Self::sampler`]).
-    #[inline(always)]
-    fn arvo(&self) -> Option<Arvo> {
+    fn arvo(&self) -> (Arvo<R>, R::Mask) {
         let Self { da, db, dc, area64 } = *self;
-        let big = area64 >= SphericalTriangle::MIN_SOLID_ANGLE && area64.is_finite();
+        let big = area64.ge(area64.lit(SphericalTriangle::MIN_SOLID_ANGLE)) & area64.is_finite();
         let ((t_ab, ok_ab), (t_ac, ok_ac)) = (tangent(da, db), tangent(da, dc));
         // α = angle between the two unit tangents: its cosine and sine directly.
         let (cos_alpha, sin_alpha) = (t_ab.dot(t_ac), t_ab.cross(t_ac).length());
@@ -113,21 +106,48 @@ impl SphericalProjection {
             sin_alpha,
             c_perp: t_ac,
         };
-        (big & ok_ab & ok_ac).then_some(arvo)
+        (arvo, big & ok_ab & ok_ac)
+    }
+}
+
+/// The first, cheap half of [`SphericalTriangle::new`]: the vertex directions and the solid
+/// angle. A light decides from the solid angle whether to sample by solid angle at all, then
+/// finishes the same projection with [`SphericalProjection::sampler`] instead of normalising
+/// and measuring the triangle a second time.
+#[derive(Clone, Copy, Debug)]
+pub struct SphericalProjection(Projection<f64>);
+
+impl SphericalProjection {
+    /// Unit directions from `p` to (v0, v1, v2); `None` if a vertex coincides with `p`.
+    #[inline(always)]
+    pub fn new(p: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<Self> {
+        let (proj, ok) = Projection::new(p.into(), v0.into(), v1.into(), v2.into());
+        ok.then_some(Self(proj))
+    }
+
+    /// Solid angle (sr), f64.
+    #[inline(always)]
+    pub fn solid_angle(&self) -> f64 {
+        self.0.area64
     }
 
     /// One direction drawn as [`SphericalTriangle::sample`] draws it, without building the
     /// whole sampler (the hot path of triangle lights: one sample per projection).
     #[inline(always)]
     pub fn sample(&self, u: Vec2) -> Option<Vec3> {
-        Some(self.arvo()?.sample(u))
+        let (arvo, ok) = self.0.arvo();
+        ok.then(|| DVec3::from(arvo.sample(u.x as f64, u.y as f64)).as_vec3())
     }
 
     /// The sampler of this triangle; `None` if it is too small or degenerate to sample.
     #[inline]
     pub fn sampler(self) -> Option<SphericalTriangle> {
-        let arvo = self.arvo()?;
-        let Self { da, db, dc, area64 } = self;
+        let (arvo, ok) = self.0.arvo();
+        if !ok {
+            return None;
+        }
+        let Projection { da, db, dc, area64 } = self.0;
+        let (da, db, dc) = (DVec3::from(da), DVec3::from(db), DVec3::from(dc));
         let triple = da.dot(db.cross(dc));
         Some(SphericalTriangle {
             a: da.as_vec3(),
@@ -144,32 +164,109 @@ impl SphericalProjection {
     }
 }
 
-/// The state of Arvo's inversion for one triangle.
-#[derive(Clone, Copy, Debug)]
-struct Arvo {
-    /// Vertex directions A and B.
-    a: DVec3,
-    b: DVec3,
-    /// Solid angle.
-    area64: f64,
-    /// cos and sin of the interior angle α at A (Arvo needs only these and sin(ξ₁Ω − α),
-    /// which the angle-difference identity gives without an atan2 and a second sincos).
-    cos_alpha: f64,
-    sin_alpha: f64,
-    /// Unit tangent at A of the arc AC (where the sub-triangle's far vertex Ĉ moves).
-    c_perp: DVec3,
+/// The f64 half of one solid-angle sample of a triangle from a point: the solid angle Ω
+/// (`None` where a vertex coincides with the point) and the drawn direction (`None` where
+/// the triangle is too small or degenerate to sample). What [`SphericalProjection::new`] and
+/// [`SphericalProjection::sample`] give, drawn by [`SolidAngleDraw::new`] one lane at a time
+/// or by [`SolidAngleDraw::lanes4`] four lanes per register, with the same bits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolidAngleDraw {
+    /// Ω (sr) rounded to f32.
+    pub omega: Option<f32>,
+    /// The unit direction drawn uniformly in the triangle's solid angle.
+    pub wi: Option<Vec3>,
 }
 
-impl Arvo {
-    /// Unit direction uniformly distributed in the spherical triangle. Branch-free (selects
-    /// only), so 16 lanes of the solid-angle kernel sample at once.
+/// [`SolidAngleDraw`] for one lane or several, before it is split into lanes.
+#[derive(Clone, Copy, Debug)]
+struct Draw<R: Real> {
+    omega: R,
+    omega_ok: R::Mask,
+    wi: R3<R>,
+    wi_ok: R::Mask,
+}
+
+impl<R: Real> Draw<R> {
+    /// Project triangle (v0, v1, v2) around `p` and draw direction (ux, uy) in it.
     #[inline(always)]
-    fn sample(&self, u: Vec2) -> Vec3 {
+    fn new(p: R3<R>, v: [R3<R>; 3], ux: R, uy: R) -> Self {
+        let (proj, omega_ok) = Projection::new(p, v[0], v[1], v[2]);
+        let (arvo, ok) = proj.arvo();
+        Draw {
+            omega: proj.area64,
+            omega_ok,
+            wi: arvo.sample(ux, uy),
+            wi_ok: omega_ok & ok,
+        }
+    }
+}
+
+impl SolidAngleDraw {
+    /// Triangle (v0, v1, v2) seen from `p`, direction drawn with `u`.
+    #[inline(always)]
+    pub fn new(p: Vec3, v: [Vec3; 3], u: Vec2) -> Self {
+        let d = Draw::new(p.into(), v.map(R3::from), u.x as f64, u.y as f64);
+        SolidAngleDraw {
+            omega: d.omega_ok.then_some(d.omega as f32),
+            wi: d.wi_ok.then(|| DVec3::from(d.wi).as_vec3()),
+        }
+    }
+
+    /// [`Self::new`] of four lanes at once, on AVX2: lane i has point `(p[0][i], p[1][i],
+    /// p[2][i])`, vertices `v[j]` likewise and draw `(u[0][i], u[1][i])`.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub fn lanes4(
+        t: crate::isa::Avx2,
+        p: [&[f32; 4]; 3],
+        v: [[&[f32; 4]; 3]; 3],
+        u: [&[f32; 4]; 2],
+    ) -> [Self; 4] {
+        use super::f64_lanes::F64x4;
+        let wide = |c: [&[f32; 4]; 3]| R3 {
+            x: F64x4::from_f32(t, c[0]),
+            y: F64x4::from_f32(t, c[1]),
+            z: F64x4::from_f32(t, c[2]),
+        };
+        let (ux, uy) = (F64x4::from_f32(t, u[0]), F64x4::from_f32(t, u[1]));
+        let d = Draw::new(wide(p), v.map(wide), ux, uy);
+        let omega = d.omega.to_f32();
+        let (x, y, z) = (d.wi.x.to_f32(), d.wi.y.to_f32(), d.wi.z.to_f32());
+        let (omega_ok, wi_ok) = (d.omega_ok.bits(), d.wi_ok.bits());
+        std::array::from_fn(|i| SolidAngleDraw {
+            omega: (omega_ok >> i & 1 != 0).then_some(omega[i]),
+            wi: (wi_ok >> i & 1 != 0).then_some(Vec3::new(x[i], y[i], z[i])),
+        })
+    }
+}
+
+/// The state of Arvo's inversion for one triangle (or one per lane).
+#[derive(Clone, Copy, Debug)]
+struct Arvo<R> {
+    /// Vertex directions A and B.
+    a: R3<R>,
+    b: R3<R>,
+    /// Solid angle.
+    area64: R,
+    /// cos and sin of the interior angle α at A (Arvo needs only these and sin(ξ₁Ω − α),
+    /// which the angle-difference identity gives without an atan2 and a second sincos).
+    cos_alpha: R,
+    sin_alpha: R,
+    /// Unit tangent at A of the arc AC (where the sub-triangle's far vertex Ĉ moves).
+    c_perp: R3<R>,
+}
+
+impl<R: Real> Arvo<R> {
+    /// Unit direction uniformly distributed in the spherical triangle for the draw (ux, uy)
+    /// (f32 values widened). Branch-free (selects only), so lanes sample together.
+    #[inline(always)]
+    fn sample(&self, ux: R, uy: R) -> R3<R> {
         let (a, b) = (self.a, self.b);
-        let sub_area = u.x as f64 * self.area64;
+        let one = ux.lit(1.0);
+        let sub_area = ux * self.area64;
         let (sin_alpha, cos_alpha) = (self.sin_alpha, self.cos_alpha);
         // (s, t) = (sin, cos) of (ξ₁Ω − α); ξ₁Ω ∈ [0, 4π] ⊂ [0, 8] since `arvo` checked Ω.
-        let (sin_sub, cos_sub) = super::warps::sin_cos_0_8_f64(sub_area);
+        let (sin_sub, cos_sub) = sin_cos_0_8(sub_area);
         let s = sin_sub * cos_alpha - cos_sub * sin_alpha;
         let t = cos_sub * cos_alpha + sin_sub * sin_alpha;
         let uu = t - cos_alpha;
@@ -177,18 +274,17 @@ impl Arvo {
         // q = cos of the arc from A to Ĉ, the far vertex of the sub-triangle of area ξ₁·Ω.
         let den = (v * s + uu * t) * sin_alpha;
         let q = (((v * t - uu * s) * cos_alpha - v) / den).clamp(-1.0, 1.0);
-        let q = if den != 0.0 { q } else { 1.0 };
+        let q = R::select(den.ne(ux.lit(0.0)), q, one);
         let c_perp = self.c_perp;
         // A unit vector already (a ⟂ c_perp, both unit): no renormalisation on this f64
         // sqrt/div latency chain, whose rounding would vanish in the f32 result anyway.
-        let c_hat = a * q + c_perp * (1.0 - q * q).max(0.0).sqrt();
+        let c_hat = a.scale(q) + c_perp.scale((one - q * q).max(ux.lit(0.0)).sqrt());
         // cos of the arc from B is uniform between Ĉ·B and 1.
-        let z = 1.0 - u.y as f64 * (1.0 - c_hat.dot(b));
+        let z = one - uy * (one - c_hat.dot(b));
         let (t, ok) = tangent(b, c_hat);
-        let dir = b * z + t * (1.0 - z * z).max(0.0).sqrt();
-        let dir = if ok { dir } else { b };
+        let dir = b.scale(z) + t.scale((one - z * z).max(ux.lit(0.0)).sqrt());
         // Unit up to f64 rounding (b ⟂ t, z² + (1 − z²) = 1), far below the f32 result's ulp.
-        dir.as_vec3()
+        R3::select(ok, dir, b)
     }
 }
 
@@ -204,7 +300,7 @@ impl SphericalTriangle {
 
     /// Unit direction uniformly distributed in the spherical triangle; pdf = 1/area.
     pub fn sample(&self, u: Vec2) -> Vec3 {
-        self.arvo.sample(u)
+        DVec3::from(self.arvo.sample(u.x as f64, u.y as f64)).as_vec3()
     }
 
     /// Inverse of [`Self::sample`] for a direction inside the triangle.
@@ -220,7 +316,7 @@ impl SphericalTriangle {
         if c_hat.dot(a + c) < 0.0 {
             c_hat = -c_hat;
         }
-        let u0 = solid_angle(a, b, c_hat) / self.area64;
+        let u0 = solid_angle(a.into(), b.into(), c_hat.into()) / self.area64;
         let den = 1.0 - c_hat.dot(b);
         let u1 = if den > 0.0 {
             (1.0 - d.dot(b)) / den
