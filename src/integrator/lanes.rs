@@ -247,7 +247,7 @@ impl TriangleLightLanes {
             };
             let u = Vec2::new(u[0][k], u[1][k]);
             // A match, not `and_then`: the closure cost mis-area 0.38 → 0.50 s (dbcda06).
-            let est = match tri.sample_li_drawn(&ctx, u, draws.map(|d| d[k])) {
+            let est = match tri.sample_li_drawn(&ctx, u, draws.as_ref().map(|d| d[k])) {
                 Some(ls) => light_estimate(
                     &ls,
                     self.pmf[k],
@@ -291,8 +291,12 @@ impl TriangleLightLanes {
                 fn q(l: &Lanes, g: usize) -> &[f32; 4] {
                     l[g..g + 4].try_into().expect("4 lanes")
                 }
-                let p = rx.cols.p.each_ref().map(|c| q(c, g));
-                let v = self.v.each_ref().map(|v| [q(&v.x, g), q(&v.y, g), q(&v.z, g)]);
+                // Written out, not `array::map`: that is a call, outside the AVX2 code.
+                let p = [q(&rx.cols.p[0], g), q(&rx.cols.p[1], g), q(&rx.cols.p[2], g)];
+                fn v3(v: &V3, g: usize) -> [&[f32; 4]; 3] {
+                    [q(&v.x, g), q(&v.y, g), q(&v.z, g)]
+                }
+                let v = [v3(&self.v[0], g), v3(&self.v[1], g), v3(&self.v[2], g)];
                 let d = SolidAngleDraw::lanes4(a, p, v, [q(&u[0], g), q(&u[1], g)]);
                 draws[g..g + 4].copy_from_slice(&d);
             }

@@ -205,7 +205,8 @@ impl SolidAngleDraw {
     /// Triangle (v0, v1, v2) seen from `p`, direction drawn with `u`.
     #[inline(always)]
     pub fn new(p: Vec3, v: [Vec3; 3], u: Vec2) -> Self {
-        let d = Draw::new(p.into(), v.map(R3::from), u.x as f64, u.y as f64);
+        let v = [v[0].into(), v[1].into(), v[2].into()];
+        let d = Draw::new(p.into(), v, u.x as f64, u.y as f64);
         SolidAngleDraw {
             omega: d.omega_ok.then_some(d.omega as f32),
             wi: d.wi_ok.then(|| DVec3::from(d.wi).as_vec3()),
@@ -229,7 +230,8 @@ impl SolidAngleDraw {
             z: F64x4::from_f32(t, c[2]),
         };
         let (ux, uy) = (F64x4::from_f32(t, u[0]), F64x4::from_f32(t, u[1]));
-        let d = Draw::new(wide(p), v.map(wide), ux, uy);
+        // Written out, not `array::map`: that is a call, outside the AVX2 code.
+        let d = Draw::new(wide(p), [wide(v[0]), wide(v[1]), wide(v[2])], ux, uy);
         let omega = d.omega.to_f32();
         let (x, y, z) = (d.wi.x.to_f32(), d.wi.y.to_f32(), d.wi.z.to_f32());
         let (omega_ok, wi_ok) = (d.omega_ok.bits(), d.wi_ok.bits());
