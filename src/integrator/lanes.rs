@@ -292,7 +292,11 @@ impl TriangleLightLanes {
                     l[g..g + 4].try_into().expect("4 lanes")
                 }
                 // Written out, not `array::map`: that is a call, outside the AVX2 code.
-                let p = [q(&rx.cols.p[0], g), q(&rx.cols.p[1], g), q(&rx.cols.p[2], g)];
+                let p = [
+                    q(&rx.cols.p[0], g),
+                    q(&rx.cols.p[1], g),
+                    q(&rx.cols.p[2], g),
+                ];
                 fn v3(v: &V3, g: usize) -> [&[f32; 4]; 3] {
                     [q(&v.x, g), q(&v.y, g), q(&v.z, g)]
                 }

@@ -376,4 +376,100 @@ mod tests {
         // Viewpoint in the triangle's plane: zero solid angle.
         assert!(SphericalTriangle::new(o, Vec3::X, Vec3::Y, Vec3::X + Vec3::Y).is_none());
     }
+
+    /// Random and awkward (point, triangle, draw) cases: ordinary triangles at all distances,
+    /// a vertex on the point, collinear vertices, the point in or a hair off the triangle's
+    /// plane (grazing), tiny far triangles (below the sampler's minimum), triangles that fill
+    /// almost a hemisphere, non-finite vertices, draws on the unit square's edges.
+    fn draw_cases() -> Vec<(Vec3, [Vec3; 3], Vec2)> {
+        use crate::sampling::hash::{next_f32, pcg_from_keys};
+        let mut rng = pcg_from_keys(&[51]);
+        let mut r = move || next_f32(&mut rng);
+        let mut cases = Vec::new();
+        let edges = [0.0, 1.0 - f32::EPSILON / 2.0, 0.5, f32::MIN_POSITIVE];
+        for i in 0..4000 {
+            let scale = 10f32.powi(i % 7 - 3);
+            let mut v3 = |s: f32| Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5) * s;
+            let p = v3(2.0);
+            let c = v3(8.0) + Vec3::new(0.0, 0.0, 3.0);
+            let mut v = [c + v3(scale), c + v3(scale), c + v3(scale)];
+            match i % 10 {
+                0 => v[1] = p,                                  // a vertex on the point
+                1 => v[2] = v[0] + (v[1] - v[0]) * r(),         // collinear
+                2 => v[2] = p + (v[0] - p) + (v[1] - p) * -1.5, // point in the plane
+                3 => {
+                    // A hair off the plane (grazing).
+                    let n = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+                    let off = n * (1e-6 * (r() - 0.5));
+                    v[2] = p + (v[0] - p) * 0.3 + (v[1] - p) * 0.6 + off;
+                }
+                4 => v = v.map(|x| p + (x - p).normalize() * 1e4 + v3(1e-3)), // tiny, far
+                5 => {
+                    v = [
+                        p + Vec3::X * 1e-3,
+                        p + Vec3::Y * 1e-3,
+                        p - Vec3::X - Vec3::Y,
+                    ]
+                } // huge
+                6 if i % 20 == 6 => v[0] = Vec3::NAN,
+                6 => v[2] = Vec3::new(f32::INFINITY, 0.0, 1.0),
+                _ => {}
+            }
+            let u = Vec2::new(r(), r());
+            let u = match i % 13 {
+                0 => Vec2::new(edges[i as usize / 13 % 4], u.y),
+                1 => Vec2::new(u.x, edges[i as usize / 13 % 4]),
+                2 => Vec2::new(edges[i as usize / 13 % 4], edges[i as usize / 7 % 4]),
+                _ => u,
+            };
+            cases.push((p, v, u));
+        }
+        cases
+    }
+
+    fn draw_bits(d: SolidAngleDraw) -> (Option<u32>, Option<[u32; 3]>) {
+        (
+            d.omega.map(f32::to_bits),
+            d.wi.map(|w| w.to_array().map(f32::to_bits)),
+        )
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn four_lane_draws_are_the_one_lane_bits() {
+        let Some(t) = crate::isa::Avx2::new() else {
+            return;
+        };
+        let cases = draw_cases();
+        let (mut some, mut none) = (0, 0);
+        for c in cases.chunks_exact(4) {
+            let col = |f: &dyn Fn(usize) -> f32| -> [f32; 4] { std::array::from_fn(f) };
+            let p = [0, 1, 2].map(|a| col(&|i| c[i].0[a]));
+            let v = [0, 1, 2].map(|j| [0, 1, 2].map(|a| col(&|i| c[i].1[j][a])));
+            let u = [0, 1].map(|a| col(&|i| c[i].2[a]));
+            let got = SolidAngleDraw::lanes4(
+                t,
+                [&p[0], &p[1], &p[2]],
+                v.each_ref().map(|v| [&v[0], &v[1], &v[2]]),
+                [&u[0], &u[1]],
+            );
+            for (i, &(p, v, u)) in c.iter().enumerate() {
+                let want = SolidAngleDraw::new(p, v, u);
+                assert_eq!(draw_bits(got[i]), draw_bits(want), "{p} {v:?} {u}");
+                // The one-lane draw is what the projection's own methods give.
+                let proj = SphericalProjection::new(p, v[0], v[1], v[2]);
+                let omega = proj.map(|q| q.solid_angle() as f32);
+                let wi = proj.and_then(|q| q.sample(u));
+                let old = SolidAngleDraw { omega, wi };
+                assert_eq!(draw_bits(want), draw_bits(old), "{p} {v:?} {u}");
+                if want.wi.is_some() {
+                    some += 1;
+                } else {
+                    none += 1;
+                }
+            }
+        }
+        // Both outcomes are exercised, the valid ones mostly.
+        assert!(some > 2500 && none > 400, "{some} drawn, {none} not");
+    }
 }
