@@ -23,10 +23,7 @@ impl Isa {
     pub fn detect() -> Isa {
         #[cfg(target_arch = "x86_64")]
         {
-            // AVX2 too (every AVX-512 CPU has it): an AVX-512 token then stands for AVX2 as
-            // well (`Token::with_avx2`).
             if std::is_x86_feature_detected!("avx512f")
-                && std::is_x86_feature_detected!("avx2")
                 && std::is_x86_feature_detected!("avx512bw")
                 && std::is_x86_feature_detected!("avx512dq")
                 && std::is_x86_feature_detected!("avx512vl")
@@ -75,13 +72,6 @@ pub trait Token: Copy + Send + Sync + 'static {
     fn avx2(self) -> Option<Avx2> {
         None
     }
-    /// An AVX2 token if this set includes AVX2 (AVX2 itself, and AVX-512, which
-    /// [`Isa::detect`] reports only where AVX2 is present too): for kernels whose widest
-    /// form is AVX2.
-    #[inline(always)]
-    fn with_avx2(self) -> Option<Avx2> {
-        None
-    }
 }
 
 /// The token of plain code: every CPU runs it.
@@ -106,10 +96,6 @@ impl Token for Avx2 {
     fn avx2(self) -> Option<Avx2> {
         Some(self)
     }
-    #[inline(always)]
-    fn with_avx2(self) -> Option<Avx2> {
-        Some(self)
-    }
 }
 
 impl Token for Avx512 {
@@ -117,11 +103,6 @@ impl Token for Avx512 {
     #[inline(always)]
     fn avx512(self) -> Option<Avx512> {
         Some(self)
-    }
-    #[inline(always)]
-    fn with_avx2(self) -> Option<Avx2> {
-        // An AVX-512 token exists only where `Isa::detect` found AVX2 as well.
-        Some(Avx2(()))
     }
 }
 

@@ -7,7 +7,11 @@
 //! each lane's bits are the per-lane path's; they hold no maths of their own. What changes is
 //! the layout: each input and output is an array over the packet's lanes, so the loop over
 //! lanes compiles to 16-wide (AVX-512), 8-wide (AVX2) or 4-wide (SSE2) vector code instead of
-//! one lane at a time, whose chains of square roots and divisions left the CPU waiting.
+//! one lane at a time, whose chains of square roots and divisions left the CPU waiting. The
+//! solid-angle light samples' f64 half (Arvo's projection and inversion, which the compiler
+//! leaves scalar) is drawn first, four lanes per AVX2 register, by the sampler's own generic
+//! code ([`SolidAngleDraw::lanes4`]); each lane then finishes in
+//! [`TriangleLight::sample_li_drawn`], the second half of the triangle's `sample_li`.
 //!
 //! Which work item goes to a kernel is decided by the light ([`Light::lane_kind`]) and the BSDF
 //! ([`Bsdf::lane_kind`]); the kernels' input queues ([`TriangleLightLanes`],
@@ -23,7 +27,7 @@ use crate::Rgb;
 use crate::bsdf::{Bxdf, Lambert};
 use crate::geometry::{PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
 use crate::isa::{Cpu, Kernel, Token};
-use crate::lights::{LightSampleContext, SamplingMode, TriangleLight};
+use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
 use crate::sampling::{Frame, SolidAngleDraw};
 use glam::{Vec2, Vec3};
 
@@ -233,7 +237,7 @@ impl TriangleLightLanes {
         out: &mut ShadowRays,
     ) {
         let draws = match mode {
-            SamplingMode::SolidAngle => Some(self.solid_angle_draws(t, rx, u)),
+            SamplingMode::SolidAngle => self.solid_angle_draws(t, rx, u),
             SamplingMode::Area => None,
         };
         for k in 0..PACKET {
@@ -247,7 +251,11 @@ impl TriangleLightLanes {
             };
             let u = Vec2::new(u[0][k], u[1][k]);
             // A match, not `and_then`: the closure cost mis-area 0.38 → 0.50 s (dbcda06).
-            let est = match tri.sample_li_drawn(&ctx, u, draws.as_ref().map(|d| d[k])) {
+            let ls = match &draws {
+                Some(d) => tri.sample_li_drawn(&ctx, u, Some(d[k])),
+                None => tri.sample_li(&ctx, u, mode),
+            };
+            let est = match ls {
                 Some(ls) => light_estimate(
                     &ls,
                     self.pmf[k],
@@ -272,21 +280,25 @@ impl TriangleLightLanes {
 
 impl TriangleLightLanes {
     /// Every lane's [`SolidAngleDraw`] (the f64 half of its solid-angle sample, which
-    /// [`TriangleLight::sample_li_drawn`] finishes): four lanes per AVX2 register where the CPU
-    /// has AVX2, else lane by lane; the same bits either way.
+    /// [`TriangleLight::sample_li_drawn`] finishes), four lanes per register, on AVX2 only:
+    /// `None` on the other sets, whose lanes draw in `sample_li` itself. There the compiler
+    /// vectorizes the whole lane loop, f64 half included, by masked AVX-512 instructions (eight
+    /// f64 lanes per register), or nothing needs speed (portable code). With AVX2's lacking
+    /// masks it left the f64 half scalar; on AVX-512 this pre-pass made cornell path 9 % slower.
     #[inline(always)]
     fn solid_angle_draws<T: Token>(
         &self,
         t: T,
         rx: &Receivers,
         u: &[Lanes; 2],
-    ) -> [SolidAngleDraw; PACKET] {
+    ) -> Option<[SolidAngleDraw; PACKET]> {
         #[cfg(target_arch = "x86_64")]
-        if let Some(a) = t.with_avx2() {
+        if let Some(a) = t.avx2() {
             let mut draws = [SolidAngleDraw {
                 omega: None,
                 wi: None,
             }; PACKET];
+            const { assert!(PACKET % 4 == 0) };
             for g in (0..PACKET).step_by(4) {
                 fn q(l: &Lanes, g: usize) -> &[f32; 4] {
                     l[g..g + 4].try_into().expect("4 lanes")
@@ -304,13 +316,10 @@ impl TriangleLightLanes {
                 let d = SolidAngleDraw::lanes4(a, p, v, [q(&u[0], g), q(&u[1], g)]);
                 draws[g..g + 4].copy_from_slice(&d);
             }
-            return draws;
+            return Some(draws);
         }
-        let _ = t;
-        std::array::from_fn(|k| {
-            let v = [self.v[0].get(k), self.v[1].get(k), self.v[2].get(k)];
-            SolidAngleDraw::new(col(&rx.cols.p, k), v, Vec2::new(u[0][k], u[1][k]))
-        })
+        let _ = (t, rx, u);
+        None
     }
 }
 
@@ -395,7 +404,6 @@ mod tests {
     use super::*;
     use crate::bsdf::LobeSampling;
     use crate::isa::Isa;
-    use crate::lights::LightSource;
     use crate::sampling::hash::{next_f32, pcg_from_keys};
     use rand_pcg::Pcg32;
 
