@@ -236,9 +236,13 @@ impl TriangleLightLanes {
         mode: SamplingMode,
         out: &mut ShadowRays,
     ) {
-        let draws = match mode {
-            SamplingMode::SolidAngle => self.solid_angle_draws(t, rx, u),
-            SamplingMode::Area => None,
+        // A constant of each copy of the loop (`t.avx2()` is one for each token type), so the
+        // loop holds one of the two ways of sampling, not a branch between them.
+        let ahead = mode == SamplingMode::SolidAngle && t.avx2().is_some();
+        let draws = if ahead {
+            self.solid_angle_draws(t, rx, u)
+        } else {
+            [SolidAngleDraw::NONE; PACKET]
         };
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
@@ -251,9 +255,10 @@ impl TriangleLightLanes {
             };
             let u = Vec2::new(u[0][k], u[1][k]);
             // A match, not `and_then`: the closure cost mis-area 0.38 → 0.50 s (dbcda06).
-            let ls = match &draws {
-                Some(d) => tri.sample_li_drawn(&ctx, u, Some(d[k])),
-                None => tri.sample_li(&ctx, u, mode),
+            let ls = if ahead {
+                tri.sample_li_drawn(&ctx, u, Some(draws[k]))
+            } else {
+                tri.sample_li(&ctx, u, mode)
             };
             let est = match ls {
                 Some(ls) => light_estimate(
@@ -280,24 +285,22 @@ impl TriangleLightLanes {
 
 impl TriangleLightLanes {
     /// Every lane's [`SolidAngleDraw`] (the f64 half of its solid-angle sample, which
-    /// [`TriangleLight::sample_li_drawn`] finishes), four lanes per register, on AVX2 only:
-    /// `None` on the other sets, whose lanes draw in `sample_li` itself. There the compiler
-    /// vectorizes the whole lane loop, f64 half included, by masked AVX-512 instructions (eight
-    /// f64 lanes per register), or nothing needs speed (portable code). With AVX2's lacking
-    /// masks it left the f64 half scalar; on AVX-512 this pre-pass made cornell path 9 % slower.
+    /// [`TriangleLight::sample_li_drawn`] finishes), four lanes per register on AVX2, else
+    /// lane by lane (the same bits). The kernel draws ahead on AVX2 only: on the other sets
+    /// its lanes draw in `sample_li` itself. There the compiler vectorizes the whole lane loop,
+    /// f64 half included, by masked AVX-512 instructions (eight f64 lanes per register), or
+    /// nothing needs speed (portable code); with AVX2's lack of masks it left the f64 half
+    /// scalar. On AVX-512 drawing ahead made cornell path 9 % slower (docs/path-tracing.md).
     #[inline(always)]
     fn solid_angle_draws<T: Token>(
         &self,
         t: T,
         rx: &Receivers,
         u: &[Lanes; 2],
-    ) -> Option<[SolidAngleDraw; PACKET]> {
+    ) -> [SolidAngleDraw; PACKET] {
         #[cfg(target_arch = "x86_64")]
         if let Some(a) = t.avx2() {
-            let mut draws = [SolidAngleDraw {
-                omega: None,
-                wi: None,
-            }; PACKET];
+            let mut draws = [SolidAngleDraw::NONE; PACKET];
             const { assert!(PACKET % 4 == 0) };
             for g in (0..PACKET).step_by(4) {
                 fn q(l: &Lanes, g: usize) -> &[f32; 4] {
@@ -316,10 +319,13 @@ impl TriangleLightLanes {
                 let d = SolidAngleDraw::lanes4(a, p, v, [q(&u[0], g), q(&u[1], g)]);
                 draws[g..g + 4].copy_from_slice(&d);
             }
-            return Some(draws);
+            return draws;
         }
-        let _ = (t, rx, u);
-        None
+        let _ = t;
+        std::array::from_fn(|k| {
+            let v = [self.v[0].get(k), self.v[1].get(k), self.v[2].get(k)];
+            SolidAngleDraw::new(col(&rx.cols.p, k), v, Vec2::new(u[0][k], u[1][k]))
+        })
     }
 }
 

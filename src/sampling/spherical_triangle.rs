@@ -204,6 +204,12 @@ impl<R: Real> Draw<R> {
 }
 
 impl SolidAngleDraw {
+    /// Neither a solid angle nor a direction.
+    pub const NONE: SolidAngleDraw = SolidAngleDraw {
+        omega: None,
+        wi: None,
+    };
+
     /// Triangle (v0, v1, v2) seen from `p`, direction drawn with `u`.
     #[inline(always)]
     pub fn new(p: Vec3, v: [Vec3; 3], u: Vec2) -> Self {
