@@ -301,7 +301,7 @@ impl TriangleLightLanes {
         #[cfg(target_arch = "x86_64")]
         if let Some(a) = t.avx2() {
             let mut draws = [SolidAngleDraw::NONE; PACKET];
-            const { assert!(PACKET % 4 == 0) };
+            const { assert!(PACKET.is_multiple_of(4)) };
             for g in (0..PACKET).step_by(4) {
                 fn q(l: &Lanes, g: usize) -> &[f32; 4] {
                     l[g..g + 4].try_into().expect("4 lanes")
