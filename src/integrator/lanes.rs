@@ -114,6 +114,8 @@ pub(super) struct TriangleLightLanes {
     /// Loaded lanes.
     pub(super) active: u32,
     pmf: Lanes,
+    /// The selection pmf inside the MIS weights (`SelectedLight::mis_pmf`).
+    mis_pmf: Lanes,
     v: [V3; 3],
     n: V3,
     area: Lanes,
@@ -128,6 +130,7 @@ impl TriangleLightLanes {
         Self {
             active: 0,
             pmf: [0.0; PACKET],
+            mis_pmf: [0.0; PACKET],
             v: [V3::ZERO; 3],
             n: V3::ZERO,
             area: [0.0; PACKET],
@@ -137,11 +140,12 @@ impl TriangleLightLanes {
         }
     }
 
-    /// Load lane k: light `tri` picked with probability `pmf`.
+    /// Load lane k: light `tri` picked with probability `pmf` (`mis_pmf` for the MIS weight).
     #[inline]
-    pub(super) fn load(&mut self, k: usize, tri: &TriangleLight, pmf: f32) {
+    pub(super) fn load(&mut self, k: usize, tri: &TriangleLight, pmf: f32, mis_pmf: f32) {
         self.active |= 1 << k;
         self.pmf[k] = pmf;
+        self.mis_pmf[k] = mis_pmf;
         for (v, p) in self.v.iter_mut().zip(tri.p) {
             v.set(k, p);
         }
@@ -264,6 +268,7 @@ impl TriangleLightLanes {
                 Some(ls) => light_estimate(
                     &ls,
                     self.pmf[k],
+                    self.mis_pmf[k],
                     &lambert,
                     &frame,
                     wo_local,
@@ -517,7 +522,7 @@ mod tests {
                     let tri = TriangleLight::new(v, unit(&mut rng), Vec3::splat(4.0), k % 3 == 0)
                         .expect("a random triangle has an area");
                     let (pmf, u) = (0.5, Vec2::new(next_f32(&mut rng), next_f32(&mut rng)));
-                    lanes.load(k, &tri, pmf);
+                    lanes.load(k, &tri, pmf, pmf);
                     tris.push((tri, pmf, u));
                 }
                 let draws = [0, 1].map(|a| std::array::from_fn(|k| tris[k].2[a]));
@@ -530,7 +535,9 @@ mod tests {
                 for (k, (tri, pmf, u)) in tris.iter().enumerate() {
                     let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
                     let want = tri.sample_li(&ctx, *u, mode).and_then(|ls| {
-                        light_estimate(&ls, *pmf, &lambert, &g.frame, g.wo_local, &ctx, &hit, mis)
+                        light_estimate(
+                            &ls, *pmf, *pmf, &lambert, &g.frame, g.wo_local, &ctx, &hit, mis,
+                        )
                     });
                     let what = format!("{isa:?} round {round} lane {k}");
                     assert_eq!(out.active >> k & 1 != 0, want.is_some(), "{what}");
