@@ -9,8 +9,8 @@
 //! lanes compiles to 16-wide (AVX-512), 8-wide (AVX2) or 4-wide (SSE2) vector code instead of
 //! one lane at a time, whose chains of square roots and divisions left the CPU waiting. The
 //! solid-angle light samples' f64 half (Arvo's projection and inversion, which the compiler
-//! leaves scalar) is drawn first, four lanes per AVX2 register, by the sampler's own generic
-//! code ([`SolidAngleDraw::lanes4`]); each lane then finishes in
+//! leaves scalar on AVX2) is drawn first there, four lanes per register, by the sampler's own
+//! generic code ([`SolidAngleDraw::lanes4`]); each lane then finishes in
 //! [`TriangleLight::sample_li_drawn`], the second half of the triangle's `sample_li`.
 //!
 //! Which work item goes to a kernel is decided by the light ([`Light::lane_kind`]) and the BSDF
