@@ -17,7 +17,10 @@
 //! the other's *for the same direction*: a light sample by h(pmf·p_L, p_B), an emitter reached
 //! by a BSDF ray by h(p_B, pmf·p_L) ([`nee_pdf`] includes the light-selection pmf, so every
 //! selector stays unbiased). Delta lobes and delta lights cannot be produced by the other
-//! technique: their weight is 1.
+//! technique: their weight is 1. The pmf inside both weights is the selector's deterministic
+//! one; `ris` divides its light sample by a random 1/W instead, which keeps the estimate
+//! unbiased, but weighting with it too would make the two weights of a direction sum to 1
+//! only on average (a bias: `mis_tests.rs`).
 //!
 //! Both techniques estimate the same integrand restricted by one hemisphere rule,
 //! [`gathers_from`]: above the geometric surface on the viewer's side for reflecting BSDFs;
@@ -47,7 +50,10 @@ pub fn shadow_ray(hit: &SurfaceHit, target: Vec3) -> Ray {
 
 /// The light-sampling estimate f·Li·cos / (pmf·pdf) of light sample `ls` (its light picked
 /// with probability `pmf`) at a receiver with BSDF `bsdf`, shading `frame`, local `wo_local`,
-/// context `ctx` and hit `hit`, weighted by heuristic `mis` against BSDF sampling when given:
+/// context `ctx` and hit `hit`, weighted by heuristic `mis` against BSDF sampling when given,
+/// with h(mis_pmf·pdf, p_B): `mis_pmf` is the selection pmf a BSDF ray reaching the same light
+/// would compute ([`crate::light_selection::SelectedLight::mis_pmf`]; `pmf` itself for every
+/// selector but RIS, whose `pmf` is random), so the two weights of a direction sum to 1:
 /// the shadow ray it needs, its value if that ray is clear (`None` when it is zero anyway) and
 /// the MIS weight inside that value (1 without MIS or for a delta light: `online` selection
 /// records the value without it). pbrt-v4's `SampleLd` after the light is chosen and sampled.
@@ -56,6 +62,7 @@ pub fn shadow_ray(hit: &SurfaceHit, target: Vec3) -> Ray {
 pub(super) fn light_estimate(
     ls: &LightLiSample,
     pmf: f32,
+    mis_pmf: f32,
     bsdf: &impl Bxdf,
     frame: &Frame,
     wo_local: Vec3,
@@ -91,7 +98,7 @@ pub(super) fn light_estimate(
     }
     let pdf = pmf * ls.pdf;
     let w = match weigh {
-        Some(h) => h.weight(pdf, bsdf_pdf),
+        Some(h) => h.weight(mis_pmf * ls.pdf, bsdf_pdf),
         None => 1.0,
     };
     Some((shadow_ray(hit, ls.p_light), f * ls.li * (w / pdf), w))

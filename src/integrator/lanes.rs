@@ -7,7 +7,11 @@
 //! each lane's bits are the per-lane path's; they hold no maths of their own. What changes is
 //! the layout: each input and output is an array over the packet's lanes, so the loop over
 //! lanes compiles to 16-wide (AVX-512), 8-wide (AVX2) or 4-wide (SSE2) vector code instead of
-//! one lane at a time, whose chains of square roots and divisions left the CPU waiting.
+//! one lane at a time, whose chains of square roots and divisions left the CPU waiting. The
+//! solid-angle light samples' f64 half (Arvo's projection and inversion, which the compiler
+//! leaves scalar on AVX2) is drawn first there, four lanes per register, by the sampler's own
+//! generic code ([`SolidAngleDraw::lanes4`]); each lane then finishes in
+//! [`TriangleLight::sample_li_drawn`], the second half of the triangle's `sample_li`.
 //!
 //! Which work item goes to a kernel is decided by the light ([`Light::lane_kind`]) and the BSDF
 //! ([`Bsdf::lane_kind`]); the kernels' input queues ([`TriangleLightLanes`],
@@ -24,7 +28,7 @@ use crate::bsdf::{Bxdf, Lambert};
 use crate::geometry::{PACKET, Ray, RayPacket, ShadingGeometry, SurfaceHit};
 use crate::isa::{Cpu, Kernel, Token};
 use crate::lights::{LightSampleContext, LightSource, SamplingMode, TriangleLight};
-use crate::sampling::Frame;
+use crate::sampling::{Frame, SolidAngleDraw};
 use glam::{Vec2, Vec3};
 
 impl Receivers {
@@ -110,6 +114,8 @@ pub(super) struct TriangleLightLanes {
     /// Loaded lanes.
     pub(super) active: u32,
     pmf: Lanes,
+    /// The selection pmf inside the MIS weights (`SelectedLight::mis_pmf`).
+    mis_pmf: Lanes,
     v: [V3; 3],
     n: V3,
     area: Lanes,
@@ -124,6 +130,7 @@ impl TriangleLightLanes {
         Self {
             active: 0,
             pmf: [0.0; PACKET],
+            mis_pmf: [0.0; PACKET],
             v: [V3::ZERO; 3],
             n: V3::ZERO,
             area: [0.0; PACKET],
@@ -133,11 +140,12 @@ impl TriangleLightLanes {
         }
     }
 
-    /// Load lane k: light `tri` picked with probability `pmf`.
+    /// Load lane k: light `tri` picked with probability `pmf` (`mis_pmf` for the MIS weight).
     #[inline]
-    pub(super) fn load(&mut self, k: usize, tri: &TriangleLight, pmf: f32) {
+    pub(super) fn load(&mut self, k: usize, tri: &TriangleLight, pmf: f32, mis_pmf: f32) {
         self.active |= 1 << k;
         self.pmf[k] = pmf;
+        self.mis_pmf[k] = mis_pmf;
         for (v, p) in self.v.iter_mut().zip(tri.p) {
             v.set(k, p);
         }
@@ -172,9 +180,9 @@ impl TriangleLightLanes {
         impl Kernel for Run<'_> {
             type Output = u32;
             #[inline(always)]
-            fn run<T: Token>(self, _: T) -> u32 {
+            fn run<T: Token>(self, t: T) -> u32 {
                 self.lanes
-                    .dispatch(self.rx, self.u, self.mis, self.mode, self.out);
+                    .dispatch(t, self.rx, self.u, self.mis, self.mode, self.out);
                 mask_of(&self.lanes.ok)
             }
         }
@@ -193,8 +201,9 @@ impl TriangleLightLanes {
     /// One copy of the lane loop per (`mis`, `mode`), each with both constant, so each loop
     /// body is straight-line code for its own case.
     #[inline(always)]
-    fn dispatch(
+    fn dispatch<T: Token>(
         &mut self,
+        t: T,
         rx: &Receivers,
         u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
@@ -203,33 +212,42 @@ impl TriangleLightLanes {
     ) {
         use SamplingMode::{Area, SolidAngle};
         match (mis, mode) {
-            (None, Area) => self.body(rx, u, None, Area, out),
-            (None, SolidAngle) => self.body(rx, u, None, SolidAngle, out),
+            (None, Area) => self.body(t, rx, u, None, Area, out),
+            (None, SolidAngle) => self.body(t, rx, u, None, SolidAngle, out),
             (Some(MisHeuristic::Power), Area) => {
-                self.body(rx, u, Some(MisHeuristic::Power), Area, out)
+                self.body(t, rx, u, Some(MisHeuristic::Power), Area, out)
             }
             (Some(MisHeuristic::Power), SolidAngle) => {
-                self.body(rx, u, Some(MisHeuristic::Power), SolidAngle, out)
+                self.body(t, rx, u, Some(MisHeuristic::Power), SolidAngle, out)
             }
             (Some(MisHeuristic::Balance), Area) => {
-                self.body(rx, u, Some(MisHeuristic::Balance), Area, out)
+                self.body(t, rx, u, Some(MisHeuristic::Balance), Area, out)
             }
             (Some(MisHeuristic::Balance), SolidAngle) => {
-                self.body(rx, u, Some(MisHeuristic::Balance), SolidAngle, out)
+                self.body(t, rx, u, Some(MisHeuristic::Balance), SolidAngle, out)
             }
         }
     }
 
     /// The lane loop, specialised in each caller for its `mis` and `mode`.
     #[inline(always)]
-    fn body(
+    fn body<T: Token>(
         &mut self,
+        t: T,
         rx: &Receivers,
         u: &[Lanes; 2],
         mis: Option<MisHeuristic>,
         mode: SamplingMode,
         out: &mut ShadowRays,
     ) {
+        // A constant of each copy of the loop (`t.avx2()` is one for each token type), so the
+        // loop holds one of the two ways of sampling, not a branch between them.
+        let ahead = mode == SamplingMode::SolidAngle && t.avx2().is_some();
+        let draws = if ahead {
+            self.solid_angle_draws(t, rx, u)
+        } else {
+            [SolidAngleDraw::NONE; PACKET]
+        };
         for k in 0..PACKET {
             let (hit, ctx, frame, wo_local, lambert) = rx.lane(k);
             let tri = TriangleLight {
@@ -241,10 +259,16 @@ impl TriangleLightLanes {
             };
             let u = Vec2::new(u[0][k], u[1][k]);
             // A match, not `and_then`: the closure cost mis-area 0.38 → 0.50 s (dbcda06).
-            let est = match tri.sample_li(&ctx, u, mode) {
+            let ls = if ahead {
+                tri.sample_li_drawn(&ctx, u, Some(draws[k]))
+            } else {
+                tri.sample_li(&ctx, u, mode)
+            };
+            let est = match ls {
                 Some(ls) => light_estimate(
                     &ls,
                     self.pmf[k],
+                    self.mis_pmf[k],
                     &lambert,
                     &frame,
                     wo_local,
@@ -261,6 +285,52 @@ impl TriangleLightLanes {
             self.ok[k] = ok;
             out.put_weighted(k, &ray, value, w);
         }
+    }
+}
+
+impl TriangleLightLanes {
+    /// Every lane's [`SolidAngleDraw`] (the f64 half of its solid-angle sample, which
+    /// [`TriangleLight::sample_li_drawn`] finishes), four lanes per register on AVX2, else
+    /// lane by lane (the same bits). The kernel draws ahead on AVX2 only: on the other sets
+    /// its lanes draw in `sample_li` itself. There the compiler vectorizes the whole lane loop,
+    /// f64 half included, by masked AVX-512 instructions (eight f64 lanes per register), or
+    /// nothing needs speed (portable code); with AVX2's lack of masks it left the f64 half
+    /// scalar. On AVX-512 drawing ahead made cornell path 9 % slower (docs/path-tracing.md).
+    #[inline(always)]
+    fn solid_angle_draws<T: Token>(
+        &self,
+        t: T,
+        rx: &Receivers,
+        u: &[Lanes; 2],
+    ) -> [SolidAngleDraw; PACKET] {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(a) = t.avx2() {
+            let mut draws = [SolidAngleDraw::NONE; PACKET];
+            const { assert!(PACKET.is_multiple_of(4)) };
+            for g in (0..PACKET).step_by(4) {
+                fn q(l: &Lanes, g: usize) -> &[f32; 4] {
+                    l[g..g + 4].try_into().expect("4 lanes")
+                }
+                // Written out, not `array::map`: that is a call, outside the AVX2 code.
+                let p = [
+                    q(&rx.cols.p[0], g),
+                    q(&rx.cols.p[1], g),
+                    q(&rx.cols.p[2], g),
+                ];
+                fn v3(v: &V3, g: usize) -> [&[f32; 4]; 3] {
+                    [q(&v.x, g), q(&v.y, g), q(&v.z, g)]
+                }
+                let v = [v3(&self.v[0], g), v3(&self.v[1], g), v3(&self.v[2], g)];
+                let d = SolidAngleDraw::lanes4(a, p, v, [q(&u[0], g), q(&u[1], g)]);
+                draws[g..g + 4].copy_from_slice(&d);
+            }
+            return draws;
+        }
+        let _ = t;
+        std::array::from_fn(|k| {
+            let v = [self.v[0].get(k), self.v[1].get(k), self.v[2].get(k)];
+            SolidAngleDraw::new(col(&rx.cols.p, k), v, Vec2::new(u[0][k], u[1][k]))
+        })
     }
 }
 
@@ -452,7 +522,7 @@ mod tests {
                     let tri = TriangleLight::new(v, unit(&mut rng), Vec3::splat(4.0), k % 3 == 0)
                         .expect("a random triangle has an area");
                     let (pmf, u) = (0.5, Vec2::new(next_f32(&mut rng), next_f32(&mut rng)));
-                    lanes.load(k, &tri, pmf);
+                    lanes.load(k, &tri, pmf, pmf);
                     tris.push((tri, pmf, u));
                 }
                 let draws = [0, 1].map(|a| std::array::from_fn(|k| tris[k].2[a]));
@@ -465,7 +535,9 @@ mod tests {
                 for (k, (tri, pmf, u)) in tris.iter().enumerate() {
                     let (hit, ctx, g, lambert) = scalar_lane(&rx, &rays, k);
                     let want = tri.sample_li(&ctx, *u, mode).and_then(|ls| {
-                        light_estimate(&ls, *pmf, &lambert, &g.frame, g.wo_local, &ctx, &hit, mis)
+                        light_estimate(
+                            &ls, *pmf, *pmf, &lambert, &g.frame, g.wo_local, &ctx, &hit, mis,
+                        )
                     });
                     let what = format!("{isa:?} round {round} lane {k}");
                     assert_eq!(out.active >> k & 1 != 0, want.is_some(), "{what}");

@@ -11,6 +11,8 @@ pub mod dims;
 pub mod estimator;
 pub mod film;
 mod lanes;
+#[cfg(test)]
+mod mis_tests;
 pub mod queues;
 pub mod render;
 mod rounds;

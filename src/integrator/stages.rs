@@ -153,7 +153,7 @@ impl Queues {
             shaded: 0,
             tri_lanes: TriangleLightLanes::new(),
             lone_light: 0,
-            picked: [SelectedLight { index: 0, pmf: 0.0 }; PACKET],
+            picked: [SelectedLight::exact(0, 0.0); PACKET],
             bsdf_lanes: DiffuseBsdfLanes::new(),
             lone_bsdf: 0,
             bsdf_rays: BsdfRays::new(),
@@ -163,7 +163,7 @@ impl Queues {
             sums: [Rgb::ZERO; PACKET],
             learning: 0,
             chosen: 0,
-            chosen_light: [SelectedLight { index: 0, pmf: 0.0 }; PACKET],
+            chosen_light: [SelectedLight::exact(0, 0.0); PACKET],
             records: Vec::new(),
         }
     }
@@ -654,7 +654,9 @@ impl<'a> Integrator<'a> {
             }
             let diffuse = q.rx.diffuse >> k & 1 != 0;
             match scene.lights[sel.index as usize].lane_kind() {
-                Some(LaneLight::Triangle(tri)) if diffuse => q.tri_lanes.load(k, tri, sel.pmf),
+                Some(LaneLight::Triangle(tri)) if diffuse => {
+                    q.tri_lanes.load(k, tri, sel.pmf, sel.mis_pmf)
+                }
                 _ => {
                     q.picked[k] = sel;
                     q.lone_light |= 1 << k;
@@ -965,6 +967,7 @@ impl<'a> Integrator<'a> {
         light_estimate(
             &ls,
             sel.pmf,
+            sel.mis_pmf,
             sh.bsdf,
             &sh.frame,
             sh.wo_local,

@@ -62,8 +62,8 @@ impl SelectorKind {
         candidates: super::ris_bvh::DEFAULT_CANDIDATES,
     };
 
-    /// Whether `pmf` is the exact probability of `sample`'s choice (all but `ris` and
-    /// `ris-bvh`, whose `pmf` is an estimate: see `ris.rs`).
+    /// Whether `sample`'s pmf is the exact probability of its choice (all but `ris` and
+    /// `ris-bvh`, which return RIS's 1/W, and a deterministic `mis_pmf` for MIS: see `ris.rs`).
     pub fn exact_pmf(self) -> bool {
         !matches!(self, SelectorKind::Ris { .. } | SelectorKind::RisBvh { .. })
     }

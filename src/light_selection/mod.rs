@@ -8,9 +8,10 @@
 //! estimated from low-resolution eye rays), [`spatial`] (a grid of per-cell tables built from
 //! conservative bounds), [`adaptive`] (the spatial grid, trained per cell by eye rays),
 //! [`online`] (the grid's tables learned while the image renders, per vertex class), and
-//! [`ris`] (resampled importance sampling of K power-sampled candidates; its `pmf` is RIS's
-//! contribution weight, not an exact probability: [`SelectorKind::exact_pmf`]) and [`ris_bvh`]
-//! (the same over K light-BVH-sampled candidates).
+//! [`ris`] (resampled importance sampling of K power-sampled candidates; `sample` returns the
+//! inverse of RIS's contribution weight, not an exact probability, and beside it the
+//! deterministic pmf MIS weights with: [`SelectedLight::mis_pmf`], [`SelectorKind::exact_pmf`])
+//! and [`ris_bvh`] (the same over K light-BVH-sampled candidates).
 //!
 //! Every strategy except `uniform` works on the *finite* lights (those with [`LightBounds`]);
 //! [`Selector`] wraps it and gives lights without bounds (environment, sky, distant) a fixed
@@ -62,8 +63,25 @@ pub struct ShadingPoint {
 pub struct SelectedLight {
     /// Index into `Scene::lights`.
     pub index: u32,
-    /// Probability of having chosen it.
+    /// What the light estimate divides by: the probability of having chosen it, or for
+    /// `ris` and `ris-bvh` the inverse of RIS's contribution weight (a random number whose
+    /// reciprocal is an unbiased estimate of the choice's 1/pmf).
     pub pmf: f32,
+    /// The probability the MIS weights use: [`LightSelector::pmf_at`] of this light at this
+    /// point, which a BSDF ray that reaches the light computes too, so the two techniques'
+    /// weights of every direction sum to 1 exactly. Equal to `pmf` for every exact selector.
+    pub mis_pmf: f32,
+}
+
+impl SelectedLight {
+    /// Light `index` chosen with the exact probability `pmf` (MIS uses the same).
+    pub fn exact(index: u32, pmf: f32) -> Self {
+        Self {
+            index,
+            pmf,
+            mis_pmf: pmf,
+        }
+    }
 }
 
 /// Chooses a light for a shading point.
@@ -107,6 +125,17 @@ pub trait FiniteSelector: Send + Sync {
     fn pmf_at(&self, ctx: &ShadingPoint, i: u32, secondary: bool) -> f32 {
         let _ = secondary;
         self.pmf(ctx, i)
+    }
+    /// [`Self::sample_at`] and, third, the pmf for the MIS weights
+    /// ([`SelectedLight::mis_pmf`]): [`Self::pmf_at`] of the chosen light, which is the second
+    /// number itself for every selector but RIS.
+    fn sample_mis_at(
+        &self,
+        ctx: &ShadingPoint,
+        u: f32,
+        secondary: bool,
+    ) -> Option<(u32, f32, f32)> {
+        self.sample_at(ctx, u, secondary).map(|(i, p)| (i, p, p))
     }
 }
 
@@ -206,11 +235,12 @@ impl LightSelector for Selector {
         if u < share {
             // Reuse u: rescaled to [0, 1) it still is uniform for the finite strategy.
             let v = (u / share).min(ONE_MINUS_EPS);
-            let (i, p) = self.finite.sample_at(ctx, v, secondary)?;
+            let (i, p, mis) = self.finite.sample_mis_at(ctx, v, secondary)?;
             let pmf = p * share;
             (pmf > 0.0).then(|| SelectedLight {
                 index: self.set.finite[i as usize],
                 pmf,
+                mis_pmf: mis * share,
             })
         } else {
             let n = self.set.other.len();
@@ -219,10 +249,10 @@ impl LightSelector for Selector {
             }
             let v = ((u - share) / (1.0 - share)).clamp(0.0, ONE_MINUS_EPS);
             let k = ((v * n as f32) as usize).min(n - 1);
-            Some(SelectedLight {
-                index: self.set.other[k],
-                pmf: (1.0 - share) / n as f32,
-            })
+            Some(SelectedLight::exact(
+                self.set.other[k],
+                (1.0 - share) / n as f32,
+            ))
         }
     }
 

@@ -9,15 +9,17 @@
 //! candidates and has no closed form. `sample` therefore returns, as its `pmf`, the inverse of
 //! RIS's *contribution weight* W = (1/p̂(y))·(1/K)·Σᵢ wᵢ: with it the light estimator
 //! f(y)·W is exactly unbiased (E[g(Y)·W] = Σₗ g(l) for every g that is zero where p̂ is;
-//! `tests/ris_selection.rs` checks this against the exhaustive sum). `pmf(ctx, l)` — which MIS
-//! asks for when a BSDF ray hits light l — cannot know the candidates of the light sample at
-//! the same vertex, so it returns the same form for a fresh candidate set conditioned to hold
-//! l: K·p̂(l) / (w(l) + Σ of K − 1 other candidates' w), the candidates drawn from a hash of the
-//! shading point (deterministic). That is an *estimate*: the two MIS weights of a path then
-//! sum to 1 only on average, so `ris` under MIS is consistent but not exactly unbiased (the
-//! test measures the bias; with `--strategy light` there is none). Exact MIS would need the
-//! integrator to weight the light sample with a deterministic pmf (e.g. the source's) while it
-//! divides by 1/W — a second number in `SelectedLight`.
+//! `tests/ris_selection.rs` checks this against the exhaustive sum). MIS needs more: the weight
+//! of a light sample and the weight a BSDF ray reaching the same light gets must sum to 1 for
+//! every direction, so both must use one *deterministic* pmf of (point, light) — 1/W is random,
+//! and weighting with it made the sum off by up to 0.63 (a bias, `integrator/mis_tests.rs`).
+//! That pmf is [`FiniteSelector::pmf`], and `sample_mis_at` returns it beside 1/W
+//! ([`crate::light_selection::SelectedLight::mis_pmf`]); since the light estimate g·W is
+//! unbiased for *any* g, including g = f·w_MIS, the MIS combination is exactly unbiased. Over
+//! power's candidates the pmf is RIS's form for a fresh candidate set (hashed from the shading
+//! point) conditioned to hold l, K·p̂(l) / (w(l) + Σ of K − 1 other candidates' w), an estimate
+//! of the choice's probability (power's own q, ignoring where the receiver is, made 1.78× the
+//! error); over the BVH it is the BVH's q ([`CandidateSource::MIS_BY_SOURCE`]).
 //!
 //! Lights whose importance is zero (cannot reach the receiver's upper hemisphere) are never
 //! chosen; every other light keeps a positive probability (its source probability is > 0).
@@ -31,6 +33,11 @@ use crate::sampling::hash::{hash_keys, hash_step, u32_to_unit};
 /// Where RIS draws its candidates from: a cheap selector whose probability of every light is
 /// known exactly (`power` here, the light BVH in `ris_bvh.rs`).
 pub trait CandidateSource: Send + Sync {
+    /// Whether RIS's deterministic pmf ([`FiniteSelector::pmf`], the one inside the MIS
+    /// weights) is the source's own probability q of the light (cheap, and as good as the
+    /// estimate of RIS's probability when the source already follows the light's importance,
+    /// as the BVH does) rather than that estimate (K − 1 more candidates per call).
+    const MIS_BY_SOURCE: bool;
     /// Draw one candidate with the uniform number `u`: (local light, its exact probability q).
     /// `None` counts as a candidate of weight zero (the source's "nowhere" mass).
     fn draw(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)>;
@@ -55,6 +62,9 @@ pub trait CandidateSource: Send + Sync {
 pub type Drawn = Option<(u32, f32, Option<f32>)>;
 
 impl CandidateSource for PowerSelector {
+    // Power ignores where the receiver is, so its q makes poor MIS weights: with it `ris`'s
+    // relMSE was 1.78× the estimate's on many-rooms and many-open (docs/many-lights.md).
+    const MIS_BY_SOURCE: bool = false;
     #[inline]
     fn draw(&self, _ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
         self.pick(u)
@@ -284,11 +294,24 @@ impl<S: CandidateSource> FiniteSelector for Ris<S> {
         (pmf > 0.0 && pmf.is_finite()).then_some((l, pmf))
     }
 
+    fn sample_mis_at(
+        &self,
+        ctx: &ShadingPoint,
+        u: f32,
+        _secondary: bool,
+    ) -> Option<(u32, f32, f32)> {
+        let (l, inv_w) = self.sample(ctx, u)?;
+        Some((l, inv_w, self.pmf(ctx, l)))
+    }
+
     fn pmf(&self, ctx: &ShadingPoint, light: u32) -> f32 {
         if light as usize >= self.bounds.len() {
             return 0.0;
         }
         let (q, given) = self.source.prob_and_target(ctx, light);
+        if S::MIS_BY_SOURCE {
+            return q;
+        }
         let t = given.unwrap_or_else(|| self.target(ctx, light));
         if t <= 0.0 || q <= 0.0 {
             return 0.0;

@@ -19,10 +19,7 @@ impl UniformSelector {
             return None;
         }
         let index = ((u * count as f32) as u32).min(count - 1);
-        Some(SelectedLight {
-            index,
-            pmf: 1.0 / count as f32,
-        })
+        Some(SelectedLight::exact(index, 1.0 / count as f32))
     }
 }
 

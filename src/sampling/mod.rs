@@ -10,6 +10,7 @@ pub mod distribution1d;
 pub mod distribution2d;
 pub mod equal_area;
 pub mod error;
+pub mod f64_lanes;
 pub mod frame;
 pub mod hash;
 pub mod pattern;
@@ -27,7 +28,7 @@ pub use frame::Frame;
 pub use pattern::{Pattern, PatternKind, PixelSamples, SamplePattern, make_pattern};
 pub use permutation::{Permutation, permute};
 pub use spherical_rectangle::SphericalRectangle;
-pub use spherical_triangle::{SphericalProjection, SphericalTriangle};
+pub use spherical_triangle::{SolidAngleDraw, SphericalProjection, SphericalTriangle};
 pub use warps::*;
 
 /// The largest f32 strictly below 1, so that samples stay in [0, 1).

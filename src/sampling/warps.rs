@@ -60,153 +60,21 @@ pub fn sin_cos_turn(t: f32) -> (f32, f32) {
 }
 
 /// `(sin x, cos x)` in f64 for 0 ≤ x ≤ 8 only (the caller guarantees the range; outside it
-/// the result is inaccurate, never UB). Pure arithmetic and selects, so Arvo's sampler
-/// (x = ξ₁Ω ∈ [0, 2π]) runs in the solid-angle lane kernel without a libm call per lane.
-///
-/// Cody–Waite reduction by π/2 to the nearest quadrant q, in two parts (the high part has 8
-/// trailing zero bits, so q·hi is exact for the q ≤ 5 that occur), then Taylor series on
-/// |r| ≤ π/4 up to r¹⁵ / r¹⁶, whose truncation error (< 5e-17) is below f64 rounding. Error
-/// vs libm is tested (≤ 2 ulp).
+/// the result is inaccurate, never UB): [`super::f64_lanes::sin_cos_0_8`] at one lane (the
+/// algorithm and its constants live there, written once for one lane or four). Error vs
+/// libm is tested (≤ 2 ulp).
 #[inline(always)]
 pub fn sin_cos_0_8_f64(x: f64) -> (f64, f64) {
-    const PIO2_HI: f64 = f64::from_bits(std::f64::consts::FRAC_PI_2.to_bits() & !0xff);
-    // The zeroed bits, plus π/2 − FRAC_PI_2 (the part of π/2 that f64 cannot hold).
-    const PIO2_LO: f64 = (std::f64::consts::FRAC_PI_2 - PIO2_HI) + 6.123_233_995_736_766e-17;
-    // The nearest quadrant q by the 1.5·2⁵² trick: adding it rounds x·2/π to an integer
-    // (ulp 1 there) whose low bits are q's, and subtracting it again gives q exactly.
-    // Not `as i32`: its saturation was 16 scalar conversions per kernel loop (dbcda06).
-    const SHIFT: f64 = 6_755_399_441_055_744.0;
-    let shifted = x * std::f64::consts::FRAC_2_PI + SHIFT;
-    let q = shifted.to_bits();
-    let qf = shifted - SHIFT;
-    let r = (x - qf * PIO2_HI) - qf * PIO2_LO;
-    let r2 = r * r;
-    // 1/n! for the Taylor terms (exact to f64 rounding as constant expressions).
-    const F3: f64 = 1.0 / 6.0;
-    const F5: f64 = F3 / 20.0;
-    const F7: f64 = F5 / 42.0;
-    const F9: f64 = F7 / 72.0;
-    const F11: f64 = F9 / 110.0;
-    const F13: f64 = F11 / 156.0;
-    const F15: f64 = F13 / 210.0;
-    const F2: f64 = 0.5;
-    const F4: f64 = F2 / 12.0;
-    const F6: f64 = F4 / 30.0;
-    const F8: f64 = F6 / 56.0;
-    const F10: f64 = F8 / 90.0;
-    const F12: f64 = F10 / 132.0;
-    const F14: f64 = F12 / 182.0;
-    const F16: f64 = F14 / 240.0;
-    // Estrin's scheme (pairs, then powers r⁴, r⁸), not Horner: a dependency chain of 4
-    // multiply-adds instead of 7. The polynomials are damped by r² ≤ 0.62 in the result, so
-    // the slightly different rounding does not show.
-    let (r4, r8) = (r2 * r2, r2 * r2 * (r2 * r2));
-    let ps = (-F3 + r2 * F5) + r4 * (-F7 + r2 * F9) + r8 * ((-F11 + r2 * F13) - r4 * F15);
-    let sin_r = r + r * r2 * ps;
-    let pc = (F4 - r2 * F6) + r4 * (F8 - r2 * F10) + r8 * ((F12 - r2 * F14) + r4 * F16);
-    let cos_r = 1.0 - r2 * F2 + r2 * r2 * pc;
-    // Rotate by qπ/2 as in `sin_cos_turn`.
-    let (a, b) = if q & 1 == 0 {
-        (sin_r, cos_r)
-    } else {
-        (cos_r, sin_r)
-    };
-    let sin_sign = (q & 2) << 62;
-    let cos_sign = (q.wrapping_add(1) & 2) << 62;
-    (
-        f64::from_bits(a.to_bits() ^ sin_sign),
-        f64::from_bits(b.to_bits() ^ cos_sign),
-    )
+    super::f64_lanes::sin_cos_0_8(x)
 }
 
-/// `atan2(y, x)` in f64 (angle of (x, y) in [−π, π]) from plain arithmetic and selects: no
-/// libm call and no branch, so 16 lanes of the spherical triangle's solid angle,
-/// 2·atan2(|triple product|, 1 + a·b + b·c + c·a), run at once on every solid-angle light
-/// sample and MIS pdf. Within 2 ulp of libm over the whole domain
-/// (zeros, subnormals, huge and infinite values, both signs; tested); NaN in, NaN out.
-///
-/// Reduction: the octant swap gives t = n/d ∈ [0, 1] (n = min(|x|, |y|), d = max), then
-/// atan t = θc + atan((t − c)/(1 + tc)) for the nearest of c ∈ {0, ¼, ½, 1}, so the Taylor
-/// series only sees |r| ≤ 0.163 and converges to below f64 rounding by r²¹. The centres are
-/// powers of two so that r = (n − c·d)/(d + c·n) (one division) has an exact numerator: c·d
-/// is exact and the subtraction too (Sterbenz: each centre's range has c·d/2 ≤ n ≤ 2·c·d).
+/// `atan2(y, x)` in f64 (angle of (x, y) in [−π, π]) from plain arithmetic and selects:
+/// [`super::f64_lanes::atan2`] at one lane (the algorithm and its constants live there).
+/// Within 2 ulp of libm over the whole domain (zeros, subnormals, huge and infinite values,
+/// both signs; tested); NaN in, NaN out.
 #[inline(always)]
 pub fn atan2_f64(y: f64, x: f64) -> f64 {
-    // Boundaries between the centres: t = ⅛ (so that n ≥ c·d/2 for c = ¼), then the tangents
-    // of the mid-angles between atan ¼, atan ½ and π/4.
-    const B2: f64 = 0.369_924_076_215_481_23;
-    const B3: f64 = 0.720_759_220_056_126_5;
-    // atan ¼ and atan ½ in two parts (hi + lo), and the lo parts of π/4, π/2 and π.
-    const TH_Q_HI: f64 = 0.244_978_663_126_864_14;
-    const TH_Q_LO: f64 = 1.069_875_561_873_445_1e-17;
-    const TH_H_HI: f64 = 0.463_647_609_000_806_1;
-    const TH_H_LO: f64 = 2.269_877_745_296_168_7e-17;
-    const PI4_LO: f64 = 3.061_616_997_868_383e-17;
-    const PI2_LO: f64 = 6.123_233_995_736_766e-17;
-    const PI_LO: f64 = 1.224_646_799_147_353_2e-16;
-    let (ay, ax) = (y.abs(), x.abs());
-    let swap = ay > ax;
-    let (n, d) = if swap { (ax, ay) } else { (ay, ax) };
-    // Special cases by select: ∞/∞ is t = 1 (angle π/4 of the octant), 0/0 is t = 0.
-    let inf = n == f64::INFINITY && d == f64::INFINITY;
-    let n = if inf { 1.0 } else { n };
-    let d = if inf || d == 0.0 { 1.0 } else { d };
-    // Exact power-of-two scaling keeps d + c·n finite and c·d normal (t is unchanged).
-    let s = if d > 1e300 {
-        1.0 / 1024.0
-    } else if d < 1e-290 {
-        18_446_744_073_709_551_616.0 // 2⁶⁴
-    } else {
-        1.0
-    };
-    let (n, d) = (n * s, d * s);
-    let (c1, c2, c3) = (n > 0.125 * d, n > B2 * d, n > B3 * d);
-    let c = if c3 {
-        1.0
-    } else if c2 {
-        0.5
-    } else {
-        0.25
-    };
-    // Centre 0 divides n/d directly (no c·d term: it would be 0·∞ for d = ∞).
-    let num = if c1 { n - c * d } else { n };
-    let den = if c1 { d + c * n } else { d };
-    let r = num / den;
-    let r2 = r * r;
-    // Taylor coefficients 1/(2k+1) with alternating signs, r³ … r²¹, by Estrin's scheme
-    // (pairs, then powers r⁴, r⁸, r¹⁶): a chain of 5 multiply-adds instead of Horner's 10,
-    // which in scalar code is latency. p enters the result multiplied by r² ≤ 0.027.
-    let (r4, r8) = (r2 * r2, r2 * r2 * (r2 * r2));
-    let r16 = r8 * r8;
-    let p01 = -1.0 / 3.0 + r2 * (1.0 / 5.0);
-    let p23 = -1.0 / 7.0 + r2 * (1.0 / 9.0);
-    let p45 = -1.0 / 11.0 + r2 * (1.0 / 13.0);
-    let p67 = -1.0 / 15.0 + r2 * (1.0 / 17.0);
-    let p89 = -1.0 / 19.0 + r2 * (1.0 / 21.0);
-    let p = ((p01 + r4 * p23) + r8 * (p45 + r4 * p67)) + r16 * p89;
-    let atan_r = r + r * r2 * p;
-    let (th_hi, th_lo) = if c3 {
-        (std::f64::consts::FRAC_PI_4, PI4_LO)
-    } else if c2 {
-        (TH_H_HI, TH_H_LO)
-    } else if c1 {
-        (TH_Q_HI, TH_Q_LO)
-    } else {
-        (0.0, 0.0)
-    };
-    // atan t ∈ [0, π/4]; the octant maps it to k + σ·atan t, k ∈ {0, π/2, π}, σ = ±1.
-    let atan_t = th_hi + (th_lo + atan_r);
-    let neg = x.is_sign_negative();
-    let (k_hi, k_lo) = if swap {
-        (std::f64::consts::FRAC_PI_2, PI2_LO)
-    } else if neg {
-        (std::f64::consts::PI, PI_LO)
-    } else {
-        (0.0, 0.0)
-    };
-    let signed = if swap == neg { atan_t } else { -atan_t };
-    let a = k_hi + (k_lo + signed);
-    a.copysign(y)
+    super::f64_lanes::atan2(y, x)
 }
 
 /// [`spherical_direction`] with the azimuth given in turns (φ = 2πt, t ∈ [0, 1]), via
