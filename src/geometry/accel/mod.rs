@@ -1,5 +1,6 @@
 //! [`Geometry`]: every primitive of a scene behind one BVH — penumbra's 4-wide BVH with
-//! 4-triangle packets ([`super::wide`], the default), its own binned-SAH BVH2 ([`super::bvh`]) or
+//! 4-triangle packets ([`super::wide`], the default; its one-ray queries run on 8-wide nodes
+//! over the same packets where the CPU has AVX2), its own binned-SAH BVH2 ([`super::bvh`]) or
 //! obvhs's compressed-wide BVH (CWBVH), see [`Backend`]. The one-ray queries and hit records
 //! are here, the 16-ray packet queries in [`packet`].
 
