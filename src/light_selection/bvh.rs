@@ -27,7 +27,7 @@
 //! levels in parallel), then collapsed: each wide node takes its binary node's two children and
 //! keeps replacing the one with the most lights by its own two children until it has eight.
 
-use super::importance::union;
+use super::importance::{cone_angle, union, union_angles};
 use super::{FiniteSelector, ShadingPoint};
 use crate::isa::{Cpu, Kernel, Token};
 use crate::lights::LightBounds;
@@ -293,9 +293,9 @@ pub struct BvhSelector {
 /// Cost of a child with bounds `b` of a node of extent `parent` split along `dim` (pbrt-v4's
 /// SAOH: power × orientation measure × surface area × the parent's aspect penalty, which
 /// discourages splitting along the node's short axes).
-fn saoh_cost(b: &LightBounds, parent: Vec3, dim: usize) -> f32 {
-    let theta_o = b.cos_theta_o.clamp(-1.0, 1.0).acos();
-    let theta_e = b.cos_theta_e.clamp(-1.0, 1.0).acos();
+/// `(theta_o, theta_e)` are `b`'s cone angles ([`cone_angle`]), carried with the bounds so the
+/// split search takes no arc cosine per candidate.
+fn saoh_cost(b: &LightBounds, (theta_o, theta_e): (f32, f32), parent: Vec3, dim: usize) -> f32 {
     let theta_w = (theta_o + theta_e).min(PI);
     let sin_o = (1.0 - b.cos_theta_o * b.cos_theta_o).max(0.0).sqrt();
     let m_omega = 2.0 * PI * (1.0 - b.cos_theta_o)
@@ -313,10 +313,12 @@ fn saoh_cost(b: &LightBounds, parent: Vec3, dim: usize) -> f32 {
     b.phi.max(1e-30) * m_omega * kr * area.max(1e-12)
 }
 
-/// Item being built: its bounds and local light index.
+/// Item being built: its bounds, their cone angles and local light index.
 #[derive(Clone, Copy)]
 struct Item {
     b: LightBounds,
+    /// `b`'s (θo, θe) ([`cone_angle`]): taken once per light instead of at every union.
+    t: (f32, f32),
     centroid: Vec3,
     light: u32,
 }
@@ -431,6 +433,7 @@ impl BvhSelector {
             .enumerate()
             .map(|(i, b)| Item {
                 b: *b,
+                t: (cone_angle(b.cos_theta_o), cone_angle(b.cos_theta_e)),
                 centroid: (b.min + b.max) * 0.5,
                 light: i as u32,
             })
@@ -678,26 +681,26 @@ fn split(items: &mut [Item], depth: u32) -> usize {
         }
         let bucket_of =
             |c: Vec3| (((c[dim] - clo[dim]) / ext[dim] * BUCKETS as f32) as usize).min(BUCKETS - 1);
-        let mut buckets: [Option<LightBounds>; BUCKETS] = [None; BUCKETS];
+        let mut buckets: [Option<Bounds>; BUCKETS] = [None; BUCKETS];
         for it in items.iter() {
             let k = bucket_of(it.centroid);
             buckets[k] = Some(match &buckets[k] {
-                Some(b) => union(b, &it.b),
-                None => it.b,
+                Some((b, t)) => union_angles(b, *t, &it.b, it.t),
+                None => (it.b, it.t),
             });
         }
         // Suffix unions so every split costs O(1) unions.
-        let mut suffix: [Option<LightBounds>; BUCKETS] = [None; BUCKETS];
-        let mut acc: Option<LightBounds> = None;
+        let mut suffix: [Option<Bounds>; BUCKETS] = [None; BUCKETS];
+        let mut acc: Option<Bounds> = None;
         for k in (0..BUCKETS).rev() {
             acc = merge(acc, buckets[k]);
             suffix[k] = acc;
         }
-        let mut prefix: Option<LightBounds> = None;
+        let mut prefix: Option<Bounds> = None;
         for k in 0..BUCKETS - 1 {
             prefix = merge(prefix, buckets[k]);
-            if let (Some(a), Some(b)) = (prefix, suffix[k + 1]) {
-                let cost = saoh_cost(&a, parent, dim) + saoh_cost(&b, parent, dim);
+            if let (Some((a, ta)), Some((b, tb))) = (prefix, suffix[k + 1]) {
+                let cost = saoh_cost(&a, ta, parent, dim) + saoh_cost(&b, tb, parent, dim);
                 if cost < best.0 {
                     best = (cost, dim, k);
                 }
@@ -718,9 +721,12 @@ fn split(items: &mut [Item], depth: u32) -> usize {
     }
 }
 
-fn merge(a: Option<LightBounds>, b: Option<LightBounds>) -> Option<LightBounds> {
+/// Bounds with their cone angles (θo, θe), as the split search carries them.
+type Bounds = (LightBounds, (f32, f32));
+
+fn merge(a: Option<Bounds>, b: Option<Bounds>) -> Option<Bounds> {
     match (a, b) {
-        (Some(a), Some(b)) => Some(union(&a, &b)),
+        (Some((a, ta)), Some((b, tb))) => Some(union_angles(&a, ta, &b, tb)),
         (x, None) | (None, x) => x,
     }
 }

@@ -107,22 +107,119 @@ pub fn importance(p: Vec3, n: Vec3, b: &LightBounds) -> f32 {
 
 /// The union of two light bounds: box union, a cone containing both cones, summed power.
 pub fn union(a: &LightBounds, b: &LightBounds) -> LightBounds {
+    union_with_angles(a, (0.0, 0.0), b, (0.0, 0.0), false).0
+}
+
+/// The half angle θ = acos(cos) of a cone as [`cone_union`] measures it (cos clamped to [−1, 1]).
+#[inline]
+pub fn cone_angle(cos: f32) -> f32 {
+    cos.clamp(-1.0, 1.0).acos()
+}
+
+/// [`union`] for bounds whose angles (θo, θe) = ([`cone_angle`] of cos θo, of cos θe) are
+/// already known, returning the union's angles too: the same bounds bit for bit, with the
+/// arc cosines a build would otherwise take again at every later union and cost.
+#[inline]
+pub fn union_angles(
+    a: &LightBounds,
+    ta: (f32, f32),
+    b: &LightBounds,
+    tb: (f32, f32),
+) -> (LightBounds, (f32, f32)) {
+    union_with_angles(a, ta, b, tb, true)
+}
+
+/// `union`'s one body: with `known`, `ta`/`tb` are the inputs' angles and the result's are
+/// returned; without, the angles are computed where needed and the returned ones are zero.
+#[inline(always)]
+fn union_with_angles(
+    a: &LightBounds,
+    ta: (f32, f32),
+    b: &LightBounds,
+    tb: (f32, f32),
+    known: bool,
+) -> (LightBounds, (f32, f32)) {
     if a.phi.is_nan() || a.phi <= 0.0 {
-        return *b;
+        return (*b, tb);
     }
     if b.phi.is_nan() || b.phi <= 0.0 {
-        return *a;
+        return (*a, ta);
     }
-    let (w, cos_o) = cone_union(a.w, a.cos_theta_o, b.w, b.cos_theta_o);
-    LightBounds {
-        min: a.min.min(b.min),
-        max: a.max.max(b.max),
-        w,
-        phi: a.phi + b.phi,
-        cos_theta_o: cos_o,
-        cos_theta_e: a.cos_theta_e.min(b.cos_theta_e),
-        two_sided: a.two_sided || b.two_sided,
+    let (w, cos_o, theta_o) = if a.w == b.w {
+        // Same axis (e.g. every light facing down): no trigonometry needed.
+        let c = a.cos_theta_o.min(b.cos_theta_o);
+        (a.w, c, pick_angle(c, a.cos_theta_o, ta.0, tb.0))
+    } else {
+        let (theta_a, theta_b) = if known {
+            (ta.0, tb.0)
+        } else {
+            (cone_angle(a.cos_theta_o), cone_angle(b.cos_theta_o))
+        };
+        match cone_union_angles(a.w, theta_a, b.w, theta_b) {
+            Cone::A => (a.w, a.cos_theta_o, ta.0),
+            Cone::B => (b.w, b.cos_theta_o, tb.0),
+            Cone::Whole => (a.w, -1.0, if known { cone_angle(-1.0) } else { 0.0 }),
+            Cone::New(w, c) => (w, c, if known { cone_angle(c) } else { 0.0 }),
+        }
+    };
+    let cos_e = a.cos_theta_e.min(b.cos_theta_e);
+    (
+        LightBounds {
+            min: a.min.min(b.min),
+            max: a.max.max(b.max),
+            w,
+            phi: a.phi + b.phi,
+            cos_theta_o: cos_o,
+            cos_theta_e: cos_e,
+            two_sided: a.two_sided || b.two_sided,
+        },
+        (theta_o, pick_angle(cos_e, a.cos_theta_e, ta.1, tb.1)),
+    )
+}
+
+/// The angle of `c` = `ca.min(cb)`: `ca`'s where `min` returned `ca`, else `cb`'s.
+#[inline(always)]
+fn pick_angle(c: f32, ca: f32, ta: f32, tb: f32) -> f32 {
+    if c.to_bits() == ca.to_bits() { ta } else { tb }
+}
+
+/// What [`cone_union`] returns for two different axes.
+enum Cone {
+    /// The first cone contains the second.
+    A,
+    /// The second contains the first.
+    B,
+    /// Every direction (cos = −1, axis: the first's).
+    Whole,
+    /// A new axis and cos of its half angle.
+    New(Vec3, f32),
+}
+
+/// [`cone_union`]'s case analysis for axes `wa` ≠ `wb` with half angles θa, θb.
+#[inline(always)]
+fn cone_union_angles(wa: Vec3, theta_a: f32, wb: Vec3, theta_b: f32) -> Cone {
+    let theta_d = wa.dot(wb).clamp(-1.0, 1.0).acos();
+    if (theta_d + theta_b).min(std::f32::consts::PI) <= theta_a {
+        return Cone::A;
     }
+    if (theta_d + theta_a).min(std::f32::consts::PI) <= theta_b {
+        return Cone::B;
+    }
+    let theta_o = (theta_a + theta_d + theta_b) * 0.5;
+    if theta_o >= std::f32::consts::PI {
+        return Cone::Whole;
+    }
+    let theta_r = theta_o - theta_a;
+    let axis = wa.cross(wb);
+    if axis.length_squared() < 1e-12 {
+        return Cone::Whole;
+    }
+    let w = glam::Quat::from_axis_angle(axis.normalize(), theta_r) * wa;
+    // A little slack so f32 rounding of the rotation cannot leave a normal outside the cone.
+    Cone::New(
+        w.normalize(),
+        (theta_o + 1e-4).min(std::f32::consts::PI).cos(),
+    )
 }
 
 /// The smallest cone (axis, cos of half angle) around two cones (pbrt-v4 `Union(DirectionCone)`).
@@ -131,28 +228,10 @@ pub fn cone_union(wa: Vec3, cos_a: f32, wb: Vec3, cos_b: f32) -> (Vec3, f32) {
     if wa == wb {
         return (wa, cos_a.min(cos_b));
     }
-    let theta_a = cos_a.clamp(-1.0, 1.0).acos();
-    let theta_b = cos_b.clamp(-1.0, 1.0).acos();
-    let theta_d = wa.dot(wb).clamp(-1.0, 1.0).acos();
-    if (theta_d + theta_b).min(std::f32::consts::PI) <= theta_a {
-        return (wa, cos_a);
+    match cone_union_angles(wa, cone_angle(cos_a), wb, cone_angle(cos_b)) {
+        Cone::A => (wa, cos_a),
+        Cone::B => (wb, cos_b),
+        Cone::Whole => (wa, -1.0),
+        Cone::New(w, c) => (w, c),
     }
-    if (theta_d + theta_a).min(std::f32::consts::PI) <= theta_b {
-        return (wb, cos_b);
-    }
-    let theta_o = (theta_a + theta_d + theta_b) * 0.5;
-    if theta_o >= std::f32::consts::PI {
-        return (wa, -1.0);
-    }
-    let theta_r = theta_o - theta_a;
-    let axis = wa.cross(wb);
-    if axis.length_squared() < 1e-12 {
-        return (wa, -1.0);
-    }
-    let w = glam::Quat::from_axis_angle(axis.normalize(), theta_r) * wa;
-    // A little slack so f32 rounding of the rotation cannot leave a normal outside the cone.
-    (
-        w.normalize(),
-        (theta_o + 1e-4).min(std::f32::consts::PI).cos(),
-    )
 }
