@@ -293,15 +293,8 @@ pub struct BvhSelector {
 /// Cost of a child with bounds `b` of a node of extent `parent` split along `dim` (pbrt-v4's
 /// SAOH: power × orientation measure × surface area × the parent's aspect penalty, which
 /// discourages splitting along the node's short axes).
-/// `(theta_o, theta_e)` are `b`'s cone angles ([`cone_angle`]), carried with the bounds so the
-/// split search takes no arc cosine per candidate.
-fn saoh_cost(b: &LightBounds, (theta_o, theta_e): (f32, f32), parent: Vec3, dim: usize) -> f32 {
-    let theta_w = (theta_o + theta_e).min(PI);
-    let sin_o = (1.0 - b.cos_theta_o * b.cos_theta_o).max(0.0).sqrt();
-    let m_omega = 2.0 * PI * (1.0 - b.cos_theta_o)
-        + PI / 2.0
-            * (2.0 * theta_w * sin_o - (theta_o - 2.0 * theta_w).cos() - 2.0 * theta_o * sin_o
-                + b.cos_theta_o);
+/// `m_omega` is `b`'s [`orientation_measure`].
+fn saoh_cost(b: &LightBounds, m_omega: f32, parent: Vec3, dim: usize) -> f32 {
     let d = b.max - b.min;
     let kr = if parent[dim] > 0.0 {
         parent.max_element() / parent[dim]
@@ -311,6 +304,37 @@ fn saoh_cost(b: &LightBounds, (theta_o, theta_e): (f32, f32), parent: Vec3, dim:
     let area = 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
     // A tiny area floor keeps coplanar point-like groups comparable.
     b.phi.max(1e-30) * m_omega * kr * area.max(1e-12)
+}
+
+/// The solid-angle measure of the directions a cone of normals (cos θo, with angles
+/// `(theta_o, theta_e)` from [`cone_angle`]) can emit into: the SAOH's orientation term.
+fn orientation_measure(cos_o: f32, (theta_o, theta_e): (f32, f32)) -> f32 {
+    let theta_w = (theta_o + theta_e).min(PI);
+    let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
+    2.0 * PI * (1.0 - cos_o)
+        + PI / 2.0
+            * (2.0 * theta_w * sin_o - (theta_o - 2.0 * theta_w).cos() - 2.0 * theta_o * sin_o
+                + cos_o)
+}
+
+/// The last [`orientation_measure`] taken and the cone it was for (cos θo, cos θe bits): the
+/// split search's running unions keep the same cone over many buckets once it is wide, so
+/// most candidates reuse it instead of taking a cosine.
+#[derive(Default)]
+struct MeasureMemo(Option<(u64, f32)>);
+
+impl MeasureMemo {
+    fn get(&mut self, (b, t): &Bounds) -> f32 {
+        let key = (b.cos_theta_o.to_bits() as u64) << 32 | b.cos_theta_e.to_bits() as u64;
+        match self.0 {
+            Some((k, m)) if k == key => m,
+            _ => {
+                let m = orientation_measure(b.cos_theta_o, *t);
+                self.0 = Some((key, m));
+                m
+            }
+        }
+    }
 }
 
 /// Item being built: its bounds, their cone angles and local light index.
@@ -675,6 +699,7 @@ fn split(items: &mut [Item], depth: u32) -> usize {
         return by_count(items);
     }
     let mut best = (f32::INFINITY, 0usize, 0usize);
+    let (mut memo_lo, mut memo_hi) = (MeasureMemo::default(), MeasureMemo::default());
     for dim in 0..3 {
         if ext[dim].is_nan() || ext[dim] <= 0.0 {
             continue;
@@ -699,8 +724,9 @@ fn split(items: &mut [Item], depth: u32) -> usize {
         let mut prefix: Option<Bounds> = None;
         for k in 0..BUCKETS - 1 {
             prefix = merge(prefix, buckets[k]);
-            if let (Some((a, ta)), Some((b, tb))) = (prefix, suffix[k + 1]) {
-                let cost = saoh_cost(&a, ta, parent, dim) + saoh_cost(&b, tb, parent, dim);
+            if let (Some(a), Some(b)) = (prefix, suffix[k + 1]) {
+                let cost = saoh_cost(&a.0, memo_lo.get(&a), parent, dim)
+                    + saoh_cost(&b.0, memo_hi.get(&b), parent, dim);
                 if cost < best.0 {
                     best = (cost, dim, k);
                 }
