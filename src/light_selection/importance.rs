@@ -155,7 +155,7 @@ fn union_with_angles(
         } else {
             (cone_angle(a.cos_theta_o), cone_angle(b.cos_theta_o))
         };
-        match cone_union_angles(a.w, theta_a, b.w, theta_b) {
+        match cone_union_angles(a.w, a.cos_theta_o, theta_a, b.w, theta_b) {
             Cone::A => (a.w, a.cos_theta_o, ta.0),
             Cone::B => (b.w, b.cos_theta_o, tb.0),
             Cone::Whole => (a.w, -1.0, if known { cone_angle(-1.0) } else { 0.0 }),
@@ -195,10 +195,19 @@ enum Cone {
     New(Vec3, f32),
 }
 
-/// [`cone_union`]'s case analysis for axes `wa` ≠ `wb` with half angles θa, θb.
+/// [`cone_union`]'s case analysis for axes `wa` ≠ `wb` with half angles θa (cos θa = `cos_a`)
+/// and θb.
 #[inline(always)]
-fn cone_union_angles(wa: Vec3, theta_a: f32, wb: Vec3, theta_b: f32) -> Cone {
-    let theta_d = wa.dot(wb).clamp(-1.0, 1.0).acos();
+fn cone_union_angles(wa: Vec3, cos_a: f32, theta_a: f32, wb: Vec3, theta_b: f32) -> Cone {
+    let cos_d = wa.dot(wb).clamp(-1.0, 1.0);
+    // A single direction (one planar emitter, θb = 0) inside the first cone: glibc's acosf
+    // is non-increasing (checked on every f32 in [−1, 1]), so cos θd ≥ cos θa gives θd ≤ θa
+    // and the first test below passes, as it must (the direction is in the cone). The common
+    // case of a build adding one light to a group, without an arc cosine.
+    if theta_b == 0.0 && cos_d >= cos_a.clamp(-1.0, 1.0) {
+        return Cone::A;
+    }
+    let theta_d = cos_d.acos();
     if (theta_d + theta_b).min(std::f32::consts::PI) <= theta_a {
         return Cone::A;
     }
@@ -228,7 +237,7 @@ pub fn cone_union(wa: Vec3, cos_a: f32, wb: Vec3, cos_b: f32) -> (Vec3, f32) {
     if wa == wb {
         return (wa, cos_a.min(cos_b));
     }
-    match cone_union_angles(wa, cone_angle(cos_a), wb, cone_angle(cos_b)) {
+    match cone_union_angles(wa, cos_a, cone_angle(cos_a), wb, cone_angle(cos_b)) {
         Cone::A => (wa, cos_a),
         Cone::B => (wb, cos_b),
         Cone::Whole => (wa, -1.0),
