@@ -288,7 +288,14 @@ pub struct BvhSelector {
     slot: Vec<u32>,
     /// The instruction set the traversal runs on ([`Cpu::dispatch`]).
     cpu: Cpu,
+    /// Levels of the deepest walk (wide nodes from the root to a leaf's node).
+    levels: usize,
 }
+
+/// Walks at most this deep (every tree below 8^16 lights unless degenerate) record their
+/// per-level probabilities in a 16-entry array: zeroing it per sample costs a quarter of
+/// the full `MAX_DEPTH` one's stores.
+const SHALLOW: usize = 16;
 
 /// Cost of a child with bounds `b` of a node of extent `parent` split along `dim` (pbrt-v4's
 /// SAOH: power × orientation measure × surface area × the parent's aspect penalty, which
@@ -406,7 +413,8 @@ fn build_binary(items: &mut [Item], depth: u32) -> Vec<BNode> {
 
 /// Collapse the binary tree below `b` (an index into `bin`) into wide node `out.nodes.len()`,
 /// depth first; returns its index.
-fn collapse(bin: &[BNode], b: usize, parent: u32, out: &mut BvhSelector) -> u32 {
+fn collapse(bin: &[BNode], b: usize, parent: u32, level: usize, out: &mut BvhSelector) -> u32 {
+    out.levels = out.levels.max(level);
     let mut kids: Vec<usize> = if bin[b].light == u32::MAX {
         vec![bin[b].left as usize, bin[b].right as usize]
     } else {
@@ -429,7 +437,7 @@ fn collapse(bin: &[BNode], b: usize, parent: u32, out: &mut BvhSelector) -> u32 
     out.parent.push(parent);
     for (k, &c) in kids.iter().enumerate() {
         let child = if bin[c].light == u32::MAX {
-            collapse(bin, c, me << 3 | k as u32, out)
+            collapse(bin, c, me << 3 | k as u32, level + 1, out)
         } else {
             out.slot[bin[c].light as usize] = me << 3 | k as u32;
             LEAF | bin[c].light
@@ -447,6 +455,7 @@ impl BvhSelector {
             parent: Vec::new(),
             slot: vec![u32::MAX; bounds.len()],
             cpu: Cpu::detect(),
+            levels: 0,
         };
         if bounds.is_empty() {
             return s;
@@ -464,7 +473,7 @@ impl BvhSelector {
             .collect();
         let bin = build_binary(&mut items, 0);
         s.nodes.reserve(bin.len() / (WIDTH - 1) + 1);
-        collapse(&bin, 0, u32::MAX, &mut s);
+        collapse(&bin, 0, u32::MAX, 1, &mut s);
         s
     }
 
@@ -499,10 +508,20 @@ impl BvhSelector {
     /// probabilities bottom-up (as `pmf_impl` does).
     #[inline(always)]
     fn sample_impl(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
+        if self.levels <= SHALLOW {
+            self.sample_walk::<SHALLOW>(ctx, u)
+        } else {
+            self.sample_walk::<{ MAX_DEPTH as usize }>(ctx, u)
+        }
+    }
+
+    /// [`Self::sample_impl`] for trees at most `N` levels deep.
+    #[inline(always)]
+    fn sample_walk<const N: usize>(&self, ctx: &ShadingPoint, u: f32) -> Option<(u32, f32)> {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut probs = [0.0f64; MAX_DEPTH as usize];
+        let mut probs = [0.0f64; N];
         let mut levels = 0;
         let mut u = u as f64;
         let mut i = 0usize;
