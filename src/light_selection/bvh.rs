@@ -944,6 +944,8 @@ mod tests {
             })
             .collect();
         let bvh = BvhSelector::new(&bounds);
+        // The walk's probability array is sized by the recorded depth.
+        assert_eq!(bvh.levels, bvh.depth());
         let mut checked = 0;
         for j in 0..200 {
             let f = j as f32;
