@@ -580,6 +580,21 @@ impl BvhSelector {
         us: &[f32],
         out: &mut [Option<(u32, f32, f32)>],
     ) {
+        if self.levels <= SHALLOW {
+            self.sample_many_walk::<SHALLOW>(ctx, us, out)
+        } else {
+            self.sample_many_walk::<{ MAX_DEPTH as usize }>(ctx, us, out)
+        }
+    }
+
+    /// [`Self::sample_many_impl`] for trees at most `N` levels deep.
+    #[inline(always)]
+    fn sample_many_walk<const N: usize>(
+        &self,
+        ctx: &ShadingPoint,
+        us: &[f32],
+        out: &mut [Option<(u32, f32, f32)>],
+    ) {
         const CACHED: usize = 8;
         let mut cached = [u32::MAX; CACHED];
         let mut imps = [[0.0f32; WIDTH]; CACHED];
@@ -591,7 +606,7 @@ impl BvhSelector {
             if self.nodes.is_empty() {
                 continue;
             }
-            let mut probs = [0.0f64; MAX_DEPTH as usize];
+            let mut probs = [0.0f64; N];
             let mut levels = 0;
             let mut u = u0 as f64;
             let mut i = 0usize;
