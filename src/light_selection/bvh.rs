@@ -752,12 +752,12 @@ fn split(items: &mut [Item], depth: u32) -> usize {
         let mut suffix: [Option<Bounds>; BUCKETS] = [None; BUCKETS];
         let mut acc: Option<Bounds> = None;
         for k in (0..BUCKETS).rev() {
-            acc = merge(acc, buckets[k]);
+            merge_into(&mut acc, &buckets[k]);
             suffix[k] = acc;
         }
         let mut prefix: Option<Bounds> = None;
         for k in 0..BUCKETS - 1 {
-            prefix = merge(prefix, buckets[k]);
+            merge_into(&mut prefix, &buckets[k]);
             if let (Some(a), Some(b)) = (prefix, suffix[k + 1]) {
                 let cost = saoh_cost(&a.0, memo_lo.get(&a), parent, dim)
                     + saoh_cost(&b.0, memo_hi.get(&b), parent, dim);
@@ -784,10 +784,14 @@ fn split(items: &mut [Item], depth: u32) -> usize {
 /// Bounds with their cone angles (θo, θe), as the split search carries them.
 type Bounds = (LightBounds, (f32, f32));
 
-fn merge(a: Option<Bounds>, b: Option<Bounds>) -> Option<Bounds> {
-    match (a, b) {
-        (Some((a, ta)), Some((b, tb))) => Some(union_angles(&a, ta, &b, tb)),
-        (x, None) | (None, x) => x,
+/// `acc` ∪ `b` into `acc` (an empty side contributes nothing), by reference: an empty bucket
+/// then costs no copy of the running bounds.
+fn merge_into(acc: &mut Option<Bounds>, b: &Option<Bounds>) {
+    if let Some((b, tb)) = b {
+        *acc = Some(match acc {
+            Some((a, ta)) => union_angles(a, *ta, b, *tb),
+            None => (*b, *tb),
+        });
     }
 }
 
