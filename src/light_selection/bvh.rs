@@ -758,9 +758,9 @@ fn split(items: &mut [Item], depth: u32) -> usize {
         let mut prefix: Option<Bounds> = None;
         for k in 0..BUCKETS - 1 {
             merge_into(&mut prefix, &buckets[k]);
-            if let (Some(a), Some(b)) = (prefix, suffix[k + 1]) {
-                let cost = saoh_cost(&a.0, memo_lo.get(&a), parent, dim)
-                    + saoh_cost(&b.0, memo_hi.get(&b), parent, dim);
+            if let (Some(a), Some(b)) = (&prefix, &suffix[k + 1]) {
+                let cost = saoh_cost(&a.0, memo_lo.get(a), parent, dim)
+                    + saoh_cost(&b.0, memo_hi.get(b), parent, dim);
                 if cost < best.0 {
                     best = (cost, dim, k);
                 }
