@@ -64,17 +64,7 @@ fn closest8_and_any8_agree_with_the_4_wide_queries_on_dense_random_triangles() {
             }
         })
         .collect();
-    let boxes: Vec<(Vec3, Vec3)> = prims
-        .iter()
-        .map(|p| {
-            (
-                p.p[0].min(p.p[1]).min(p.p[2]),
-                p.p[0].max(p.p[1]).max(p.p[2]),
-            )
-        })
-        .collect();
-    let tree = Tree2::ploc(&boxes);
-    let w = WideBvh::build(&tree, &prims, &[]).expect("tree too deep");
+    let w = wide_of(&prims);
     assert!(w.has_nodes8());
     // Memory: the 8-wide nodes share the packets; a node is twice a 4-wide one (256 vs 128
     // bytes) but there are fewer (measured: 4-wide nodes 20.8, 8-wide nodes 28.9, packets
@@ -205,16 +195,7 @@ fn ties_on_shared_edges_and_vertices_give_the_4_wide_hit() {
             }
         }
     }
-    let boxes: Vec<(Vec3, Vec3)> = prims
-        .iter()
-        .map(|p| {
-            (
-                p.p[0].min(p.p[1]).min(p.p[2]),
-                p.p[0].max(p.p[1]).max(p.p[2]),
-            )
-        })
-        .collect();
-    let w = WideBvh::build(&Tree2::ploc(&boxes), &prims, &[]).expect("tree too deep");
+    let w = wide_of(&prims);
     let mut s = pcg_from_keys(&[90]);
     let rays: Vec<Ray> = (0..100_000)
         .map(|_| {
@@ -233,4 +214,18 @@ fn ties_on_shared_edges_and_vertices_give_the_4_wide_hit() {
         hits += c4.is_some() as usize;
     }
     assert!(hits > rays.len() / 4, "{hits} hits of {}", rays.len());
+}
+
+/// The wide BVH (both node widths) over triangles `prims`, built as the scene build does.
+fn wide_of(prims: &[Primitive]) -> WideBvh {
+    let boxes: Vec<(Vec3, Vec3)> = prims
+        .iter()
+        .map(|p| {
+            (
+                p.p[0].min(p.p[1]).min(p.p[2]),
+                p.p[0].max(p.p[1]).max(p.p[2]),
+            )
+        })
+        .collect();
+    WideBvh::build(&Tree2::ploc(&boxes), prims, &[]).expect("tree too deep")
 }

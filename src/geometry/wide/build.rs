@@ -11,6 +11,38 @@ use std::ops::Range;
 /// Subtrees with at most this many primitives become a single leaf.
 const LEAF_PRIMS: usize = 4;
 
+/// Whether binary node `k` becomes one leaf of the wide trees (at most [`LEAF_PRIMS`]
+/// primitives, or no children).
+pub(super) fn is_leaf(tree: &Tree2, k: usize) -> bool {
+    tree.nodes[k].range.len() <= LEAF_PRIMS || tree.nodes[k].children.is_none()
+}
+
+/// The children of a wide node over binary node `n2`: its two children, then the one with the
+/// largest surface area opened in place until there are `width` (or only leaves are left); a
+/// subtree of at most [`LEAF_PRIMS`] primitives stays one leaf. The 4-wide and 8-wide
+/// collapses share it, so both trees' leaves are the same packets.
+pub(super) fn open_children(tree: &Tree2, n2: usize, width: usize) -> Vec<usize> {
+    let nodes = &tree.nodes;
+    let mut kids: Vec<usize> = match nodes[n2].children {
+        Some(c) if !is_leaf(tree, n2) => c.to_vec(),
+        _ => vec![n2],
+    };
+    while kids.len() < width {
+        let widest = kids
+            .iter()
+            .enumerate()
+            .filter(|&(_, &k)| !is_leaf(tree, k))
+            .max_by(|a, b| nodes[*a.1].half_area().total_cmp(&nodes[*b.1].half_area()));
+        let Some((i, &k)) = widest else { break };
+        let Some([a, b]) = nodes[k].children else {
+            break;
+        };
+        kids[i] = a;
+        kids.push(b);
+    }
+    kids
+}
+
 impl Node4 {
     /// No child: inverted boxes, which every ray misses.
     const EMPTY: Node4 = Node4 {
@@ -105,28 +137,11 @@ impl WideBvh {
         n2: usize,
     ) {
         let nodes = &tree.nodes;
-        let is_leaf = |k: usize| nodes[k].range.len() <= LEAF_PRIMS || nodes[k].children.is_none();
-        let mut kids: Vec<usize> = match nodes[n2].children {
-            Some(c) if !is_leaf(n2) => c.to_vec(),
-            _ => vec![n2],
-        };
-        while kids.len() < 4 {
-            let widest = kids
-                .iter()
-                .enumerate()
-                .filter(|&(_, &k)| !is_leaf(k))
-                .max_by(|a, b| nodes[*a.1].half_area().total_cmp(&nodes[*b.1].half_area()));
-            let Some((i, &k)) = widest else { break };
-            let Some([a, b]) = nodes[k].children else {
-                break;
-            };
-            kids[i] = a;
-            kids.push(b);
-        }
+        let kids = open_children(tree, n2, 4);
         let idx = self.nodes.len();
         self.nodes.push(Node4::EMPTY);
         for (lane, &k) in kids.iter().enumerate() {
-            let child = if is_leaf(k) {
+            let child = if is_leaf(tree, k) {
                 let child = LEAF | self.leaf(tree, prims, called_back, nodes[k].range.clone());
                 leaf_of[k] = child;
                 child

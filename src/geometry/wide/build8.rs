@@ -5,11 +5,9 @@
 //! exactly when it is a leaf candidate whose ancestors are not (leaves are never split), so
 //! both trees have the same leaves and share their packets.
 
+use super::build::{is_leaf, open_children};
 use super::{LEAF, Node8};
 use crate::geometry::tree2::Tree2;
-
-/// Subtrees with at most this many primitives are leaves (as in the 4-wide collapse).
-const LEAF_PRIMS: usize = 4;
 
 impl Node8 {
     /// No child: inverted boxes, which every ray misses.
@@ -35,28 +33,11 @@ pub(super) fn collapse8(tree: &Tree2, leaf_of: &[u32]) -> Vec<Node8> {
 /// if a leaf has no reference.
 fn collapse(tree: &Tree2, leaf_of: &[u32], out: &mut Vec<Node8>, n2: usize) -> Option<()> {
     let nodes = &tree.nodes;
-    let is_leaf = |k: usize| nodes[k].range.len() <= LEAF_PRIMS || nodes[k].children.is_none();
-    let mut kids: Vec<usize> = match nodes[n2].children {
-        Some(c) if !is_leaf(n2) => c.to_vec(),
-        _ => vec![n2],
-    };
-    while kids.len() < 8 {
-        let widest = kids
-            .iter()
-            .enumerate()
-            .filter(|&(_, &k)| !is_leaf(k))
-            .max_by(|a, b| nodes[*a.1].half_area().total_cmp(&nodes[*b.1].half_area()));
-        let Some((i, &k)) = widest else { break };
-        let Some([a, b]) = nodes[k].children else {
-            break;
-        };
-        kids[i] = a;
-        kids.push(b);
-    }
+    let kids = open_children(tree, n2, 8);
     let idx = out.len();
     out.push(Node8::EMPTY);
     for (lane, &k) in kids.iter().enumerate() {
-        let child = if is_leaf(k) {
+        let child = if is_leaf(tree, k) {
             let child = leaf_of[k];
             if child & LEAF == 0 || child == u32::MAX {
                 return None;
