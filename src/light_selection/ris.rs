@@ -317,33 +317,14 @@ impl<S: CandidateSource> FiniteSelector for Ris<S> {
             return 0.0;
         }
         let w = t as f64 / q as f64;
+        // The hashed estimate's K − 1 other candidates are i.i.d. draws of the source even
+        // for a stratified `sample`: any deterministic function of (point, light) keeps the
+        // MIS weights summing to 1, and only power's RIS (never stratified) asks for it.
         let key = self.point_key(ctx, 2);
         let mut sum = w;
-        if self.stratified {
-            // The K − 1 others through the source's batched draw, in ascending order (their
-            // sum does not depend on the order).
-            let n = (self.k - 1) as usize;
-            let mut us = [0.0f32; INLINE_CANDIDATES];
-            let mut drawn: [Drawn; INLINE_CANDIDATES] = [None; INLINE_CANDIDATES];
-            for start in (0..n).step_by(INLINE_CANDIDATES) {
-                let m = (n - start).min(INLINE_CANDIDATES);
-                for (j, v) in us[..m].iter_mut().enumerate() {
-                    *v = unit(hash_step(key, (start + j + 1) as u64));
-                }
-                us[..m].sort_unstable_by(f32::total_cmp);
-                self.source.draw_many(ctx, &us[..m], &mut drawn[..m]);
-                for &(l, qi, ti) in drawn[..m].iter().flatten() {
-                    let ti = ti.unwrap_or_else(|| self.target(ctx, l));
-                    if qi > 0.0 && ti > 0.0 {
-                        sum += ti as f64 / qi as f64;
-                    }
-                }
-            }
-        } else {
-            for i in 1..self.k {
-                if let Some((_, _, wi)) = self.candidate(ctx, key, i) {
-                    sum += wi;
-                }
+        for i in 1..self.k {
+            if let Some((_, _, wi)) = self.candidate(ctx, key, i) {
+                sum += wi;
             }
         }
         (self.k as f64 * t as f64 / sum) as f32
